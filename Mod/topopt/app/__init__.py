@@ -1,0 +1,1 @@
+"""Headless part of TopOpt: never imports FreeCADGui or PySide."""

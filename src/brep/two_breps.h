@@ -1,0 +1,28 @@
+// The input of the whole method: the part Ω and the non-design solids Ω̄ as two separate
+// B-Rep models, checked, indexed and classified against each other.
+#pragma once
+#include <TopoDS_Shape.hxx>
+#include <string>
+#include <vector>
+
+#include "brep/classify.h"
+#include "brep/topology_index.h"
+#include "common/progress.h"
+
+namespace topopt::brep {
+
+struct TwoBReps {
+  TopologyIndex part;          ///< Ω: one solid, numbered as FreeCAD numbers it
+  TopologyIndex nondesign;     ///< Ω̄: a compound of solids Ω1..ΩN in input order (may be empty)
+  Classification nd_on_part;   ///< where each vertex, edge and face of Ω̄ lies on Ω
+  ContainmentReport relations; ///< contacts among the Ωi, warnings
+  std::vector<std::string> notes;  ///< repairs made while checking the inputs
+};
+
+/// Checks both inputs (check_solids), indexes them, verifies that every Ωi lies inside Ω and
+/// that no two overlap, and classifies Ω̄ against Ω. `nondesign` may be a null shape (no
+/// non-design solids). Throws topopt::Error with a message naming what to fix.
+TwoBReps load_two_breps(const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
+                        const ClassifyParams& params = {}, const Progress& progress = {});
+
+}  // namespace topopt::brep

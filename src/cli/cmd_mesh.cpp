@@ -1,0 +1,11 @@
+// topopt mesh: not built yet; the issue that brings this stage replaces this file.
+#include "cli/commands.h"
+#include "common/error.h"
+
+namespace topopt::cli {
+
+int cmd_mesh(const Args&) {
+  throw Error(ErrorCode::Internal, "'topopt mesh' is not available in this build yet");
+}
+
+}  // namespace topopt::cli

@@ -1,0 +1,39 @@
+// Sub-commands of build/topopt. Each takes the arguments after its name and returns the exit
+// code; a topopt::Error escaping one is printed by main with its code.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace topopt::cli {
+
+using Args = std::vector<std::string>;
+
+int cmd_info(const Args& args);
+int cmd_mesh(const Args& args);
+int cmd_solve(const Args& args);
+int cmd_optimize(const Args& args);
+
+/// Small argument reader shared by the sub-commands: `--name value` options, `--flag`
+/// switches and positionals. Unknown options are an error with the usage text.
+class ArgReader {
+ public:
+  ArgReader(const Args& args, std::string usage);
+  /// Value of --name, or `fallback` if absent. Throws InvalidParameter if given without a value.
+  std::string option(const std::string& name, const std::string& fallback = "");
+  double number(const std::string& name, double fallback);
+  bool flag(const std::string& name);
+  bool has(const std::string& name) const;
+  /// Remaining positional arguments; call after every option and flag has been read.
+  /// Throws InvalidParameter naming any option that was not consumed.
+  std::vector<std::string> positionals();
+  bool wants_help() const { return help_; }
+  const std::string& usage() const { return usage_; }
+
+ private:
+  std::vector<std::string> args_;
+  std::vector<bool> used_;
+  std::string usage_;
+  bool help_ = false;
+};
+
+}  // namespace topopt::cli

@@ -1,0 +1,120 @@
+// build/topopt: meshing, analysis and topology optimisation from the shell.
+#include <Standard_Failure.hxx>
+#include <cstring>
+#include <iostream>
+#include <map>
+
+#include "cli/commands.h"
+#include "common/error.h"
+
+namespace topopt::cli {
+
+ArgReader::ArgReader(const Args& args, std::string usage)
+    : args_(args), used_(args.size(), false), usage_(std::move(usage)) {
+  for (size_t i = 0; i < args_.size(); ++i)
+    if (args_[i] == "--help" || args_[i] == "-h") help_ = true, used_[i] = true;
+}
+
+std::string ArgReader::option(const std::string& name, const std::string& fallback) {
+  for (size_t i = 0; i < args_.size(); ++i) {
+    if (args_[i] != "--" + name) continue;
+    if (i + 1 >= args_.size())
+      throw Error(ErrorCode::InvalidParameter, "--" + name + " needs a value\n" + usage_);
+    used_[i] = used_[i + 1] = true;
+    return args_[i + 1];
+  }
+  return fallback;
+}
+
+double ArgReader::number(const std::string& name, double fallback) {
+  std::string s = option(name);
+  if (s.empty()) return fallback;
+  try {
+    size_t end = 0;
+    double v = std::stod(s, &end);
+    if (end != s.size()) throw std::invalid_argument(s);
+    return v;
+  } catch (const std::exception&) {
+    throw Error(ErrorCode::InvalidParameter, "--" + name + " takes a number, not '" + s + "'");
+  }
+}
+
+bool ArgReader::flag(const std::string& name) {
+  for (size_t i = 0; i < args_.size(); ++i)
+    if (args_[i] == "--" + name) return used_[i] = true;
+  return false;
+}
+
+bool ArgReader::has(const std::string& name) const {
+  for (const auto& a : args_)
+    if (a == "--" + name) return true;
+  return false;
+}
+
+std::vector<std::string> ArgReader::positionals() {
+  std::vector<std::string> out;
+  for (size_t i = 0; i < args_.size(); ++i) {
+    if (used_[i]) continue;
+    if (args_[i].rfind("--", 0) == 0)
+      throw Error(ErrorCode::InvalidParameter, "unknown option " + args_[i] + "\n" + usage_);
+    out.push_back(args_[i]);
+  }
+  return out;
+}
+
+}  // namespace topopt::cli
+
+namespace {
+
+const char* kUsage =
+    "usage: topopt <command> [options]\n"
+    "commands:\n"
+    "  info      check the part and non-design solids; print topology and classification\n"
+    "  mesh      mesh part and non-design solids into one tagged tetrahedral mesh\n"
+    "  solve     linear elastic analysis of a job file\n"
+    "  optimize  topology optimisation of a job file: mesh, SIMP, result surface\n"
+    "Run 'topopt <command> --help' for a command's options.\n";
+
+/// Exit codes: 0 success, 1 user error (message printed), 2 usage, 3 internal error.
+int exit_code_for(topopt::ErrorCode code) {
+  switch (code) {
+    case topopt::ErrorCode::InvalidParameter: return 2;
+    case topopt::ErrorCode::Internal: return 3;
+    default: return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace topopt::cli;
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::map<std::string, int (*)(const Args&)> commands{
+      {"info", cmd_info}, {"mesh", cmd_mesh}, {"solve", cmd_solve}, {"optimize", cmd_optimize}};
+  auto it = commands.find(argv[1]);
+  if (it == commands.end()) {
+    std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;
+    return 2;
+  }
+  Args args(argv + 2, argv + argc);
+  try {
+    return it->second(args);
+  } catch (const topopt::Error& e) {
+    std::cerr << "topopt " << argv[1] << ": error (" << topopt::error_code_name(e.code()) << "): " << e.what()
+              << "\n";
+    return exit_code_for(e.code());
+  } catch (const Standard_Failure& e) {
+    std::cerr << "topopt " << argv[1] << ": geometry kernel error: "
+              << (e.GetMessageString() ? e.GetMessageString() : "unknown") << "\n";
+    return 3;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "topopt " << argv[1] << ": out of memory: use a coarser mesh size\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "topopt " << argv[1] << ": internal error: " << e.what() << "\n";
+    return 3;
+  }
+}
