@@ -1,0 +1,45 @@
+// Supports and loads given on the part's B-Rep faces (FreeCAD numbering, "Face7"), turned
+// into fixed degrees of freedom and consistent nodal load vectors on a TetMesh.
+//
+// INTERFACE CONTRACT (SIMP, CLI, job files and the workbench rely on it).
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "fem/elasticity.h"
+
+namespace topopt::fem {
+
+/// One support on a set of faces.
+struct SupportSpec {
+  enum class Kind { Fixed, Components, Symmetry } kind = Kind::Fixed;
+  std::vector<int> faces;              ///< 1-based face numbers of Ω (FreeCAD FaceN)
+  std::array<bool, 3> fix{true, true, true};  ///< Components: which of x, y, z are fixed
+  // Symmetry: the faces must be planar; the normal component is fixed.
+};
+
+/// One load item; a load case is a list of them.
+struct LoadSpec {
+  enum class Kind { Force, Pressure, Gravity } kind = Kind::Force;
+  std::vector<int> faces;               ///< Force, Pressure: 1-based face numbers of Ω
+  std::array<double, 3> vector{0, 0, 0};///< Force: total force (N) spread by area;
+                                        ///< Gravity: acceleration (mm/s²)
+  double value = 0;                     ///< Pressure: MPa, positive pushes into the part
+};
+
+struct LoadCase {
+  std::string name;
+  std::vector<LoadSpec> items;
+  double weight = 1.0;  ///< weight in a multi-case objective
+};
+
+/// Fixed dofs of the supports. Throws Error(FaceNotFound) naming a face the mesh lacks and
+/// Error(NoSupport) if nothing is fixed.
+Supports make_supports(const TetMesh& mesh, const std::vector<SupportSpec>& specs);
+
+/// (3*#V) by #cases consistent nodal loads (area-weighted on the faces' triangles).
+Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
+                           const std::vector<LoadCase>& cases);
+
+}  // namespace topopt::fem
