@@ -1,6 +1,6 @@
 // Flat array types shared by all stages (geogram/libigl style): one row per entity.
 #pragma once
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <vector>
 
 namespace topopt {
