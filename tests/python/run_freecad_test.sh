@@ -16,5 +16,8 @@ if [ "$mode" = app ]; then
   exec freecadcmd -c "$code"
 else
   # The GUI runs under a virtual X server; the runner exits FreeCAD with the test status.
-  exec xvfb-run -a -s "-screen 0 1280x1024x24" freecad -c "$code"
+  # FreeCAD runs a .py given on its command line as a macro once the GUI is up. The Start
+  # page uses QtWebEngine, which will not start as root with its sandbox on.
+  export QTWEBENGINE_DISABLE_SANDBOX=1 QTWEBENGINE_CHROMIUM_FLAGS="--no-sandbox"
+  exec xvfb-run -a -s "-screen 0 1280x1024x24" freecad "$here/runner.py"
 fi

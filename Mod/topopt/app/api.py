@@ -123,3 +123,18 @@ def job_of(study):
     """The job dict the study runs (the same format as hand-written job files)."""
     from .job import study_to_job
     return study_to_job(study)
+
+
+def run(study, on_progress=None):
+    """Runs the study (mesh → SIMP → result surface) and returns the result Mesh feature.
+    on_progress(record) is called per stage and iteration; returning True cancels."""
+    from . import runner
+    return runner.run(study, on_progress)
+
+
+def export_stl(study, path):
+    """Writes the study's result shape to an STL file."""
+    if study.Result is None:
+        raise TopOptError("the study has no result yet: run it first", "InvalidParameter")
+    study.Result.Mesh.write(path)
+    return path
