@@ -1,4 +1,5 @@
 #include "brep/classify.h"
+#include "brep/point_locator.h"
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAlgoAPI_Common.hxx>
@@ -41,85 +42,6 @@ namespace {
 double default_tolerance(const TopologyIndex& base, const ClassifyParams& params) {
   return params.tolerance > 0 ? params.tolerance : 1e-6 * std::max(base.diagonal(), 1.0);
 }
-
-/// A hit of a point on an entity: which one, the parameters there, and the distance.
-struct Hit {
-  int index;
-  double t0, t1, distance;
-};
-
-/// Answers "which vertices / edges / faces of one model does this point lie on?".
-/// Built once per model; bounding boxes cut the candidates before any projection.
-class Prober {
- public:
-  Prober(const TopologyIndex& model, double tol) : m_(model), tol_(tol) {
-    edge_box_.resize(m_.num_edges());
-    for (int i = 0; i < m_.num_edges(); ++i) {
-      BRepBndLib::Add(m_.edges(i + 1), edge_box_[i], false);
-      edge_box_[i].Enlarge(tol_ + m_.edge_tolerance[i]);
-    }
-    face_box_.resize(m_.num_faces());
-    for (int i = 0; i < m_.num_faces(); ++i) {
-      BRepBndLib::Add(m_.faces(i + 1), face_box_[i], false);
-      face_box_[i].Enlarge(tol_ + m_.face_tolerance[i]);
-    }
-  }
-
-  std::vector<Hit> vertices_at(const gp_Pnt& p, double extra_tol) const {
-    std::vector<Hit> hits;
-    for (int i = 0; i < m_.num_vertices(); ++i) {
-      gp_Pnt q(m_.vertex_point(i, 0), m_.vertex_point(i, 1), m_.vertex_point(i, 2));
-      double d = p.Distance(q);
-      if (d <= tol_ + extra_tol + m_.vertex_tolerance[i]) hits.push_back({i, 0, 0, d});
-    }
-    return hits;
-  }
-
-  std::vector<Hit> edges_at(const gp_Pnt& p, double extra_tol) const {
-    std::vector<Hit> hits;
-    for (int i = 0; i < m_.num_edges(); ++i) {
-      if (m_.edge_degenerate[i] || edge_box_[i].IsOut(p)) continue;
-      const TopoDS_Edge& e = TopoDS::Edge(m_.edges(i + 1));
-      double first, last;
-      Handle(Geom_Curve) curve = BRep_Tool::Curve(e, first, last);
-      if (curve.IsNull()) continue;
-      gp_Pnt proj;
-      double param;
-      ShapeAnalysis_Curve sac;
-      double d = sac.Project(curve, p, tol_, proj, param, first, last, false);
-      if (d <= tol_ + extra_tol + m_.edge_tolerance[i]) hits.push_back({i, param, 0, d});
-    }
-    return hits;
-  }
-
-  std::vector<Hit> faces_at(const gp_Pnt& p, double extra_tol) const {
-    std::vector<Hit> hits;
-    for (int i = 0; i < m_.num_faces(); ++i) {
-      if (face_box_[i].IsOut(p)) continue;
-      const TopoDS_Face& f = TopoDS::Face(m_.faces(i + 1));
-      Handle(Geom_Surface) surface = BRep_Tool::Surface(f);
-      if (surface.IsNull()) continue;
-      double u0, u1, v0, v1;
-      BRepTools::UVBounds(f, u0, u1, v0, v1);
-      GeomAPI_ProjectPointOnSurf proj(p, surface, u0, u1, v0, v1);
-      if (proj.NbPoints() == 0) continue;
-      const double allowed = tol_ + extra_tol + m_.face_tolerance[i];
-      double d = proj.LowerDistance();
-      if (d > allowed) continue;
-      double u, v;
-      proj.LowerDistanceParameters(u, v);
-      BRepClass_FaceClassifier inside(f, gp_Pnt2d(u, v), allowed);
-      TopAbs_State state = inside.State();
-      if (state == TopAbs_IN || state == TopAbs_ON) hits.push_back({i, u, v, d});
-    }
-    return hits;
-  }
-
- private:
-  const TopologyIndex& m_;
-  double tol_;
-  std::vector<Bnd_Box> edge_box_, face_box_;
-};
 
 std::vector<gp_Pnt> edge_samples(const TopoDS_Edge& edge, int n) {
   std::vector<gp_Pnt> out;
@@ -216,7 +138,7 @@ std::string fmt(double x) {
 Classification classify(const TopologyIndex& base, const TopologyIndex& other,
                         const ClassifyParams& params) {
   const double tol = default_tolerance(base, params);
-  Prober probe(base, tol);
+  PointLocator probe(base, tol);
   ensure_triangulated(other.shape);
   Classification out;
 
@@ -356,7 +278,7 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
       Contact contact{i, j, {}};
       // Faces of a lying on faces of b: sample a's faces, probe b's.
       TopologyIndex bi = index_topology(b);
-      Prober probe_b(bi, tol);
+      PointLocator probe_b(bi, tol);
       for (const int* fa = nondesign.solid_faces.begin(i); fa != nondesign.solid_faces.end(i); ++fa) {
         for (const gp_Pnt& p : face_samples(TopoDS::Face(nondesign.faces(*fa + 1)), 12)) {
           auto hits = probe_b.faces_at(p, nondesign.face_tolerance[*fa]);

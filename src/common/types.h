@@ -23,6 +23,10 @@ struct TetMesh {
   VecXi domain;       ///< #T: 0 = design domain Ω0, i >= 1 = non-design solid Ωi (input order)
   MatX3i F;           ///< #F by 3 boundary triangles of Ω, oriented outwards
   VecXi face;         ///< #F: Ω's B-Rep face number, 1-based as FreeCAD's FaceN (0 if unknown)
+  /// #F (or empty): the face of the non-design compound Ω̄ that the triangle also lies on,
+  /// 1-based in FreeCAD's numbering of that compound; 0 if none. Lets loads and supports
+  /// act on a load pad's face where it forms part of Ω's boundary.
+  VecXi nd_face;
 };
 
 }  // namespace topopt

@@ -1,6 +1,7 @@
 #include "mesh/structured_box.h"
 
 #include <cassert>
+#include <cmath>
 
 #include "common/error.h"
 
@@ -80,9 +81,24 @@ TetMesh structured_box_mesh(const StructuredBoxParams& p) {
     }
   m.F.resize(tris.size(), 3);
   m.face.resize(tris.size());
+  m.nd_face = VecXi::Zero(tris.size());
   for (size_t f = 0; f < tris.size(); ++f) {
     m.F.row(f) << tris[f][0], tris[f][1], tris[f][2];
     m.face[f] = faces[f];
+    // The non-design box face this triangle lies on, numbered as in a compound of OCCT boxes
+    // (6 faces each, in the same order as the part's).
+    Eigen::RowVector3d c = (m.V.row(tris[f][0]) + m.V.row(tris[f][1]) + m.V.row(tris[f][2])) / 3.0;
+    const int axis = (faces[f] - 1) / 2;
+    const bool at_max = (faces[f] - 1) % 2 == 1;
+    for (size_t b = 0; b < p.nondesign.size() && !m.nd_face[f]; ++b) {
+      const auto& box = p.nondesign[b];
+      const double plane = at_max ? box[3 + axis] : box[axis];
+      const double eps = 1e-9 * (p.size[0] + p.size[1] + p.size[2]);
+      bool inside = std::abs(c[axis] - plane) <= eps;
+      for (int k = 0; k < 3 && inside; ++k)
+        if (k != axis) inside = c[k] > box[k] && c[k] < box[3 + k];
+      if (inside) m.nd_face[f] = static_cast<int>(6 * b) + faces[f];
+    }
   }
   return m;
 }

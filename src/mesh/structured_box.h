@@ -21,6 +21,8 @@ struct StructuredBoxParams {
 /// Each cell is split into 6 tets around its main diagonal (Kuhn split, the same in every
 /// cell, so the mesh is conformal). Boundary triangles carry the box's face numbers in
 /// OCCT/FreeCAD order: 1 x=min, 2 x=max, 3 y=min, 4 y=max, 5 z=min, 6 z=max.
+/// nd_face marks boundary triangles lying on a non-design box's face, numbered as FreeCAD
+/// numbers the faces of a compound of those boxes (box k's face j is 6k + j).
 /// Returns a TetMesh with positively oriented tets and outward boundary triangles.
 TetMesh structured_box_mesh(const StructuredBoxParams& params);
 
