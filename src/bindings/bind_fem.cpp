@@ -1,6 +1,57 @@
-// Python bindings of the fem stage (filled in by the issue that brings the stage).
+// Python bindings of the fem stage: a linear static solve on arrays.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
 #include "bindings/bindings.h"
+#include "common/error.h"
+#include "io/job.h"
+#include "pipeline/solve_job.h"
 
 namespace topopt::py {
-void bind_fem(pybind11::module_&) {}
+
+void bind_fem(pybind11::module_& m) {
+  m.def(
+      "solve",
+      [](const MatX3d& nodes, const MatX4i& tets, const MatX3i& tris, const VecXi& tri_face, const VecXi& domain,
+         const std::string& job_json) {
+        TetMesh mesh;
+        mesh.V = nodes;
+        mesh.T = tets;
+        mesh.F = tris;
+        mesh.face = tri_face;
+        mesh.domain = domain.size() ? domain : VecXi(VecXi::Zero(tets.rows()));
+        if (mesh.face.size() != mesh.F.rows())
+          throw Error(ErrorCode::InvalidParameter, "tri_face must have one face number per triangle");
+        if (mesh.domain.size() != mesh.T.rows())
+          throw Error(ErrorCode::InvalidParameter, "domain must have one tag per tet");
+        pipeline::SolveResult r;
+        {
+          pybind11::gil_scoped_release release;
+          io::Job job = io::parse_job(job_json, "");
+          r = pipeline::solve_job(job, mesh);
+        }
+        pybind11::dict out;
+        pybind11::list disp, vm;
+        for (size_t c = 0; c < r.case_names.size(); ++c) {
+          MatX3d U = Eigen::Map<const MatX3d>(r.U.col(c).data(), nodes.rows(), 3);
+          disp.append(U);
+          vm.append(r.von_mises[c]);
+        }
+        out["case_names"] = r.case_names;
+        out["displacement"] = disp;
+        out["von_mises"] = vm;
+        out["compliance"] = r.compliance;
+        return out;
+      },
+      pybind11::arg("nodes"), pybind11::arg("tets"), pybind11::arg("tris"), pybind11::arg("tri_face"),
+      pybind11::arg("domain"), pybind11::arg("job_json"),
+      R"doc(Linear static analysis on a tet mesh.
+
+nodes #V x 3 (mm), tets #T x 4 (0-based), tris #F x 3 boundary triangles with tri_face #F
+(FreeCAD face numbers, 1-based), domain #T (0 design, i non-design solid i); job_json: the
+job file text (material, supports, load_cases; see docs/job-format.md). Returns a dict:
+case_names, displacement (one #V x 3 array per case), von_mises (#T per case), compliance.
+Raises TopOptError (.code "NoSupport", "FaceNotFound", ...) naming what to fix.)doc");
+}
+
 }  // namespace topopt::py

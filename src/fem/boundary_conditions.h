@@ -16,7 +16,11 @@ struct SupportSpec {
   enum class Kind { Fixed, Components, Symmetry } kind = Kind::Fixed;
   std::vector<int> faces;              ///< 1-based face numbers of Ω (FreeCAD FaceN)
   std::array<bool, 3> fix{true, true, true};  ///< Components: which of x, y, z are fixed
-  // Symmetry: the faces must be planar; the normal component is fixed.
+  // Symmetry: the faces must be planar and perpendicular to x, y or z; the normal
+  // component is fixed.
+  /// Faces of the non-design compound Ω̄ ("NonDesign:FaceN", 1-based), matched through
+  /// TetMesh::nd_face where they form part of Ω's boundary (load pads).
+  std::vector<int> nd_faces;
 };
 
 /// One load item; a load case is a list of them.
@@ -26,6 +30,7 @@ struct LoadSpec {
   std::array<double, 3> vector{0, 0, 0};///< Force: total force (N) spread by area;
                                         ///< Gravity: acceleration (mm/s²)
   double value = 0;                     ///< Pressure: MPa, positive pushes into the part
+  std::vector<int> nd_faces;            ///< as SupportSpec::nd_faces
 };
 
 struct LoadCase {
@@ -38,7 +43,10 @@ struct LoadCase {
 /// Error(NoSupport) if nothing is fixed.
 Supports make_supports(const TetMesh& mesh, const std::vector<SupportSpec>& specs);
 
-/// (3*#V) by #cases consistent nodal loads (area-weighted on the faces' triangles).
+/// (3*#V) by #cases consistent nodal loads: a total force is spread over the faces'
+/// triangles by area (a third of each triangle's share to each of its nodes), a pressure
+/// acts along each triangle's inward normal, gravity loads every tet with ρ·vol/4 per node.
+/// Throws Error(FaceNotFound) for a face the mesh lacks.
 Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
                            const std::vector<LoadCase>& cases);
 
