@@ -37,6 +37,7 @@ int cmd_solve(const Args& args) {
   progress.report = [](const std::string& stage, double, const std::string& msg) {
     std::cerr << "[" << stage << "] " << msg << "\n";
   };
+  progress.log = [](LogLevel, const std::string& msg) { std::cerr << "  " << msg << "\n"; };
   TetMesh mesh = pipeline::job_mesh(job, progress);
   std::cout << "mesh: " << mesh.V.rows() << " nodes, " << mesh.T.rows() << " tets\n";
   pipeline::SolveResult r = pipeline::solve_job(job, mesh, sp, VecXd(), progress);

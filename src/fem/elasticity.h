@@ -28,6 +28,13 @@ struct SolverParams {
   double tolerance = 1e-8;             ///< iterative: relative residual
   int max_iterations = 5000;           ///< iterative
   int threads = 0;                     ///< assembly threads; 0 = hardware concurrency
+  /// Direct solver, after set_scale: first try conjugate gradients preconditioned by the
+  /// previous Cholesky factor (SIMP's stiffness changes little between iterations) and
+  /// refactorise only when that takes more than `recycle_iterations` iterations. The result
+  /// then meets `recycle_tolerance` (relative residual) instead of machine precision.
+  bool recycle_factor = true;
+  int recycle_iterations = 40;
+  double recycle_tolerance = 1e-9;
 };
 
 /// Dirichlet data: fixed degrees of freedom (3*node + component) with prescribed values.

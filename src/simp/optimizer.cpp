@@ -1,0 +1,185 @@
+// The SIMP loop (see optimizer.h).
+#include "simp/optimizer.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.h"
+#include "simp/update.h"
+
+namespace topopt::simp {
+
+double mean_edge_length(const TetMesh& mesh) {
+  double s = 0;
+  long n = 0;
+  for (long t = 0; t < mesh.T.rows(); t += std::max<long>(1, mesh.T.rows() / 20000))
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) s += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm(), ++n;
+  return n ? s / n : 0;
+}
+
+ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& material,
+                                     const fem::Supports& supports, const Eigen::MatrixXd& loads,
+                                     const std::vector<double>& weights, const SimpParams& params,
+                                     const Progress& progress)
+    : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
+  if (!(params.volume_fraction > 0 && params.volume_fraction < 1))
+    throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1 (e.g. 0.3)");
+  if (!(params.law.penalty >= 1)) throw Error(ErrorCode::InvalidParameter, "the SIMP penalty must be at least 1");
+  const long nt = mesh.T.rows();
+  for (long t = 0; t < nt; ++t)
+    if (mesh.domain.size() != nt || mesh.domain[t] == 0) design_.push_back(static_cast<int>(t));
+  const int nd = static_cast<int>(design_.size());
+  if (nd == 0)
+    throw Error(ErrorCode::InvalidParameter, "the mesh has no design elements: the non-design solids fill the part");
+  if (weights_.empty()) weights_.assign(loads.cols(), 1.0);
+  const VecXd volume = tet_volumes(mesh);
+  vd_.resize(nd);
+  for (int i = 0; i < nd; ++i) vd_[i] = volume[design_[i]];
+  design_volume_ = vd_.sum();
+  FilterParams fp = params.filter;
+  if (fp.radius <= 0) fp.radius = 2.5 * mean_edge_length(mesh);
+  filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
+  progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " +
+                std::to_string(filter_->mean_neighbours()) + " neighbours per element");
+  fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
+  scale_ = VecXd::Ones(nt);
+  if (!params.heaviside)
+    volume_weights_ = (params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
+}
+
+ComplianceProblem::~ComplianceProblem() = default;
+
+void ComplianceProblem::forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
+  rho_tilde = params_.sensitivity_filter ? x : filter_->apply(x);
+  rho_bar = rho_tilde;
+  if (params_.heaviside)
+    for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
+}
+
+VecXd ComplianceProblem::physical(const VecXd& x) const {
+  VecXd rt, rb;
+  forward(x, rt, rb);
+  return rb;
+}
+
+double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
+  const int nd = static_cast<int>(design_.size());
+  VecXd rho_tilde, rho_bar;
+  forward(x, rho_tilde, rho_bar);
+  // ---- FE analysis
+  for (int i = 0; i < nd; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
+  fe_->set_scale(scale_);
+  Eigen::MatrixXd U = fe_->solve(loads_, progress_);
+  // ---- objective and sensitivities (w.r.t. ρ̄)
+  double c = 0;
+  VecXd dc_bar = VecXd::Zero(nd);
+  for (long k = 0; k < loads_.cols(); ++k) {
+    c += weights_[k] * loads_.col(k).dot(U.col(k));
+    if (!dc) continue;
+    VecXd energy = fe_->element_energy(U.col(k));
+    for (int i = 0; i < nd; ++i) dc_bar[i] -= weights_[k] * params_.law.derivative(rho_bar[i]) * energy[design_[i]];
+  }
+  if (dc) {
+    // ---- chain rule back through projection and filter
+    if (params_.heaviside)
+      for (int i = 0; i < nd; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
+    *dc = params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar);
+  }
+  return c;
+}
+
+double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
+  if (volume_weights_.size()) {  // linear: cheap enough for OC's bisection
+    if (dv) *dv = volume_weights_;
+    return volume_weights_.dot(x);
+  }
+  VecXd rho_tilde, rho_bar;
+  forward(x, rho_tilde, rho_bar);
+  if (dv) {
+    VecXd g = vd_ / design_volume_;
+    if (params_.heaviside)
+      for (long i = 0; i < g.size(); ++i) g[i] *= proj_.derivative(rho_tilde[i]);
+    *dv = params_.sensitivity_filter ? g : filter_->apply_transpose(g);
+  }
+  return vd_.dot(rho_bar) / design_volume_;
+}
+
+VecXd ComplianceProblem::filter_sensitivity(const VecXd& x, const VecXd& dc) const {
+  return filter_->filter_sensitivity(x, dc);
+}
+
+SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
+                    const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
+                    const Progress& progress, const std::function<void(const IterationRecord&)>& on_iteration) {
+  if (params.max_iterations < 1) throw Error(ErrorCode::InvalidParameter, "the iteration cap must be at least 1");
+  ComplianceProblem problem(mesh, material, supports, loads, weights, params, progress);
+  SimpResult res;
+  res.design = problem.design();
+  const int nd = static_cast<int>(res.design.size());
+  Mma mma(nd, 1, params.move);
+  VecXd x = VecXd::Constant(nd, params.volume_fraction);
+  double previous = 0;
+  int calm = 0;
+  for (int it = 1; it <= params.max_iterations; ++it) {
+    auto t0 = std::chrono::steady_clock::now();
+    progress.check_cancel("the optimisation (iteration " + std::to_string(it) + ")");
+    // ---- FE analysis, objective and sensitivities
+    VecXd dc, dv;
+    double c = problem.compliance(x, &dc);
+    double vol = problem.volume_fraction(x, &dv);
+    // ---- filter (sensitivity filtering; the density filter is inside the chain rule)
+    if (params.sensitivity_filter) dc = problem.filter_sensitivity(x, dc);
+    // ---- update
+    VecXd xnew;
+    if (params.update == UpdateKind::OC) {
+      auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params.volume_fraction; };
+      xnew = oc_update(x, dc, dv.cwiseMax(1e-30), params.move, excess);
+    } else {
+      // objective scaled to about 1 so MMA's regularisation terms are well sized
+      double s = 1.0 / std::max(1e-300, std::abs(c));
+      VecXd f(1);
+      f[0] = vol / params.volume_fraction - 1;
+      Eigen::MatrixXd df = (dv / params.volume_fraction).transpose();
+      xnew = mma.update(x, c * s, dc * s, f, df);
+    }
+    double change = (xnew - x).cwiseAbs().maxCoeff();
+    x = xnew;
+
+    IterationRecord rec;
+    rec.iteration = it;
+    rec.compliance = c;
+    rec.volume_fraction = vol;
+    rec.change = change;
+    rec.beta = params.heaviside ? problem.beta() : 1.0;
+    rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.history.push_back(rec);
+    if (on_iteration) on_iteration(rec);
+    std::ostringstream msg;
+    msg << "iteration " << it << ": compliance " << c << ", volume " << vol << ", change " << change;
+    progress.say("simp", static_cast<double>(it) / params.max_iterations, msg.str());
+
+    // ---- convergence (only at full sharpness when projecting)
+    bool sharp = !params.heaviside || problem.beta() >= params.beta_max;
+    calm = (it > 1 && std::abs(c - previous) < params.tol_objective * std::abs(c)) ? calm + 1 : 0;
+    previous = c;
+    if (sharp && it > 1 && (change < params.tol_change || calm >= 5)) {
+      res.converged = true;
+      res.status = "converged after " + std::to_string(it) + " iterations";
+      break;
+    }
+    if (params.heaviside && it % params.beta_every == 0 && problem.beta() < params.beta_max) {
+      problem.set_beta(std::min(params.beta_max, 2 * problem.beta()));
+      calm = 0;
+    }
+  }
+  if (!res.converged) res.status = "iteration cap (" + std::to_string(params.max_iterations) + ") reached";
+  res.variables = x;
+  VecXd rho = problem.physical(x);
+  res.density = VecXd::Ones(mesh.T.rows());
+  for (int i = 0; i < nd; ++i) res.density[res.design[i]] = rho[i];
+  return res;
+}
+
+}  // namespace topopt::simp

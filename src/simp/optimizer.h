@@ -1,0 +1,104 @@
+// SIMP topology optimisation on a tagged tet mesh: minimum (weighted) compliance under a
+// volume fraction of the design domain. Reads like top88: FE analysis → objective and
+// sensitivities → filter → update, with the mesh-dependent parts built once outside the loop.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/progress.h"
+#include "common/types.h"
+#include "fem/elasticity.h"
+#include "simp/density_filter.h"
+#include "simp/simp_law.h"
+
+namespace topopt::simp {
+
+enum class UpdateKind { OC, MMA };
+
+struct SimpParams {
+  double volume_fraction = 0.3;  ///< of the design domain (Ω0), in (0, 1)
+  SimpLaw law;                   ///< penalty 3, e_min 1e-9
+  FilterParams filter;           ///< Gaussian; radius <= 0: 2.5 × mean element size
+  bool sensitivity_filter = false;  ///< filter sensitivities instead of densities
+  bool heaviside = false;        ///< Heaviside projection with β continuation
+  double beta_max = 32;          ///< continuation doubles β from 1 up to this
+  int beta_every = 20;           ///< iterations between doublings
+  UpdateKind update = UpdateKind::OC;
+  double move = 0.2;             ///< move limit per iteration
+  int max_iterations = 100;
+  double tol_change = 0.01;      ///< stop when max |Δx| falls below this
+  double tol_objective = 1e-4;   ///< ... or the relative objective change stays below this for 5 iterations
+  fem::SolverParams solver;
+};
+
+/// One iteration, as reported to the caller and kept in the history.
+struct IterationRecord {
+  int iteration = 0;
+  double compliance = 0;       ///< weighted compliance Σ w_k F_kᵀU_k (N·mm)
+  double volume_fraction = 0;  ///< of the design domain, with the physical densities
+  double change = 0;           ///< max |Δx|
+  double beta = 1;             ///< Heaviside sharpness (1 without projection)
+  double seconds = 0;          ///< wall time of this iteration
+};
+
+struct SimpResult {
+  VecXd density;        ///< #T physical densities ρ̄ (non-design tets 1)
+  VecXd variables;      ///< #D design variables x
+  std::vector<int> design;  ///< #D tet index of each variable
+  std::vector<IterationRecord> history;
+  bool converged = false;
+  std::string status;   ///< "converged after N iterations" / "iteration cap (N) reached"
+};
+
+/// The objective and constraint of SIMP as functions of the design variables x (#D): the
+/// filter, projection and FE model are built once; evaluate() runs one FE analysis.
+class ComplianceProblem {
+ public:
+  ComplianceProblem(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
+                    const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
+                    const Progress& progress = {});
+  ~ComplianceProblem();
+  /// Weighted compliance c(x) and, if dc is given, dc/dx (#D) through projection and filter.
+  double compliance(const VecXd& x, VecXd* dc = nullptr);
+  /// Volume fraction of the design domain with the physical densities, and d/dx if asked.
+  double volume_fraction(const VecXd& x, VecXd* dv = nullptr) const;
+  /// Physical densities ρ̄ (#D) of x.
+  VecXd physical(const VecXd& x) const;
+  /// Sensitivities of compliance filtered by Sigmund's filter (when params ask for it).
+  VecXd filter_sensitivity(const VecXd& x, const VecXd& dc) const;
+  const std::vector<int>& design() const { return design_; }
+  double beta() const { return proj_.beta; }
+  void set_beta(double b) { proj_.beta = b; }
+
+ private:
+  const TetMesh& mesh_;
+  SimpParams params_;
+  std::vector<int> design_;
+  VecXd vd_;
+  VecXd volume_weights_;  // without projection the volume is linear in x: w·x
+  double design_volume_ = 0;
+  std::unique_ptr<DensityFilter> filter_;
+  std::unique_ptr<fem::Elasticity> fe_;
+  Eigen::MatrixXd loads_;
+  std::vector<double> weights_;
+  Heaviside proj_;
+  Progress progress_;
+  VecXd scale_;
+  void forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const;
+};
+
+/// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1).
+/// on_iteration is called after every iteration; progress.cancelled stops at the next
+/// iteration with Error(Cancelled). Throws Error(InvalidParameter) for a volume fraction
+/// outside (0, 1) or a mesh without design tets, Error(NoSupport) for a singular system.
+SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
+                    const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
+                    const Progress& progress = {},
+                    const std::function<void(const IterationRecord&)>& on_iteration = {});
+
+/// Mean edge length of the mesh's tets (for default filter radii).
+double mean_edge_length(const TetMesh& mesh);
+
+}  // namespace topopt::simp

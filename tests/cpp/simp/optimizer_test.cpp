@@ -1,0 +1,179 @@
+// SIMP: gradients against finite differences, the volume constraint, non-design elements,
+// MMA against OC, cancellation, and the filter's basic properties.
+#include "simp/optimizer.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "mesh/structured_box.h"
+#include "simp/update.h"
+
+namespace topopt::simp {
+namespace {
+
+struct Case {
+  TetMesh mesh;
+  fem::Material mat;
+  fem::Supports supports;
+  Eigen::MatrixXd loads;
+};
+
+Case cantilever(std::array<int, 3> cells = {12, 4, 2}) {
+  Case c;
+  mesh::StructuredBoxParams p;
+  p.size = {30, 10, 5};
+  p.cells = cells;
+  p.nondesign = {{27.5, 0, 0, 30, 10, 5}};  // a load pad
+  c.mesh = mesh::structured_box_mesh(p);
+  c.supports = fem::make_supports(c.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
+  fem::LoadSpec push{fem::LoadSpec::Kind::Force, {2}, {0, 0, -60}, 0, {}};
+  c.loads = fem::make_loads(c.mesh, c.mat, {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}});
+  return c;
+}
+
+void check_gradient(SimpParams params, unsigned seed) {
+  Case c = cantilever({6, 2, 2});
+  params.solver.recycle_factor = false;  // every solve to machine precision
+  ComplianceProblem prob(c.mesh, c.mat, c.supports, c.loads, {1.0, 0.5}, params);
+  const int nd = static_cast<int>(prob.design().size());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.2, 0.8);
+  VecXd x(nd);
+  for (int i = 0; i < nd; ++i) x[i] = u(rng);
+  VecXd dc, dv;
+  double c0 = prob.compliance(x, &dc);
+  prob.volume_fraction(x, &dv);
+  // central differences; h balances truncation (h²) against the solver's round-off (1e-12/h)
+  const double h = 1e-4;
+  for (int i : {0, nd / 3, nd / 2, nd - 1}) {
+    VecXd xp = x, xm = x;
+    xp[i] += h, xm[i] -= h;
+    double fd = (prob.compliance(xp) - prob.compliance(xm)) / (2 * h);
+    EXPECT_NEAR(dc[i], fd, 1e-5 * std::abs(fd) + 1e-9 * std::abs(c0)) << "variable " << i;
+    double fdv = (prob.volume_fraction(xp) - prob.volume_fraction(xm)) / (2 * h);
+    EXPECT_NEAR(dv[i], fdv, 1e-6 * std::abs(fdv) + 1e-12);
+  }
+}
+
+TEST(Simp, ComplianceGradientMatchesFiniteDifferencesThroughTheFilter) {
+  SimpParams p;
+  p.filter.radius = 6;
+  check_gradient(p, 1);
+  p.filter.kind = FilterKind::Cone;
+  check_gradient(p, 2);
+}
+
+TEST(Simp, GradientThroughHeavisideProjection) {
+  SimpParams p;
+  p.filter.radius = 6;
+  p.heaviside = true;
+  check_gradient(p, 3);  // β = 1
+}
+
+TEST(Simp, OcMeetsTheVolumeAndKeepsNonDesignSolid) {
+  Case c = cantilever();
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.max_iterations = 40;
+  std::vector<IterationRecord> seen;
+  SimpResult r = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p, {}, [&](const IterationRecord& rec) { seen.push_back(rec); });
+  ASSERT_FALSE(r.history.empty());
+  EXPECT_EQ(seen.size(), r.history.size());
+  // volume of the design domain at the end, from the returned densities
+  VecXd vol = tet_volumes(c.mesh);
+  double kept = 0, total = 0;
+  for (long t = 0; t < c.mesh.T.rows(); ++t) {
+    if (c.mesh.domain[t] != 0) {
+      EXPECT_EQ(r.density[t], 1.0);
+      continue;
+    }
+    kept += vol[t] * r.density[t], total += vol[t];
+    EXPECT_GE(r.density[t], 0.0);
+    EXPECT_LE(r.density[t], 1.0);
+  }
+  EXPECT_NEAR(kept / total, 0.4, 0.005 * 0.4);
+  // the optimiser lowers compliance well below the uniform start
+  EXPECT_LT(r.history.back().compliance, 0.7 * r.history.front().compliance);
+}
+
+TEST(Simp, MmaReachesAboutTheSameDesignAsOc) {
+  Case c = cantilever();
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.max_iterations = 60;
+  SimpResult oc = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  p.update = UpdateKind::MMA;
+  SimpResult mma = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  double a = oc.history.back().compliance, b = mma.history.back().compliance;
+  EXPECT_NEAR(a, b, 0.05 * a);
+  EXPECT_NEAR(mma.history.back().volume_fraction, 0.4, 0.01);
+}
+
+TEST(Simp, MmaSolvesAConvexProblemWithTwoConstraints) {
+  // min Σ (x_i − 0.9)²  s.t.  Σ x_i / n <= 0.5,  x_0 − x_1 <= -0.2  (optimum: all 0.5 but
+  // x_1 = x_0 + 0.2; with n = 4 the volume then forces the others down)
+  const int n = 4;
+  Mma mma(n, 2, 0.3);
+  VecXd x = VecXd::Constant(n, 0.3);
+  for (int it = 0; it < 80; ++it) {
+    VecXd df0 = 2 * (x.array() - 0.9);
+    VecXd f(2);
+    f << x.mean() - 0.5, x[0] - x[1] + 0.2;
+    Eigen::MatrixXd df = Eigen::MatrixXd::Zero(2, n);
+    df.row(0).setConstant(1.0 / n);
+    df(1, 0) = 1, df(1, 1) = -1;
+    x = mma.update(x, (x.array() - 0.9).square().sum(), df0, f, df);
+  }
+  EXPECT_NEAR(x.mean(), 0.5, 2e-3);
+  EXPECT_NEAR(x[1] - x[0], 0.2, 2e-3);
+  // KKT by symmetry: x_2 = x_3, and x_0 + x_1 = 2 x_2 (the pair shares one multiplier)
+  EXPECT_NEAR(x[2], x[3], 1e-3);
+  EXPECT_NEAR(x[0] + x[1], 2 * x[2], 5e-3);
+}
+
+TEST(Simp, CancelAndBadInput) {
+  Case c = cantilever({6, 2, 2});
+  SimpParams p;
+  Progress cancel;
+  int calls = 0;
+  cancel.cancelled = [&] { return ++calls > 3; };
+  try {
+    optimize(c.mesh, c.mat, c.supports, c.loads, {}, p, cancel);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Cancelled);
+  }
+  p.volume_fraction = 1.2;
+  try {
+    optimize(c.mesh, c.mat, c.supports, c.loads, {}, p);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);
+  }
+}
+
+TEST(DensityFilter, PreservesConstantsAndVolume) {
+  Case c = cantilever({8, 3, 2});
+  std::vector<int> design;
+  for (long t = 0; t < c.mesh.T.rows(); ++t)
+    if (c.mesh.domain[t] == 0) design.push_back(static_cast<int>(t));
+  VecXd vol = tet_volumes(c.mesh);
+  for (FilterKind k : {FilterKind::Gaussian, FilterKind::Cone}) {
+    DensityFilter f(c.mesh, design, vol, {k, 4.0, 0});
+    VecXd ones = VecXd::Ones(design.size());
+    EXPECT_LT((f.apply(ones) - ones).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_GT(f.mean_neighbours(), 5);
+    // adjoint identity: <H x, y> = <x, Hᵀ y>
+    VecXd x = VecXd::Random(design.size()), y = VecXd::Random(design.size());
+    EXPECT_NEAR(f.apply(x).dot(y), x.dot(f.apply_transpose(y)), 1e-10);
+  }
+}
+
+}  // namespace
+}  // namespace topopt::simp
