@@ -1,6 +1,134 @@
-// Python bindings of the simp stage (filled in by the issue that brings the stage).
+// Python bindings of the whole run (mesh → SIMP → surface) and of the result surface alone.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+
 #include "bindings/bindings.h"
+#include "brep/shape_io.h"
+#include "common/error.h"
+#include "io/job.h"
+#include "pipeline/optimize_job.h"
+#include "pipeline/solve_job.h"
 
 namespace topopt::py {
-void bind_simp(pybind11::module_&) {}
+namespace pyb = pybind11;
+
+void bind_simp(pyb::module_& m) {
+  m.def(
+      "run_job",
+      [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep,
+         pyb::object callback) {
+        io::Job job = io::parse_job(job_json, "");
+        // The callback runs with the GIL held; returning True (or raising) cancels.
+        std::atomic<bool> stop{false};
+        std::string callback_error;
+        auto call = [&](pyb::dict d) {
+          if (callback.is_none() || stop) return;
+          pyb::gil_scoped_acquire gil;
+          try {
+            pyb::object r = callback(d);
+            if (!r.is_none() && r.cast<bool>()) stop = true;
+          } catch (const pyb::error_already_set& e) {
+            callback_error = e.what();
+            stop = true;
+          }
+        };
+        Progress progress;
+        progress.cancelled = [&] { return stop.load(); };
+        progress.report = [&](const std::string& stage, double fraction, const std::string& message) {
+          if (stage == "simp") return;  // iterations come as records below
+          pyb::gil_scoped_acquire gil;
+          pyb::dict d;
+          d["stage"] = stage, d["fraction"] = fraction, d["message"] = message;
+          call(d);
+        };
+        TetMesh mesh;
+        pipeline::OptimizeResult r;
+        {
+          pyb::gil_scoped_release release;
+          pipeline::optimize_settings(job);  // a bad setting is reported before meshing
+          if (!job.mesh_file.empty()) {
+            mesh = pipeline::job_mesh(job, progress);
+          } else {
+            if (part_brep.empty()) throw Error(ErrorCode::InvalidParameter, "no part given");
+            TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
+            TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
+            mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
+          }
+          progress.check_cancel("meshing");
+          r = pipeline::optimize_job(job, mesh, progress, [&](const simp::IterationRecord& rec) {
+            pyb::gil_scoped_acquire gil;
+            pyb::dict d;
+            d["iteration"] = rec.iteration, d["compliance"] = rec.compliance, d["volume"] = rec.volume_fraction,
+            d["change"] = rec.change, d["seconds"] = rec.seconds;
+            call(d);
+          });
+        }
+        if (!callback_error.empty()) throw Error(ErrorCode::Cancelled, "the progress callback raised: " + callback_error);
+        pyb::dict out;
+        out["nodes"] = mesh.V;
+        out["tets"] = mesh.T;
+        out["domain"] = mesh.domain;
+        out["boundary_triangles"] = mesh.F;
+        out["boundary_faces"] = mesh.face;
+        out["densities"] = r.simp.density;
+        pyb::list hist;
+        for (const auto& h : r.simp.history) {
+          pyb::dict d;
+          d["iteration"] = h.iteration, d["compliance"] = h.compliance, d["volume"] = h.volume_fraction,
+          d["change"] = h.change, d["seconds"] = h.seconds;
+          hist.append(d);
+        }
+        out["history"] = hist;
+        out["threshold"] = r.threshold;
+        out["surface_points"] = r.surface.V;
+        out["surface_triangles"] = r.surface.F;
+        out["surface_tags"] = r.surface.tag;
+        out["status"] = r.simp.status;
+        out["seconds"] = pyb::make_tuple(r.seconds_simp, r.seconds_surface);
+        return out;
+      },
+      pyb::arg("job_json"), pyb::arg("part_brep") = "", pyb::arg("nondesign_brep") = "",
+      pyb::arg("callback") = pyb::none(),
+      R"doc(Mesh, optimise and extract the result shape.
+
+job_json: job file text (docs/job-format.md; faces by FreeCAD name). part_brep, nondesign_brep:
+BREP strings (Shape.exportBrepToString()), unless the job names a mesh file. callback(dict) is
+called with {"stage", "fraction", "message"} while meshing and {"iteration", "compliance",
+"volume", "change", "seconds"} after each iteration; returning True cancels (TopOptError with
+.code "Cancelled"). Returns a dict: nodes #V x 3, tets #T x 4, domain #T, boundary_triangles,
+boundary_faces, densities #T, history (list of dicts), threshold, surface_points #P x 3,
+surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp, surface).)doc");
+
+  m.def(
+      "extract_surface",
+      [](const MatX3d& nodes, const MatX4i& tets, const VecXi& domain, const VecXd& density, double threshold,
+         double volume_fraction, int smoothing_iterations) {
+        TetMesh mesh;
+        mesh.V = nodes;
+        mesh.T = tets;
+        mesh.domain = domain.size() ? domain : VecXi(VecXi::Zero(tets.rows()));
+        if (density.size() != tets.rows() || mesh.domain.size() != tets.rows())
+          throw Error(ErrorCode::InvalidParameter, "one density and one domain tag per tet expected");
+        if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
+          throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
+        surface::TriSurface s;
+        {
+          pyb::gil_scoped_release release;
+          surface::SmoothParams sp;
+          sp.iterations = smoothing_iterations;
+          s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
+                                       volume_fraction, sp);
+        }
+        return pyb::make_tuple(s.V, s.F);
+      },
+      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold") = -1.0,
+      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20,
+      R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
+volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
+oriented outwards.)doc");
+}
+
 }  // namespace topopt::py

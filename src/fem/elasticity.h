@@ -33,7 +33,7 @@ struct SolverParams {
   /// refactorise only when that takes more than `recycle_iterations` iterations. The result
   /// then meets `recycle_tolerance` (relative residual) instead of machine precision.
   bool recycle_factor = true;
-  int recycle_iterations = 40;
+  int recycle_iterations = 20;
   double recycle_tolerance = 1e-9;
 };
 

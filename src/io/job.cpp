@@ -94,8 +94,6 @@ Job parse_job(const std::string& text, const std::string& base_dir) {
     if (job.mesh_size < 0) bad("mesh.size", "must be positive (mm), or 0 for automatic");
     if (job.mesh_min_size < 0) bad("mesh.min_size", "must be positive (mm), or 0 for automatic");
   }
-  if (job.part.empty() && job.mesh_file.empty())
-    bad("part", "is missing: give the part's STEP/BREP file, or a mesh with \"mesh\": {\"file\": ...}");
   if (j.contains("material")) {
     const json& m = j["material"];
     job.material.young = number(m, "E", job.material.young, "material.");

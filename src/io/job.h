@@ -16,7 +16,8 @@ namespace topopt::io {
 struct Job {
   nlohmann::json raw;
   std::string base_dir;           ///< folder of the job file ("" for a job given as text)
-  std::string part;               ///< Ω: STEP/IGES/BREP path ("" if only a mesh file is given)
+  std::string part;               ///< Ω: STEP/IGES/BREP path ("" if a mesh file is given, or the
+                                  ///< shapes come separately, as from the workbench)
   std::string nondesign;          ///< Ω̄: path, or "" for none
   std::string mesh_file;          ///< a ready MSH 4.1 mesh, or ""
   double mesh_size = 0;           ///< target element size (mm); 0 = automatic

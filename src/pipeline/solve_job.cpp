@@ -6,6 +6,8 @@
 
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
+#include "brep/two_breps.h"
+#include "mesh/gmsh_fragments.h"
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "io/inp.h"
@@ -22,22 +24,35 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 TetMesh job_mesh(const io::Job& job, const Progress& progress) {
-  if (!job.part.empty()) {
-    // Face names are checked against the part itself, so that a typo is reported as such
-    // and not as "no triangles on that face".
-    TopoDS_Shape part = brep::read_shape_file(job.part);
-    brep::TopologyIndex idx = brep::index_topology(part);
-    int nd_faces = -1;
-    if (!job.nondesign.empty()) nd_faces = brep::index_topology(brep::read_shape_file(job.nondesign)).num_faces();
-    io::check_faces(job, idx.num_faces(), nd_faces);
-  }
   if (!job.mesh_file.empty()) {
+    if (!job.part.empty()) {
+      // Face names are checked against the part itself, so that a typo is reported as such
+      // and not as "no triangles on that face".
+      TopoDS_Shape part = brep::read_shape_file(job.part);
+      int nd_faces = -1;
+      if (!job.nondesign.empty()) nd_faces = brep::index_topology(brep::read_shape_file(job.nondesign)).num_faces();
+      io::check_faces(job, brep::index_topology(part).num_faces(), nd_faces);
+    }
     progress.say("mesh", -1, "reading " + job.mesh_file);
     return io::read_msh(job.mesh_file);
   }
-  throw Error(ErrorCode::MeshingFailed,
-              "this build cannot mesh the part from its geometry yet: give a ready mesh with "
-              "\"mesh\": {\"file\": \"part.msh\"} (Gmsh MSH 4.1 with physical groups)");
+  if (job.part.empty())
+    throw Error(ErrorCode::InvalidParameter,
+                "job file: \"part\" is missing: give the part's STEP/BREP file, or a mesh with \"mesh\": {\"file\": ...}");
+  TopoDS_Shape part = brep::read_shape_file(job.part);
+  TopoDS_Shape nd = job.nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(job.nondesign);
+  return mesh_job_shapes(job, part, nd, progress);
+}
+
+TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
+                        const Progress& progress) {
+  progress.say("mesh", -1, "checking the part and the non-design solids");
+  brep::TwoBReps model = brep::load_two_breps(part, nondesign, {}, progress);
+  io::check_faces(job, model.part.num_faces(), model.nondesign.num_faces());
+  mesh::FragmentMeshParams mp;
+  mp.size = job.mesh_size;
+  mp.min_size = job.mesh_min_size;
+  return mesh::mesh_with_gmsh_fragments(model, mp, progress);
 }
 
 SolveResult solve_job(const io::Job& job, const TetMesh& mesh, const fem::SolverParams& solver,

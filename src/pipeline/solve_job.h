@@ -1,6 +1,7 @@
 // The analysis path shared by the CLI (`topopt solve`) and the Python module: a job's mesh,
 // its supports and loads, the solve and the result files.
 #pragma once
+#include <TopoDS_Shape.hxx>
 #include <string>
 #include <vector>
 
@@ -11,11 +12,16 @@
 
 namespace topopt::pipeline {
 
-/// The mesh of a job: the MSH file of "mesh.file" if given, else the two-B-Rep mesh of the
-/// part and non-design solids. Checks that supports and loads name faces that exist.
+/// The mesh of a job: the MSH file of "mesh.file" if given, else the conformal tagged mesh
+/// of the part and non-design solids (interim: mesh/gmsh_fragments.h). Checks that supports and loads name faces that exist.
 /// Throws Error(Io) for an unreadable file, Error(MeshingFailed) if meshing fails,
 /// Error(FaceNotFound) for a face the part lacks.
 TetMesh job_mesh(const io::Job& job, const Progress& progress = {});
+
+/// The mesh of a job whose shapes are given (the workbench passes them as BREP strings):
+/// checks and classifies them, checks the face names, meshes at the job's mesh size.
+TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
+                        const Progress& progress = {});
 
 /// Results of a linear static analysis, one entry per load case.
 struct SolveResult {

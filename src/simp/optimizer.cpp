@@ -39,7 +39,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   for (int i = 0; i < nd; ++i) vd_[i] = volume[design_[i]];
   design_volume_ = vd_.sum();
   FilterParams fp = params.filter;
-  if (fp.radius <= 0) fp.radius = 2.5 * mean_edge_length(mesh);
+  if (fp.radius <= 0) fp.radius = 1.5 * mean_edge_length(mesh);
   filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
   progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " +
                 std::to_string(filter_->mean_neighbours()) + " neighbours per element");

@@ -20,7 +20,7 @@ enum class UpdateKind { OC, MMA };
 struct SimpParams {
   double volume_fraction = 0.3;  ///< of the design domain (Ω0), in (0, 1)
   SimpLaw law;                   ///< penalty 3, e_min 1e-9
-  FilterParams filter;           ///< Gaussian; radius <= 0: 2.5 × mean element size
+  FilterParams filter;           ///< Gaussian; radius <= 0: 1.5 × mean edge length
   bool sensitivity_filter = false;  ///< filter sensitivities instead of densities
   bool heaviside = false;        ///< Heaviside projection with β continuation
   double beta_max = 32;          ///< continuation doubles β from 1 up to this

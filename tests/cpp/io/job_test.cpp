@@ -47,7 +47,7 @@ TEST(Job, ParsesTheDocumentedFormat) {
 
 TEST(Job, BadInputIsNamed) {
   EXPECT_EQ(code_of("{"), ErrorCode::Io);
-  EXPECT_EQ(code_of(R"({"mesh": {"size": 1}})"), ErrorCode::InvalidParameter);  // no part
+  EXPECT_EQ(code_of(R"({"mesh": {"size": -1}})"), ErrorCode::InvalidParameter);
   EXPECT_EQ(code_of(R"({"part": "p", "supports": [{"faces": ["Fase3"]}]})"), ErrorCode::FaceNotFound);
   EXPECT_EQ(code_of(R"({"part": "p", "supports": [{"type": "glued", "faces": ["Face3"]}]})"),
             ErrorCode::InvalidParameter);
