@@ -44,6 +44,12 @@ void write_inp(const std::string& path, const TetMesh& mesh, const fem::Material
     std::string name = g.first.first == 0 ? "DESIGN" : "NONDESIGN" + std::to_string(g.first.first);
     std::fprintf(f, "*SOLID SECTION, ELSET=%s_M%d, MATERIAL=M%d\n", name.c_str(), g.first.second, g.first.second);
   }
+  if (supports.dofs.empty() && loads.size() == 0) {  // a mesh only
+    bool ok = std::ferror(f) == 0;
+    ok &= std::fclose(f) == 0;
+    if (!ok) throw Error(ErrorCode::Io, "error while writing " + path + " (disk full?)");
+    return;
+  }
   std::fprintf(f, "*STEP\n*STATIC\n*BOUNDARY\n");
   for (size_t i = 0; i < supports.dofs.size(); ++i) {
     int d = supports.dofs[i];
