@@ -45,6 +45,22 @@ def execute(prepared, on_progress=None):
         raise _native_error(e) from None
 
 
+def mesh_only(study):
+    """Meshes the study's shapes (no optimisation) and stores the tagged mesh in the study.
+    Returns the native result dict (nodes, tets, domain, boundary triangles, quality)."""
+    prepared = prepare(study)
+    core = native()
+    try:
+        result = core.mesh_shapes(json.dumps(prepared.job), prepared.part_brep, prepared.nondesign_brep)
+    except core.TopOptError as e:
+        raise _native_error(e) from None
+    study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]
+    study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
+    study.MeshDomains = [int(i) for i in result["domain"]]
+    study.Densities = []
+    return result
+
+
 def result_mesh(points, triangles):
     """A Mesh.Mesh from #P×3 points and #Q×3 triangles (points as FreeCAD.Vector: FreeCAD 0.20
     crashes on Mesh.Mesh((points, facets)) with plain tuples)."""

@@ -150,6 +150,27 @@ class RunStudy:
         open_study_panel(active_study()).start_run()
 
 
+class MeshStudy:
+    def GetResources(self):
+        return {"MenuText": "Mesh", "Pixmap": _icon("TopOptStudy.svg"),
+                "ToolTip": "Mesh the part and the non-design solids into one tagged mesh and show it, "
+                           "coloured by domain"}
+
+    def IsActive(self):
+        return active_study() is not None
+
+    @_guarded
+    def Activated(self):
+        from topopt.app import runner
+        from topopt.gui import display
+        study = active_study()
+        FreeCAD.Console.PrintMessage("TopOpt: meshing %s…\n" % study.Label)
+        result = runner.mesh_only(study)
+        display.show_domains(study)
+        FreeCAD.Console.PrintMessage("TopOpt: %d nodes, %d tets (mean radius ratio %.2f)\n" % (
+            len(result["nodes"]), len(result["tets"]), result["mean_radius_ratio"]))
+
+
 class ExportStl:
     def GetResources(self):
         return {"MenuText": "Export result as STL", "Pixmap": _icon("TopOptStudy.svg"),
@@ -171,7 +192,7 @@ class ExportStl:
 
 COMMANDS = [("TopOpt_NewStudy", NewStudy), ("TopOpt_Fixed", AddFixed), ("TopOpt_Force", AddForce),
             ("TopOpt_Pressure", AddPressure), ("TopOpt_Symmetry", AddSymmetry),
-            ("TopOpt_Run", RunStudy), ("TopOpt_ExportStl", ExportStl)]
+            ("TopOpt_Mesh", MeshStudy), ("TopOpt_Run", RunStudy), ("TopOpt_ExportStl", ExportStl)]
 
 
 def register():

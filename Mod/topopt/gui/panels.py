@@ -151,6 +151,8 @@ class StudyPanel:
                 self.cancel_button.setEnabled(False)
                 if kind == "done":
                     runner.apply(self.study, payload)
+                    from topopt.gui import display
+                    display.show_density(self.study)
                     self.progress.setValue(100)
                     self.status.setText(self.study.Status)
                     self.threshold.setEnabled(True)

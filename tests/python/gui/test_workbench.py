@@ -88,6 +88,63 @@ class Workbench(unittest.TestCase):
         self.assertGreater(os.path.getsize(path), 10000)
         FreeCADGui.Control.closeDialog()
 
+    def test_mesh_run_and_result_in_the_panel(self):
+        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        doc = FreeCAD.newDocument("GuiRun")
+        part = doc.addObject("Part::Feature", "Lever")
+        part.Shape = Part.read(os.path.join(EXAMPLES, "lever.step"))
+        keeps = []
+        for i, s in enumerate(Part.read(os.path.join(EXAMPLES, "lever_nondesign.step")).Solids):
+            o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
+            o.Shape = s
+            keeps.append(o)
+        doc.recompute()
+        study = api.new_study(doc, part, keeps, volume_fraction=0.35, mesh_size=4.0)
+        study.MaxIterations = 15
+        api.add_fixed(study, "Face9")
+        api.add_force(study, "Face10", (0, -2000, 0))
+        doc.recompute()
+        # Mesh: one feature per domain, coloured
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(study)
+        FreeCADGui.runCommand("TopOpt_Mesh")
+        settle()
+        domains = [o for o in doc.Objects if o.Name.startswith(study.Name + "_MeshDomain")]
+        self.assertEqual(len(domains), 4)  # design + 3 non-design solids
+        part.Visibility = False
+        for o in keeps:
+            o.Visibility = False
+        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
+        FreeCADGui.SendMsgToActiveView("ViewFit")
+        screenshot("workbench_mesh.png")
+        for o in domains:
+            o.Visibility = False
+        # Run from the panel, on its worker thread, and wait for it
+        from topopt.gui.panels import open_study_panel
+        panel = open_study_panel(study)
+        panel.start_run()
+        self.assertFalse(panel.run_button.isEnabled())
+        panel.wait(600)
+        self.assertIsNotNone(study.Result, panel.status.text())
+        self.assertTrue(study.Result.Mesh.isSolid())
+        self.assertGreater(len(panel.plot.compliance), 1)  # the live plot got the iterations
+        self.assertIsNotNone(doc.getObject(study.Name + "_Density"))
+        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
+        FreeCADGui.SendMsgToActiveView("ViewFit")
+        path = screenshot("workbench_result.png")
+        self.assertGreater(os.path.getsize(path), 10000)
+        # The threshold slider re-extracts without a run
+        before = study.Result.Mesh.Volume
+        panel.threshold.setValue(25)
+        panel.reextract()
+        settle()
+        self.assertGreater(study.Result.Mesh.Volume, before)
+        density = doc.getObject(study.Name + "_Density")
+        study.Result.Visibility = False
+        density.Visibility = True
+        screenshot("workbench_density.png")
+        FreeCADGui.Control.closeDialog()
+
     def test_bad_selection_reports_and_does_not_crash(self):
         FreeCADGui.activateWorkbench("TopOptWorkbench")
         doc = FreeCAD.newDocument("GuiBad")
