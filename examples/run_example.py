@@ -1,4 +1,6 @@
-"""The bundled example, run headless in FreeCADCmd by scripts/run-example.
+"""The bundled example, run headless in FreeCADCmd by scripts/run-example: a study on the lever
+built from script (as a user's macro would), run end to end (mesh → SIMP → result surface),
+saved as a FreeCAD document, exported as STL.
 
 Environment: TOPOPT_EXAMPLE_DIR (this folder), TOPOPT_OUT (where results go).
 Exits with a non-zero status on any failure (FreeCADCmd itself would not).
@@ -6,8 +8,10 @@ Exits with a non-zero status on any failure (FreeCADCmd itself would not).
 import json
 import os
 import sys
+import time
 import traceback
 
+import FreeCAD
 import Part
 
 from topopt.app import api
@@ -19,17 +23,47 @@ def main():
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(here, "lever.topopt.json")) as f:
         job = json.load(f)
-    part = Part.read(os.path.join(here, job["part"]))
-    nondesign = Part.read(os.path.join(here, job["nondesign"]))
-    report = api.info(part, nondesign)
-    path = os.path.join(out, "lever_inputs.json")
-    with open(path, "w") as f:
-        json.dump(report, f, indent=2)
-    print("part: %d faces, volume %.1f mm3" % (report["part"]["faces"], report["part"]["volume"]))
-    for s in report["nondesign"]["solids"]:
-        on = ["%s on %s" % (f["name"], f["on_entity"]) for f in s["faces"] if f["on"] == "face"]
-        print("non-design solid %d: volume %.1f mm3; %s" % (s["index"], s["volume"], ", ".join(on)))
-    print("input report: %s" % path)
+    doc = FreeCAD.newDocument("LeverExample")
+    part = doc.addObject("Part::Feature", "Lever")
+    part.Shape = Part.read(os.path.join(here, job["part"]))
+    keep = []
+    for i, solid in enumerate(Part.read(os.path.join(here, job["nondesign"])).Solids):
+        o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
+        o.Shape = solid
+        keep.append(o)
+    doc.recompute()
+    opt = job["optimization"]
+    study = api.new_study(doc, part, keep, volume_fraction=opt["volume_fraction"],
+                          mesh_size=job["mesh"]["size"])
+    study.MaxIterations = opt["max_iterations"]
+    study.FilterRadius = opt["filter_radius"]
+    api.add_fixed(study, job["supports"][0]["faces"])
+    load = job["load_cases"][0]["loads"][0]
+    api.add_force(study, load["faces"], tuple(load["vector"]))
+    doc.recompute()
+
+    t0 = time.time()
+
+    def progress(record):
+        if "iteration" in record and record["iteration"] % 10 == 0:
+            print("  iteration %3d: compliance %.2f N·mm, volume %.3f" % (
+                record["iteration"], record["compliance"], record["volume"]))
+        elif "stage" in record and record["stage"] == "mesh":
+            print("  " + record["message"])
+
+    result = api.run(study, progress)
+    print("run: %s in %.1f s; %d tets; result shape %d triangles, %s, volume %.0f mm³" % (
+        study.Status, time.time() - t0, len(study.MeshTets) // 4, result.Mesh.CountFacets,
+        "closed" if result.Mesh.isSolid() else "NOT closed", result.Mesh.Volume))
+    stl = api.export_stl(study, os.path.join(out, "lever_result.stl"))
+    fcstd = os.path.join(out, "lever_study.FCStd")
+    doc.saveAs(fcstd)
+    with open(os.path.join(out, "lever_history.json"), "w") as f:
+        json.dump({"compliance": list(study.ComplianceHistory), "volume": list(study.VolumeHistory),
+                   "status": study.Status}, f, indent=1)
+    print("document: %s\nSTL: %s" % (fcstd, stl))
+    if not result.Mesh.isSolid():
+        raise RuntimeError("the result shape is not closed")
 
 
 try:
