@@ -1,0 +1,549 @@
+// 3D advancing front (see volume_front.h).
+#include "mesh/volume_front.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <queue>
+#include <sstream>
+#include <unordered_map>
+#include <vector>
+
+#include "common/error.h"
+#include "mesh/predicates.h"
+#include "mesh/tet_quality.h"
+
+namespace topopt::mesh {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Tri = std::array<int, 3>;
+
+/// Outward faces of a positive tet, opposite vertex 0..3.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+struct TriKey {
+  int a, b, c;
+  bool operator==(const TriKey& o) const { return a == o.a && b == o.b && c == o.c; }
+};
+struct TriKeyHash {
+  size_t operator()(const TriKey& k) const {
+    return static_cast<size_t>(k.a) * 73856093u ^ static_cast<size_t>(k.b) * 19349663u ^
+           static_cast<size_t>(k.c) * 83492791u;
+  }
+};
+TriKey key_of(int a, int b, int c) {
+  int v[3] = {a, b, c};
+  std::sort(v, v + 3);
+  return {v[0], v[1], v[2]};
+}
+
+/// Uniform grid of buckets over ids with a box each; lookups return candidates (the caller
+/// filters stale or far ones). Entries are removed lazily by the caller's alive flags.
+class Grid {
+ public:
+  Grid(const Vec3& origin, double cell) : origin_(origin), inv_(1.0 / cell) {}
+  void insert(int id, const Vec3& lo, const Vec3& hi) {
+    auto a = cell(lo), b = cell(hi);
+    for (long x = a[0]; x <= b[0]; ++x)
+      for (long y = a[1]; y <= b[1]; ++y)
+        for (long z = a[2]; z <= b[2]; ++z) buckets_[key(x, y, z)].push_back(id);
+  }
+  /// Appends the ids in the cells overlapping [lo, hi] (with duplicates) to out.
+  void query(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+    auto a = cell(lo), b = cell(hi);
+    for (long x = a[0]; x <= b[0]; ++x)
+      for (long y = a[1]; y <= b[1]; ++y)
+        for (long z = a[2]; z <= b[2]; ++z) {
+          auto it = buckets_.find(key(x, y, z));
+          if (it != buckets_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+        }
+  }
+
+ private:
+  std::array<long, 3> cell(const Vec3& p) const {
+    return {static_cast<long>(std::floor((p[0] - origin_[0]) * inv_)), static_cast<long>(std::floor((p[1] - origin_[1]) * inv_)),
+            static_cast<long>(std::floor((p[2] - origin_[2]) * inv_))};
+  }
+  static long key(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
+  Vec3 origin_;
+  double inv_;
+  std::unordered_map<long, std::vector<int>> buckets_;
+};
+
+using predicates::orient3d;
+
+/// Does segment (u, v) meet triangle (x, y, z) anywhere other than at a shared vertex?
+/// Exact; touching counts as meeting (conservative), coplanar configurations too unless the
+/// segment shares a vertex with the triangle and leaves it outside.
+bool segment_meets_triangle(const std::vector<Vec3>& P, int u, int v, int x, int y, int z) {
+  bool u_shared = u == x || u == y || u == z, v_shared = v == x || v == y || v == z;
+  if (u_shared && v_shared) return false;  // the segment is an edge of the triangle
+  // separated boxes: no predicate needed (exact: comparisons of the input doubles)
+  for (int k = 0; k < 3; ++k) {
+    double slo = std::min(P[u][k], P[v][k]), shi = std::max(P[u][k], P[v][k]);
+    double tlo = std::min({P[x][k], P[y][k], P[z][k]}), thi = std::max({P[x][k], P[y][k], P[z][k]});
+    if (shi < tlo || slo > thi) return false;
+  }
+  const double *pu = P[u].data(), *pv = P[v].data(), *px = P[x].data(), *py = P[y].data(), *pz = P[z].data();
+  int su = u_shared ? 0 : orient3d(px, py, pz, pu), sv = v_shared ? 0 : orient3d(px, py, pz, pv);
+  if (su == sv && su != 0) return false;
+  if (su == 0 && sv == 0) {
+    // coplanar: meet unless separated; decide in the plane with the 2D predicate on the
+    // projection that keeps the triangle non-degenerate
+    Vec3 n = (P[y] - P[x]).cross(P[z] - P[x]);
+    int drop = 0;
+    n.cwiseAbs().maxCoeff(&drop);
+    int i0 = (drop + 1) % 3, i1 = (drop + 2) % 3;
+    auto q = [&](int k) { return std::array<double, 2>{P[k][i0], P[k][i1]}; };
+    auto U = q(u), Vv = q(v), X = q(x), Y = q(y), Z = q(z);
+    int o = predicates::orient2d(X.data(), Y.data(), Z.data());
+    auto inside = [&](const std::array<double, 2>& p) {
+      int a = predicates::orient2d(X.data(), Y.data(), p.data()) * o, b = predicates::orient2d(Y.data(), Z.data(), p.data()) * o,
+          c = predicates::orient2d(Z.data(), X.data(), p.data()) * o;
+      return a > 0 && b > 0 && c > 0;
+    };
+    auto crosses = [&](const std::array<double, 2>& a, const std::array<double, 2>& b, const std::array<double, 2>& c,
+                       const std::array<double, 2>& d) {  // proper crossing of ab and cd
+      int s1 = predicates::orient2d(a.data(), b.data(), c.data()), s2 = predicates::orient2d(a.data(), b.data(), d.data());
+      int s3 = predicates::orient2d(c.data(), d.data(), a.data()), s4 = predicates::orient2d(c.data(), d.data(), b.data());
+      return s1 * s2 < 0 && s3 * s4 < 0;
+    };
+    if ((!u_shared && inside(U)) || (!v_shared && inside(Vv))) return true;
+    if (crosses(U, Vv, X, Y) || crosses(U, Vv, Y, Z) || crosses(U, Vv, Z, X)) return true;
+    std::array<double, 2> mid{0.5 * (U[0] + Vv[0]), 0.5 * (U[1] + Vv[1])};
+    return inside(mid);
+  }
+  // the segment crosses (or touches) the plane: where does the line pass the triangle?
+  int a = orient3d(pu, pv, px, py), b = orient3d(pu, pv, py, pz), c = orient3d(pu, pv, pz, px);
+  bool hit = (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
+  if (!hit) return false;
+  // contact only at a shared vertex: the touching endpoint is that vertex
+  if (su == 0 && u_shared) return false;
+  if (sv == 0 && v_shared) return false;
+  return true;
+}
+
+class Front {
+ public:
+  Front(std::vector<Vec3>& P, double cell, const Vec3& origin) : P_(P), faces_grid_(origin, cell), nodes_grid_(origin, cell) {}
+
+  int add_face(int a, int b, int c) {
+    TriKey k = key_of(a, b, c);
+    auto it = index_.find(k);
+    if (it != index_.end()) {  // the opposite face is already on the front: both close
+      kill(it->second);
+      return -1;
+    }
+    int id = static_cast<int>(faces_.size());
+    faces_.push_back({a, b, c});
+    alive_.push_back(1);
+    fails_.push_back(0);
+    index_.emplace(k, id);
+    Vec3 lo = P_[a].cwiseMin(P_[b]).cwiseMin(P_[c]), hi = P_[a].cwiseMax(P_[b]).cwiseMax(P_[c]);
+    faces_grid_.insert(id, lo, hi);
+    for (int v : {a, b, c}) {
+      if (static_cast<int>(active_.size()) <= v) active_.resize(v + 1, 0), in_grid_.resize(v + 1, 0);
+      if (active_[v]++ == 0 && !in_grid_[v]) nodes_grid_.insert(v, P_[v], P_[v]), in_grid_[v] = 1;
+    }
+    ++count_;
+    return id;
+  }
+  void kill(int id) {
+    if (!alive_[id]) return;
+    alive_[id] = 0;
+    index_.erase(key_of(faces_[id][0], faces_[id][1], faces_[id][2]));
+    for (int v : faces_[id]) --active_[v];
+    --count_;
+  }
+  bool alive(int id) const { return alive_[id]; }
+  const Tri& face(int id) const { return faces_[id]; }
+  long size() const { return count_; }
+  int& fails(int id) { return fails_[id]; }
+  bool active(int v) const { return v < static_cast<int>(active_.size()) && active_[v] > 0; }
+  void faces_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+    out.clear();
+    faces_grid_.query(lo, hi, out);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    out.erase(std::remove_if(out.begin(), out.end(), [&](int f) { return !alive_[f]; }), out.end());
+  }
+  void nodes_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+    out.clear();
+    nodes_grid_.query(lo, hi, out);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    out.erase(std::remove_if(out.begin(), out.end(), [&](int v) { return !active(v); }), out.end());
+  }
+  int any_alive() const {
+    for (size_t i = 0; i < alive_.size(); ++i)
+      if (alive_[i]) return static_cast<int>(i);
+    return -1;
+  }
+  size_t capacity() const { return faces_.size(); }
+
+ private:
+  std::vector<Vec3>& P_;
+  std::vector<Tri> faces_;
+  std::vector<char> alive_;
+  std::vector<int> fails_;
+  std::unordered_map<TriKey, int, TriKeyHash> index_;
+  std::vector<int> active_;
+  std::vector<char> in_grid_;
+  Grid faces_grid_, nodes_grid_;
+  long count_ = 0;
+};
+
+double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
+
+}  // namespace
+
+VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
+                             const Progress& progress) {
+  std::vector<Vec3> P(V.rows());
+  for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
+  if (F.rows() == 0) throw Error(ErrorCode::MeshingFailed, "nothing to fill: the boundary has no triangles");
+  // Cell size: the mean boundary edge.
+  double mean_edge = 0;
+  Vec3 lo = P[F(0, 0)], hi = lo;
+  for (long t = 0; t < F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      mean_edge += (P[F(t, k)] - P[F(t, (k + 1) % 3)]).norm();
+      lo = lo.cwiseMin(P[F(t, k)]), hi = hi.cwiseMax(P[F(t, k)]);
+    }
+  mean_edge /= 3.0 * F.rows();
+  Front front(P, 1.5 * mean_edge, lo);
+  std::vector<std::array<int, 4>> tets;
+
+  // ---- the initial front: boundary triangles reversed (normals into the region), then the
+  // free faces of the existing tets (outward from them, i.e. into the unfilled region)
+  std::unordered_map<TriKey, int, TriKeyHash> t0_faces;
+  for (long t = 0; t < T0.rows(); ++t)
+    for (const auto& f : kFace) t0_faces[key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]))]++;
+  std::unordered_map<TriKey, char, TriKeyHash> boundary;
+  for (long t = 0; t < F.rows(); ++t) {
+    TriKey k = key_of(F(t, 0), F(t, 1), F(t, 2));
+    boundary[k] = 1;
+    if (t0_faces.count(k)) continue;  // covered by an existing tet
+    front.add_face(F(t, 0), F(t, 2), F(t, 1));
+  }
+  for (long t = 0; t < T0.rows(); ++t)
+    for (const auto& f : kFace) {
+      TriKey k = key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
+      if (t0_faces[k] > 1 || boundary.count(k)) continue;
+      front.add_face(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
+    }
+
+  // ---- the driver loop: smallest face first
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  auto face_size = [&](int id) {
+    const Tri& f = front.face(id);
+    return (P[f[0]] - P[f[1]]).norm() + (P[f[1]] - P[f[2]]).norm() + (P[f[2]] - P[f[0]]).norm();
+  };
+  for (size_t id = 0; id < front.capacity(); ++id)
+    if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
+  std::vector<int> near_faces, near_nodes;
+  std::vector<std::pair<double, int>> candidates;  // (score, node; -1 = the ideal point)
+  const double sqrt23 = std::sqrt(2.0 / 3.0);
+
+  auto valid = [&](int a, int b, int c, int p, double qmin, int self) {
+    if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[p].data()) <= 0) return false;
+    if (tet_rho(P, a, b, c, p) < qmin) return false;
+    Vec3 tlo = P[a].cwiseMin(P[b]).cwiseMin(P[c]).cwiseMin(P[p]), thi = P[a].cwiseMax(P[b]).cwiseMax(P[c]).cwiseMax(P[p]);
+    Vec3 pad = Vec3::Constant(1e-9 * (thi - tlo).norm());
+    front.faces_near(tlo - pad, thi + pad, near_faces);
+    // The edges ab, bc, ca are already part of the front and cross nothing: only the new
+    // edges against front faces, and front edges against the new faces, need checking.
+    const Tri new_faces[3] = {{a, b, p}, {b, c, p}, {c, a, p}};
+    const TriKey new_keys[3] = {key_of(a, b, p), key_of(b, c, p), key_of(c, a, p)};
+    for (int g : near_faces) {
+      if (g == self) continue;
+      const Tri& t = front.face(g);
+      TriKey kt = key_of(t[0], t[1], t[2]);
+      for (int v : {a, b, c})
+        if (segment_meets_triangle(P, v, p, t[0], t[1], t[2])) {
+          // an edge of the closing face itself lies on that face: allowed
+          bool closing = false;
+          for (const TriKey& k : new_keys) closing |= k == kt;
+          if (!closing) return false;
+        }
+      for (int i = 0; i < 3; ++i) {
+        if (new_keys[i] == kt) continue;  // closing against that face
+        for (int k = 0; k < 3; ++k)
+          if (segment_meets_triangle(P, t[k], t[(k + 1) % 3], new_faces[i][0], new_faces[i][1], new_faces[i][2]))
+            return false;
+      }
+    }
+    front.nodes_near(tlo - pad, thi + pad, near_nodes);
+    for (int q : near_nodes) {
+      if (q == a || q == b || q == c || q == p) continue;
+      const double* x = P[q].data();
+      if (orient3d(P[a].data(), P[b].data(), P[c].data(), x) >= 0 && orient3d(P[a].data(), P[b].data(), x, P[p].data()) >= 0 &&
+          orient3d(P[b].data(), P[c].data(), x, P[p].data()) >= 0 && orient3d(P[c].data(), P[a].data(), x, P[p].data()) >= 0)
+        return false;  // a front node inside (or on) the new tet
+    }
+    return true;
+  };
+
+  const double qmins[] = {params.min_quality, 0.1, 0.02, 1e-4, 0};
+  const double reach[] = {1.0, 1.6, 2.5, 4.0, 6.0};
+  // Rounds: advance (with widening passes), fill what is left from single points, and if a
+  // stuck region remains, remove the new tets around it and advance again.
+  for (int round = 0; round < 4 && front.size() > 0; ++round) {
+    if (round > 0) {
+      std::unordered_map<TriKey, int, TriKeyHash> owner;
+      for (size_t t = 0; t < tets.size(); ++t) {
+        if (tets[t][0] < 0) continue;
+        for (const auto& o : kFace) owner[key_of(tets[t][o[0]], tets[t][o[1]], tets[t][o[2]])] = static_cast<int>(t);
+      }
+      std::vector<int> doomed;
+      for (size_t id = 0; id < front.capacity(); ++id) {
+        if (!front.alive(static_cast<int>(id))) continue;
+        const Tri& f = front.face(static_cast<int>(id));
+        auto it = owner.find(key_of(f[0], f[1], f[2]));
+        if (it != owner.end()) doomed.push_back(it->second);
+        // and the tets around each of its nodes, for room to move
+        for (int v : f)
+          for (size_t t = 0; t < tets.size(); ++t)
+            if (tets[t][0] >= 0 && (tets[t][0] == v || tets[t][1] == v || tets[t][2] == v || tets[t][3] == v))
+              doomed.push_back(static_cast<int>(t));
+      }
+      std::sort(doomed.begin(), doomed.end());
+      doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
+      for (int t : doomed) {
+        const auto tv = tets[t];
+        for (const auto& o : kFace) front.add_face(tv[o[0]], tv[o[2]], tv[o[1]]);
+        tets[t][0] = -1;
+      }
+      progress.info("advancing front: re-meshing around a stuck region (" + std::to_string(doomed.size()) + " tets removed)");
+      for (size_t id = 0; id < front.capacity(); ++id)
+        if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
+    }
+    for (int pass = 0; pass < std::max(1, params.passes) + 1 && front.size() > 0; ++pass) {
+      const int ip = std::min(pass + round, 4);
+      if (pass > 0 || round > 0) {
+        progress.info("advancing front: pass " + std::to_string(pass + 1) + " over " + std::to_string(front.size()) +
+                      " faces that failed");
+        for (size_t id = 0; id < front.capacity(); ++id)
+          if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
+      }
+      std::vector<int> deferred;
+      while (!queue.empty()) {
+        int f = queue.top().second;
+        queue.pop();
+        if (!front.alive(f)) continue;
+          if (static_cast<long>(tets.size()) > params.max_tets)
+          throw Error(ErrorCode::TooLarge, "the volume mesh exceeds " + std::to_string(params.max_tets) + " tets");
+        if (tets.size() % 20000 == 0) progress.check_cancel("volume meshing");
+        const Tri face = front.face(f);
+        int a = face[0], b = face[1], c = face[2];
+        Vec3 n = (P[b] - P[a]).cross(P[c] - P[a]);
+        double L = face_size(f) / 3.0;
+        Vec3 centre = (P[a] + P[b] + P[c]) / 3.0;
+        double h = params.size ? std::clamp(params.size(centre.data()), 0.55 * L, 1.8 * L) : L;
+        Vec3 ideal = centre + n.normalized() * h * sqrt23;
+        // candidates: front nodes near the ideal point, on the right side. Connecting to an
+        // existing node closes the front, so those come first (best quality first); the ideal
+        // point is tried last, and only where no front node is already close to it.
+        candidates.clear();
+        double r = reach[ip] * h;
+        front.nodes_near(ideal - Vec3::Constant(r), ideal + Vec3::Constant(r), near_nodes);
+        bool crowded = false;
+        std::vector<int> nodes = near_nodes;
+        for (int q : nodes) {
+          if (q == a || q == b || q == c) continue;
+          double d = (P[q] - ideal).norm();
+          if (d > r) continue;
+          if (d < 0.7 * h) crowded = true;
+          if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[q].data()) <= 0) continue;
+          double rho = tet_rho(P, a, b, c, q);
+          if (rho < qmins[ip]) continue;
+          candidates.push_back({-rho + 0.25 * d / h - 10.0, q});
+        }
+        if (!crowded || pass > 0) {
+          P.push_back(ideal);
+          double rho = tet_rho(P, a, b, c, static_cast<int>(P.size()) - 1);
+          P.pop_back();
+          candidates.push_back({-rho, -1});
+        }
+        std::sort(candidates.begin(), candidates.end());
+        int chosen = -2;
+        for (const auto& [score, q] : candidates) {
+          int p = q;
+          if (q < 0) {
+            P.push_back(ideal);
+            p = static_cast<int>(P.size()) - 1;
+          }
+          if (valid(a, b, c, p, qmins[ip], f)) {
+            chosen = p;
+            break;
+          }
+          if (q < 0) P.pop_back();
+        }
+        if (chosen == -2) {
+          deferred.push_back(f);
+          continue;
+        }
+        int p = chosen;
+        tets.push_back({a, b, c, p});
+        front.kill(f);
+        const int tv[4] = {a, b, c, p};
+        for (int k = 0; k < 3; ++k) {  // outward faces of (a, b, c, p) other than (a, c, b)
+          const int* o = kFace[k];
+          int id = front.add_face(tv[o[0]], tv[o[1]], tv[o[2]]);
+          if (id >= 0) queue.push({face_size(id), id});
+        }
+      }
+      if (front.size() == 0) break;
+    }
+    // ---- last resort for small cavities left over: fill each closed component of the front
+    // from one point that sees all its faces (the centroid of its nodes, or one of its nodes)
+    if (front.size() > 0 && front.size() < 400) {
+      std::vector<int> faces;
+      for (size_t id = 0; id < front.capacity(); ++id)
+        if (front.alive(static_cast<int>(id))) faces.push_back(static_cast<int>(id));
+      // components through shared nodes
+      std::unordered_map<int, std::vector<int>> by_node;
+      for (int f : faces)
+        for (int v : front.face(f)) by_node[v].push_back(f);
+      std::unordered_map<int, int> comp;
+      int ncomp = 0;
+      for (int f : faces) {
+        if (comp.count(f)) continue;
+        std::vector<int> stack{f};
+        comp[f] = ncomp;
+        while (!stack.empty()) {
+          int g = stack.back();
+          stack.pop_back();
+          for (int v : front.face(g))
+            for (int h2 : by_node[v])
+              if (!comp.count(h2)) comp[h2] = ncomp, stack.push_back(h2);
+        }
+        ++ncomp;
+      }
+      for (int k = 0; k < ncomp; ++k) {
+        std::vector<int> cf;
+        std::vector<int> cn;
+        for (int f : faces)
+          if (comp[f] == k) {
+            cf.push_back(f);
+            for (int v : front.face(f)) cn.push_back(v);
+          }
+        std::sort(cn.begin(), cn.end());
+        cn.erase(std::unique(cn.begin(), cn.end()), cn.end());
+        auto sees_all = [&](int apex) {
+          for (int f : cf) {
+            const Tri& t = front.face(f);
+            if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
+            if (orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[apex].data()) <= 0) return false;
+          }
+          return true;
+        };
+        // the apex: among the cavity's nodes, its centroid and points spread over its box, the
+        // one that sees every face with the best worst tet
+        auto worst_quality = [&](int apex) {
+          double w = 1;
+          for (int f : cf) {
+            const Tri& t = front.face(f);
+            if (t[0] != apex && t[1] != apex && t[2] != apex) w = std::min(w, tet_rho(P, t[0], t[1], t[2], apex));
+          }
+          return w;
+        };
+        int apex = -1;
+        double best = -1;
+        for (int v : cn)
+          if (sees_all(v) && worst_quality(v) > best) best = worst_quality(v), apex = v;
+        Vec3 clo = P[cn[0]], chi = P[cn[0]], centre = Vec3::Zero();
+        for (int v : cn) clo = clo.cwiseMin(P[v]), chi = chi.cwiseMax(P[v]), centre += P[v];
+        centre /= cn.size();
+        Vec3 best_point;
+        unsigned seed = 12345;
+        for (int trial = 0; trial < 400; ++trial) {
+          Vec3 x = centre;
+          if (trial > 0)
+            for (int d = 0; d < 3; ++d) {
+              seed = seed * 1664525u + 1013904223u;
+              x[d] = clo[d] + (chi[d] - clo[d]) * ((seed >> 8) & 0xFFFF) / 65535.0;
+            }
+          P.push_back(x);
+          int id = static_cast<int>(P.size()) - 1;
+          if (sees_all(id)) {
+            double w = worst_quality(id);
+            if (w > best) best = w, apex = -2, best_point = x;
+          }
+          P.pop_back();
+        }
+        if (apex == -2) {
+          P.push_back(best_point);
+          apex = static_cast<int>(P.size()) - 1;
+        }
+        if (apex < 0) continue;
+        for (int f : cf) {
+          const Tri t = front.face(f);
+          if (t[0] == apex || t[1] == apex || t[2] == apex) {
+            front.kill(f);
+            continue;
+          }
+          tets.push_back({t[0], t[1], t[2], apex});
+          front.kill(f);
+        }
+        progress.info("advancing front: closed a cavity of " + std::to_string(cf.size()) + " faces from one point");
+      }
+    }
+  }
+  if (front.size() > 0) {
+    int f = front.any_alive();
+    const Tri& t = front.face(f);
+    Vec3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
+    std::ostringstream s;
+    s << "the volume mesh could not be closed: " << front.size() << " front faces remain, e.g. near (" << c.x() << ", "
+      << c.y() << ", " << c.z() << "); a finer or smoother surface mesh there may help";
+    throw Error(ErrorCode::MeshingFailed, s.str());
+  }
+
+  tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }), tets.end());
+  // ---- node smoothing of the new nodes: move to the neighbours' centroid when that
+  // improves the worst radius ratio around the node and keeps every tet positive
+  const int first_new = static_cast<int>(V.rows());
+  if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
+    std::vector<std::vector<int>> around(P.size() - first_new);
+    for (size_t t = 0; t < tets.size(); ++t)
+      for (int v : tets[t])
+        if (v >= first_new) around[v - first_new].push_back(static_cast<int>(t));
+    for (int it = 0; it < params.smoothing_iterations; ++it)
+      for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
+        const auto& ts = around[v - first_new];
+        Vec3 sum = Vec3::Zero();
+        int n = 0;
+        double worst = 1;
+        for (int t : ts) {
+          worst = std::min(worst, tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]));
+          for (int w : tets[t])
+            if (w != v) sum += P[w], ++n;
+        }
+        if (!n) continue;
+        Vec3 old = P[v];
+        P[v] = sum / n;
+        bool ok = true;
+        double now = 1;
+        for (int t : ts) {
+          const auto& q = tets[t];
+          if (orient3d(P[q[0]].data(), P[q[1]].data(), P[q[2]].data(), P[q[3]].data()) <= 0) {
+            ok = false;
+            break;
+          }
+          now = std::min(now, tet_rho(P, q[0], q[1], q[2], q[3]));
+        }
+        if (!ok || now < worst) P[v] = old;
+      }
+  }
+  VolumeFillResult out;
+  out.V.resize(P.size(), 3);
+  for (size_t i = 0; i < P.size(); ++i) out.V.row(i) = P[i].transpose();
+  out.T.resize(tets.size(), 4);
+  for (size_t t = 0; t < tets.size(); ++t) out.T.row(t) << tets[t][0], tets[t][1], tets[t][2], tets[t][3];
+  return out;
+}
+
+}  // namespace topopt::mesh

@@ -1,0 +1,39 @@
+// 3D advancing front: fills a region bounded by a closed triangle surface with tets, starting
+// from any front — the boundary triangles plus the free faces of tets already present inside
+// (step 14 of the two-B-Rep method starts from Ω̄'s tets). Every decision goes through the
+// exact predicates; existing tets and boundary triangles are never changed.
+//
+// The engine in three parts (DESIGN.md): the front container with its spatial search
+// (FrontIndex, in the .cpp), the geometry of candidate points, and the driver loop
+// fill_volume() below: take the smallest front face, try candidates from the ideal point and
+// from nearby front nodes, accept the best valid tet, update the front; faces that fail are
+// retried with a wider search and a looser quality bound.
+#pragma once
+#include <functional>
+
+#include "common/progress.h"
+#include "common/types.h"
+
+namespace topopt::mesh {
+
+struct VolumeFillParams {
+  /// Target edge length at a point; empty: interpolated from the boundary's edge lengths.
+  std::function<double(const double*)> size;
+  double min_quality = 0.25;    ///< radius ratio a new tet must reach on the first pass
+  int passes = 4;               ///< widening passes over faces that failed
+  long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
+  int smoothing_iterations = 5; ///< node smoothing sweeps after filling (quality never drops)
+};
+
+struct VolumeFillResult {
+  MatX3d V;   ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones
+  MatX4i T;   ///< #T' by 4: the new tets only, positively oriented
+};
+
+/// Fills the region bounded by F (#F by 3, oriented with normals pointing OUT of the region)
+/// on nodes V (#V by 3), around the existing tets T0 (#T0 by 4, kept, may be empty).
+/// Throws Error(MeshingFailed) naming where the front could not be closed.
+VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params = {},
+                             const Progress& progress = {});
+
+}  // namespace topopt::mesh
