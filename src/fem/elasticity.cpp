@@ -574,21 +574,28 @@ Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& 
   return U;
 }
 
+namespace {
+/// Strain ε = sym(∇u) of element t, with ∇u = Σ_a u_a ⊗ g_a over its four nodes.
+Eigen::Matrix3d element_strain(const TetMesh& mesh, const std::vector<double>& grad, long t, const VecXd& u) {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 4; ++a) {
+    const double* g = &grad[12 * t + 3 * a];
+    int n = mesh.T(t, a);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) H(i, j) += u[3 * n + i] * g[j];
+  }
+  return 0.5 * (H + H.transpose());
+}
+}  // namespace
+
 VecXd Elasticity::element_energy(const VecXd& u) const {
   const Impl& m = *impl_;
   const long nt = m.mesh.T.rows();
   VecXd out(nt);
   parallel_for(nt, m.threads, [&](long b, long e) {
     for (long t = b; t < e; ++t) {
-      // ∇u = Σ_a u_a ⊗ g_a; u^T K0 u = vol (λ (tr ε)² + 2μ ε:ε)
-      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-      for (int a = 0; a < 4; ++a) {
-        const double* g = &m.grad[12 * t + 3 * a];
-        int n = m.mesh.T(t, a);
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) H(i, j) += u[3 * n + i] * g[j];
-      }
-      Eigen::Matrix3d eps = 0.5 * (H + H.transpose());
+      // u^T K0 u = vol (λ (tr ε)² + 2μ ε:ε)
+      Eigen::Matrix3d eps = element_strain(m.mesh, m.grad, t, u);
       double tr = eps.trace();
       out[t] = m.vol[t] * (m.lambda * tr * tr + 2 * m.mu * eps.cwiseAbs2().sum());
     }
@@ -602,14 +609,7 @@ VecXd Elasticity::von_mises(const VecXd& u) const {
   VecXd out(nt);
   parallel_for(nt, m.threads, [&](long b, long e) {
     for (long t = b; t < e; ++t) {
-      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-      for (int a = 0; a < 4; ++a) {
-        const double* g = &m.grad[12 * t + 3 * a];
-        int n = m.mesh.T(t, a);
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) H(i, j) += u[3 * n + i] * g[j];
-      }
-      Eigen::Matrix3d eps = 0.5 * (H + H.transpose());
+      Eigen::Matrix3d eps = element_strain(m.mesh, m.grad, t, u);
       Eigen::Matrix3d s = m.scale[t] * (m.lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * m.mu * eps);
       double d = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) + (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
                         (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +

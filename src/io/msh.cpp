@@ -11,23 +11,13 @@
 #include <unordered_map>
 
 #include "common/error.h"
+#include "common/face_key.h"
 
 namespace topopt::io {
 namespace {
 
-/// Orientation-independent key of a triangle.
-std::array<int, 3> sorted_key(int a, int b, int c) {
-  std::array<int, 3> k{a, b, c};
-  std::sort(k.begin(), k.end());
-  return k;
-}
-
-struct KeyHash {
-  size_t operator()(const std::array<int, 3>& k) const {
-    return (static_cast<size_t>(k[0]) * 73856093u) ^ (static_cast<size_t>(k[1]) * 19349663u) ^
-           (static_cast<size_t>(k[2]) * 83492791u);
-  }
-};
+using KeyHash = FaceKeyHash;
+inline FaceKey sorted_key(int a, int b, int c) { return face_key(a, b, c); }
 
 }  // namespace
 

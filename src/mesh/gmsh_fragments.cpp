@@ -14,6 +14,7 @@
 
 #include "brep/point_locator.h"
 #include "common/error.h"
+#include "common/face_key.h"
 #include "io/msh.h"
 
 namespace topopt::mesh {
@@ -33,11 +34,7 @@ struct GmshSession {
   ~GmshSession() { gmsh::finalize(); }
 };
 
-std::array<int, 3> key3(int a, int b, int c) {
-  std::array<int, 3> k{a, b, c};
-  std::sort(k.begin(), k.end());
-  return k;
-}
+inline FaceKey key3(int a, int b, int c) { return face_key(a, b, c); }
 
 /// The face (0-based) of `locator`'s model nearest to p among those within tolerance, or -1.
 int face_at(const brep::PointLocator& locator, const gp_Pnt& p, double tol) {

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "common/error.h"
+#include "common/face_key.h"
 
 namespace topopt::surface {
 namespace {
@@ -15,17 +16,8 @@ namespace {
 /// Faces of a positive tet, opposite vertex i, oriented outwards.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-std::array<int, 3> sorted3(int a, int b, int c) {
-  std::array<int, 3> k{a, b, c};
-  std::sort(k.begin(), k.end());
-  return k;
-}
-struct Hash3 {
-  size_t operator()(const std::array<int, 3>& k) const {
-    return static_cast<size_t>(k[0]) * 73856093u ^ static_cast<size_t>(k[1]) * 19349663u ^
-           static_cast<size_t>(k[2]) * 83492791u;
-  }
-};
+using Hash3 = FaceKeyHash;
+inline FaceKey sorted3(int a, int b, int c) { return face_key(a, b, c); }
 
 /// Value of the level-set function at a node: never exactly 0 (a node on the threshold
 /// counts as inside), so every crossing lies strictly inside an edge.

@@ -35,6 +35,20 @@ def screenshot(name):
     return view_path
 
 
+def lever_document(name):
+    """A document with the bundled lever and its three non-design solids."""
+    doc = FreeCAD.newDocument(name)
+    part = doc.addObject("Part::Feature", "Lever")
+    part.Shape = Part.read(os.path.join(EXAMPLES, "lever.step"))
+    keeps = []
+    for i, s in enumerate(Part.read(os.path.join(EXAMPLES, "lever_nondesign.step")).Solids):
+        o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
+        o.Shape = s
+        keeps.append(o)
+    doc.recompute()
+    return doc, part, keeps
+
+
 class Workbench(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -56,15 +70,7 @@ class Workbench(unittest.TestCase):
 
     def test_new_study_from_selection_and_panel(self):
         FreeCADGui.activateWorkbench("TopOptWorkbench")
-        doc = FreeCAD.newDocument("GuiLever")
-        part = doc.addObject("Part::Feature", "Lever")
-        part.Shape = Part.read(os.path.join(EXAMPLES, "lever.step"))
-        keeps = []
-        for i, s in enumerate(Part.read(os.path.join(EXAMPLES, "lever_nondesign.step")).Solids):
-            o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
-            o.Shape = s
-            keeps.append(o)
-        doc.recompute()
+        doc, part, keeps = lever_document("GuiLever")
         FreeCADGui.Selection.clearSelection()
         FreeCADGui.Selection.addSelection(part)
         for o in keeps:
@@ -90,15 +96,7 @@ class Workbench(unittest.TestCase):
 
     def test_mesh_run_and_result_in_the_panel(self):
         FreeCADGui.activateWorkbench("TopOptWorkbench")
-        doc = FreeCAD.newDocument("GuiRun")
-        part = doc.addObject("Part::Feature", "Lever")
-        part.Shape = Part.read(os.path.join(EXAMPLES, "lever.step"))
-        keeps = []
-        for i, s in enumerate(Part.read(os.path.join(EXAMPLES, "lever_nondesign.step")).Solids):
-            o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
-            o.Shape = s
-            keeps.append(o)
-        doc.recompute()
+        doc, part, keeps = lever_document("GuiRun")
         study = api.new_study(doc, part, keeps, volume_fraction=0.35, mesh_size=4.0)
         study.MaxIterations = 15
         api.add_fixed(study, "Face9")
