@@ -299,7 +299,9 @@ TEST(BoundaryConditions, LoadsOnNonDesignPads) {
   double fz = 0;
   for (long i = 0; i < m.V.rows(); ++i) {
     fz += F(3 * i + 2, 0);
-    if (F(3 * i + 2, 0) != 0) EXPECT_NEAR(m.V(i, 0), 6.0, 1e-12);
+    if (F(3 * i + 2, 0) != 0) {
+      EXPECT_NEAR(m.V(i, 0), 6.0, 1e-12);
+    }
   }
   EXPECT_NEAR(fz, -4, 1e-12);
 }

@@ -75,7 +75,9 @@ TEST(IsoSurface, SmoothingKeepsItClosedAndNonDesignInPlace) {
   double moved_free = 0;
   for (long i = 0; i < s.V.rows(); ++i) {
     double d = (s.V.row(i) - before.row(i)).norm();
-    if (s.lock[i] == 2) EXPECT_EQ(d, 0.0) << "non-design point " << i << " moved";
+    if (s.lock[i] == 2) {
+      EXPECT_EQ(d, 0.0) << "non-design point " << i << " moved";
+    }
     if (s.lock[i] == 1) {
       // on Ω's planar faces: still on the box
       bool on_box = false;
