@@ -20,13 +20,15 @@ namespace topopt::cli {
 int cmd_mesh(const Args& args) {
   ArgReader a(args,
               "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] --out FILE\n"
-              "                   [--stats STATS.json]\n"
+              "                   [--stats STATS.json] [--volume gmsh|native]\n"
               "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
               "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
               "  part's face numbers (FreeCAD's FaceN).\n"
               "  --out    FILE.msh (Gmsh MSH 4.1), FILE.vtu (ParaView) or FILE.inp (CalculiX mesh)\n"
               "  --size   target element size in mm (default: part diagonal / 50)\n"
               "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
+              "  --volume who fills the volumes: gmsh (default) or native (our advancing front on\n"
+              "           Gmsh's surface mesh; experimental)\n"
               "  Meshing is currently done by Gmsh's OCC fragments (interim, see README).");
   if (a.wants_help()) {
     std::cout << a.usage() << "\n";
@@ -36,6 +38,9 @@ int cmd_mesh(const Args& args) {
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);
   mp.min_size = a.number("min-size", 0);
+  std::string volume = a.option("volume", "gmsh");
+  if (volume != "gmsh" && volume != "native") throw Error(ErrorCode::InvalidParameter, "--volume takes gmsh or native");
+  mp.native_volume = volume == "native";
   if (!a.positionals().empty() || part.empty() || out.empty())
     throw Error(ErrorCode::InvalidParameter, "give --part and --out\n" + a.usage());
   if (mp.size < 0 || mp.min_size < 0) throw Error(ErrorCode::InvalidParameter, "mesh sizes must be positive (mm)");
@@ -78,7 +83,7 @@ int cmd_mesh(const Args& args) {
     j["quality"] = q.to_json();
     j["conformity"] = conf.to_json();
     j["seconds"] = {{"read_and_classify", sec(t0, t1)}, {"mesh", sec(t1, t2)}, {"write", sec(t2, t3)}};
-    j["mesher"] = "gmsh-fragments (interim)";
+    j["mesher"] = mp.native_volume ? "gmsh surfaces + native advancing front" : "gmsh-fragments (interim)";
     std::ofstream f(stats);
     f << j.dump(2) << "\n";
     if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);

@@ -16,6 +16,7 @@
 #include "common/error.h"
 #include "common/face_key.h"
 #include "io/msh.h"
+#include "mesh/volume_front.h"
 
 namespace topopt::mesh {
 namespace {
@@ -96,7 +97,7 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
     gmsh::option::setNumber("Mesh.MeshSizeMin", hmin);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 40);  // elements per 2π: the faceting error of a bore (≈ (2π/N)²/6 of a ring's volume) stays under 0.5 %
     gmsh::option::setNumber("Mesh.Optimize", 1);
-    gmsh::model::mesh::generate(3);
+    gmsh::model::mesh::generate(params.native_volume ? 2 : 3);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -129,6 +130,74 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
       tets.push_back({index.at(nt[4 * k]), index.at(nt[4 * k + 1]), index.at(nt[4 * k + 2]), index.at(nt[4 * k + 3])});
       dom.push_back(domain);
     }
+  }
+  if (params.native_volume) {
+    // Steps 12–14 on Gmsh's surface mesh: each non-design solid filled from its boundary,
+    // then Ω filled around their tets, by our advancing front.
+    auto shell = [&](const std::vector<std::pair<int, int>>& volumes) {
+      std::vector<std::pair<int, int>> bnd;
+      gmsh::model::getBoundary(volumes, bnd, true, false, false);
+      std::vector<std::array<int, 3>> tri;
+      for (auto [d, st] : bnd) {
+        std::vector<std::size_t> et, nt;
+        gmsh::model::mesh::getElementsByType(2, et, nt, std::abs(st));
+        for (size_t k = 0; k < et.size(); ++k)
+          tri.push_back({index.at(nt[3 * k]), index.at(nt[3 * k + 1]), index.at(nt[3 * k + 2])});
+      }
+      // Orient consistently by walking across shared edges (each edge used in opposite
+      // directions by its two triangles), then outward by the sign of the enclosed volume.
+      std::map<std::pair<int, int>, std::vector<int>> edge_tris;
+      for (size_t k = 0; k < tri.size(); ++k)
+        for (int e = 0; e < 3; ++e)
+          edge_tris[std::minmax(tri[k][e], tri[k][(e + 1) % 3])].push_back(static_cast<int>(k));
+      std::vector<char> done(tri.size(), 0);
+      for (size_t seed = 0; seed < tri.size(); ++seed) {
+        if (done[seed]) continue;
+        std::vector<int> stack{static_cast<int>(seed)};
+        done[seed] = 1;
+        while (!stack.empty()) {
+          int k = stack.back();
+          stack.pop_back();
+          for (int e = 0; e < 3; ++e) {
+            int a = tri[k][e], b = tri[k][(e + 1) % 3];
+            for (int j : edge_tris[std::minmax(a, b)]) {
+              if (done[j]) continue;
+              // j must use the edge as b → a
+              bool same = false;
+              for (int f = 0; f < 3; ++f) same |= tri[j][f] == a && tri[j][(f + 1) % 3] == b;
+              if (same) std::swap(tri[j][1], tri[j][2]);
+              done[j] = 1;
+              stack.push_back(j);
+            }
+          }
+        }
+      }
+      MatX3i F(tri.size(), 3);
+      double vol = 0;
+      for (size_t k = 0; k < tri.size(); ++k) {
+        F.row(k) << tri[k][0], tri[k][1], tri[k][2];
+        Eigen::Vector3d a = m.V.row(tri[k][0]), b = m.V.row(tri[k][1]), c = m.V.row(tri[k][2]);
+        vol += a.dot(b.cross(c)) / 6.0;
+      }
+      if (vol < 0) F.col(1).swap(F.col(2));
+      return F;
+    };
+    auto append = [&](const VolumeFillResult& r, int domain) {
+      m.V = r.V;
+      for (long t = 0; t < r.T.rows(); ++t) {
+        tets.push_back({r.T(t, 0), r.T(t, 1), r.T(t, 2), r.T(t, 3)});
+        dom.push_back(domain);
+      }
+    };
+    VolumeFillParams vp;
+    for (size_t i = 0; i < nd_volume.size(); ++i) {
+      progress.say("mesh", 0.5, "advancing front: non-design solid " + std::to_string(i + 1));
+      append(fill_volume(m.V, shell({{3, nd_volume[i]}}), MatX4i(), vp, progress), static_cast<int>(i) + 1);
+    }
+    MatX4i T0(tets.size(), 4);
+    for (size_t t = 0; t < tets.size(); ++t) T0.row(t) << tets[t][0], tets[t][1], tets[t][2], tets[t][3];
+    progress.say("mesh", 0.7, "advancing front: the design domain around the non-design tets");
+    append(fill_volume(m.V, shell(vols), T0, vp, progress), 0);
   }
   if (tets.empty()) throw Error(ErrorCode::MeshingFailed, "Gmsh produced no tetrahedra; try a smaller mesh size");
   m.T.resize(tets.size(), 4);

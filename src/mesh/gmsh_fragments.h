@@ -16,6 +16,10 @@ struct FragmentMeshParams {
   double min_size = 0;  ///< smallest size (mm); <= 0: size / 5
   /// Refuse meshes estimated above this many tets (memory: ~1 kB per tet through SIMP).
   double max_tets = 6e6;
+  /// Fill the volumes with our advancing front (mesh/volume_front.h) instead of Gmsh's 3D
+  /// mesher: each non-design solid from its surface, then Ω around their tets (steps 12–14
+  /// of the method, on Gmsh's conformal surface mesh). Experimental.
+  bool native_volume = false;
 };
 
 /// Meshes Ω with Ω̄ into one conformal tagged tet mesh: domain 0 = Ω − Ω̄, i = the i-th

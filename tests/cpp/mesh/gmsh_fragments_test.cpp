@@ -45,6 +45,19 @@ TEST(GmshFragments, CantileverAndBracketWithPadsInContact) {
   check("bracket", 0);
 }
 
+TEST(GmshFragments, NativeAdvancingFrontFillsTheVolumesConformally) {
+  // steps 12–14 on Gmsh's surface mesh: non-design solids first, then Ω around their tets
+  brep::TwoBReps model = example("cantilever");
+  FragmentMeshParams p;
+  p.size = 2.5;
+  p.native_volume = true;
+  TetMesh m = mesh_with_gmsh_fragments(model, p);
+  ConformityReport c = check_conformity(m, &model);
+  EXPECT_TRUE(c.ok()) << c.to_json().dump();
+  EXPECT_LT(c.max_volume_error, 1e-9);  // planar faces: exact
+  EXPECT_EQ(c.domain_volume.size(), 3u);
+}
+
 TEST(GmshFragments, TooLargeIsRefusedWithASizeToUse) {
   brep::TwoBReps model = example("cantilever");
   FragmentMeshParams p;
