@@ -17,7 +17,8 @@ int cmd_solve(const Args& args) {
               "  (displacements and von Mises stress per case) for ParaView. The job format is in\n"
               "  docs/job-format.md.\n"
               "  --out-dir  output folder (default: the job's output.directory, or out/ beside it)\n"
-              "  --solver   direct (CHOLMOD, default below 3 million unknowns) or iterative (PCG)\n"
+              "  --solver   direct (CHOLMOD sparse Cholesky, auto below 40 000 unknowns) or iterative\n"
+              "             (conjugate gradients with smoothed-aggregation multigrid, auto above)\n"
               "  --inp      also write the problem (first load case) as a CalculiX deck, to check\n"
               "             the result with: ccx -i <name without .inp>");
   if (a.wants_help()) {
