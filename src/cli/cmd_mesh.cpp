@@ -13,6 +13,7 @@
 #include "io/vtu.h"
 #include "mesh/conformity.h"
 #include "mesh/gmsh_fragments.h"
+#include "mesh/reorder.h"
 #include "mesh/tet_quality.h"
 
 namespace topopt::cli {
@@ -56,6 +57,7 @@ int cmd_mesh(const Args& args) {
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) { std::cerr << "[" << stage << "] " << msg << "\n"; };
   TetMesh m = mesh::mesh_with_gmsh_fragments(model, mp, progress);
+  mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
   auto t2 = clock::now();
   if (ext == ".msh") io::write_msh(out, m);
   else if (ext == ".vtu") io::write_vtu(out, m, {}, {});
