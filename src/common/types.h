@@ -9,6 +9,8 @@ namespace topopt {
 using MatX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 /// #T by 4 tetrahedra (node indices, 0-based, positive orientation).
 using MatX4i = Eigen::Matrix<int, Eigen::Dynamic, 4, Eigen::RowMajor>;
+/// #P by 2 points of a parameter plane (u, v).
+using MatX2d = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 /// #F by 3 triangles (node indices, 0-based).
 using MatX3i = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 /// #E by 2 segments (node indices, 0-based).
