@@ -6,7 +6,10 @@
 #include "brep/shape_io.h"
 #include "common/error.h"
 #include "io/job.h"
+#include "brep/topology_index.h"
 #include "mesh/conformity.h"
+#include "mesh/surface_check.h"
+#include "mesh/surface_mesher.h"
 #include "mesh/tet_quality.h"
 #include "pipeline/solve_job.h"
 
@@ -40,6 +43,44 @@ void bind_mesh(pybind11::module_& m) {
       R"doc(The conformal tagged tet mesh of a job's shapes (BREP strings) at the job's mesh size.
 Returns a dict: nodes #V x 3, tets #T x 4, domain #T (0 design, i non-design solid i),
 boundary_triangles #F x 3 with boundary_faces #F (FreeCAD face numbers), quality figures.)doc");
+
+  m.def(
+      "surface_mesh",
+      [](const std::string& brep, double size) {
+        if (size < 0) throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
+        mesh::SurfaceMesh sm;
+        std::vector<long> open;
+        long crossings = 0;
+        mesh::SurfaceQuality q;
+        {
+          pybind11::gil_scoped_release release;
+          const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep, "shape"));
+          mesh::SurfaceMeshParams p;
+          p.size = size;
+          sm = mesh::mesh_surface(topo, p);
+          open = mesh::open_edges_per_solid(topo, sm);
+          for (int s = 0; s < topo.num_solids(); ++s)
+            crossings += static_cast<long>(mesh::self_intersections(sm.V, mesh::solid_triangles(topo, sm, s)).size());
+          q = mesh::surface_quality(sm.V, sm.F);
+        }
+        pybind11::dict out;
+        out["nodes"] = sm.V;
+        out["triangles"] = sm.F;
+        out["faces"] = sm.face;
+        out["failed_faces"] = sm.failed_faces;
+        out["failure_reasons"] = sm.reasons;
+        out["open_edges_per_solid"] = open;
+        out["self_intersecting_pairs"] = crossings;
+        out["min_angle"] = q.min_angle;
+        out["share_below_20deg"] = q.share_below_20;
+        return out;
+      },
+      pybind11::arg("brep"), pybind11::arg("size") = 0.0,
+      R"doc(The native surface mesh of one model (a BREP string) at `size` mm (0: diagonal / 50).
+Returns a dict: nodes #V x 3, triangles #F x 3 (outward), faces #F (FreeCAD face numbers),
+failed_faces with failure_reasons, open_edges_per_solid (0 = closed and oriented),
+self_intersecting_pairs (within each solid, at most 100 counted), min_angle (degrees) and
+share_below_20deg.)doc");
 }
 
 }  // namespace topopt::py

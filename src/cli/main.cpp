@@ -71,6 +71,7 @@ const char* kUsage =
     "commands:\n"
     "  info      check the part and non-design solids; print topology and classification\n"
     "  mesh      mesh part and non-design solids into one tagged tetrahedral mesh\n"
+    "  surface   native surface mesh of one model, with its checks (closed, oriented, no self-intersection)\n"
     "  solve     linear elastic analysis of a job file\n"
     "  optimize  topology optimisation of a job file: mesh, SIMP, result surface\n"
     "Run 'topopt <command> --help' for a command's options.\n";
@@ -93,7 +94,7 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::map<std::string, int (*)(const Args&)> commands{
-      {"info", cmd_info}, {"mesh", cmd_mesh}, {"solve", cmd_solve}, {"optimize", cmd_optimize}};
+      {"info", cmd_info}, {"mesh", cmd_mesh}, {"solve", cmd_solve}, {"optimize", cmd_optimize}, {"surface", cmd_surface}};
   auto it = commands.find(argv[1]);
   if (it == commands.end()) {
     std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;

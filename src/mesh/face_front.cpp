@@ -66,10 +66,11 @@ class Front {
     lookup_[edge_key(a, b)] = id;
     ++degree_[a];
     ++degree_[b];
-    const double m[2] = {0.5 * (p(a)[0] + p(b)[0]), 0.5 * (p(a)[1] + p(b)[1])};
-    edge_cells_[cell_of(m)].push_back(id);
-    const double dx = p(a)[0] - p(b)[0], dy = p(a)[1] - p(b)[1];
-    max_len_ = std::max(max_len_, std::sqrt(dx * dx + dy * dy));
+    // in every cell its bounding box overlaps, so searches need not widen by the longest edge
+    const long i0 = cell_index(std::min(p(a)[0], p(b)[0]) - lo_[0]), i1 = cell_index(std::max(p(a)[0], p(b)[0]) - lo_[0]);
+    const long j0 = cell_index(std::min(p(a)[1], p(b)[1]) - lo_[1]), j1 = cell_index(std::max(p(a)[1], p(b)[1]) - lo_[1]);
+    for (long i = i0; i <= i1; ++i)
+      for (long j = j0; j <= j1; ++j) edge_cells_[cell_key(i, j)].push_back(id);
     ++alive_count_;
     return id;
   }
@@ -85,14 +86,14 @@ class Front {
   bool alive(int id) const { return alive_[id]; }
   int& fails(int id) { return fails_[id]; }
   long alive_count() const { return alive_count_; }
-  double max_len() const { return max_len_; }
 
   /// Calls fn(node) for nodes in grid cells within distance r of q (a superset).
   template <class Fn>
   void nodes_near(const double* q, double r, Fn&& fn) const {
     visit(node_cells_, q, r, fn);
   }
-  /// Calls fn(edge) for alive edges whose midpoint lies in cells within r of q.
+  /// Calls fn(edge) for alive edges that pass through cells within r of q (an edge may come
+  /// more than once).
   template <class Fn>
   void edges_near(const double* q, double r, Fn&& fn) const {
     visit(edge_cells_, q, r, [&](int e) {
@@ -103,9 +104,8 @@ class Front {
  private:
   using Cells = std::unordered_map<uint64_t, std::vector<int>>;
   uint64_t cell_key(long i, long j) const { return edge_key(static_cast<int>(i), static_cast<int>(j)); }
-  uint64_t cell_of(const double* q) const {
-    return cell_key(static_cast<long>(std::floor((q[0] - lo_[0]) / cell_)), static_cast<long>(std::floor((q[1] - lo_[1]) / cell_)));
-  }
+  long cell_index(double x) const { return static_cast<long>(std::floor(x / cell_)); }
+  uint64_t cell_of(const double* q) const { return cell_key(cell_index(q[0] - lo_[0]), cell_index(q[1] - lo_[1])); }
   template <class Fn>
   void visit(const Cells& cells, const double* q, double r, Fn&& fn) const {
     const long i0 = static_cast<long>(std::floor((q[0] - r - lo_[0]) / cell_)), i1 = static_cast<long>(std::floor((q[0] + r - lo_[0]) / cell_));
@@ -131,7 +131,6 @@ class Front {
   std::vector<char> pending_;
   std::unordered_map<uint64_t, int> lookup_;
   Cells node_cells_, edge_cells_;
-  double max_len_ = 0;
   long alive_count_ = 0;
 };
 
@@ -280,7 +279,7 @@ FaceFrontResult fill_face(const FaceFrontInput& in, const FaceFrontParams& param
     for (const auto& c : cand) crowded |= c.first < 0.45 * d;
     if (!crowded && pass < 3) cand.emplace_back(0.5 * d, -1);
     std::sort(cand.begin(), cand.end());
-    const double search = R + d + front.max_len();
+    const double search = R + d;
     int chosen = -1;
     bool made_new = false;
     for (const auto& c : cand) {

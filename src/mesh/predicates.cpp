@@ -2,9 +2,12 @@
 // expansions: sums of non-overlapping doubles, combined with error-free transformations
 // (two_sum; two_product by FMA), as in Shewchuk's "Adaptive Precision Floating-Point
 // Arithmetic and Fast Robust Geometric Predicates" (1997). It is only reached for nearly
-// degenerate inputs, so it favours clarity over speed.
+// degenerate inputs (though on meshes of planar faces that is often: collinear boundary
+// nodes, coplanar triangles), so its components live in an inline buffer and only very long
+// expansions (in-sphere of nearly cospherical points) reach the heap.
 #include "mesh/predicates.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -19,6 +22,41 @@ constexpr double kOrient2dBound = (3.0 + 16.0 * kEps) * kEps;
 constexpr double kOrient3dBound = (7.0 + 56.0 * kEps) * kEps;
 constexpr double kIncircleBound = (10.0 + 96.0 * kEps) * kEps;
 constexpr double kInsphereBound = (16.0 + 224.0 * kEps) * kEps;
+
+/// Storage of an expansion's components: inline up to 32, on the heap beyond.
+class Components {
+ public:
+  size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  double* begin() { return data(); }
+  double* end() { return data() + n_; }
+  const double* begin() const { return data(); }
+  const double* end() const { return data() + n_; }
+  double& operator[](size_t i) { return data()[i]; }
+  double back() const { return data()[n_ - 1]; }
+  void push_back(double x) {
+    if (n_ < kInline) {
+      buf_[n_++] = x;
+      return;
+    }
+    if (n_ == kInline) heap_.assign(buf_, buf_ + kInline);
+    heap_.push_back(x);
+    ++n_;
+  }
+  void resize_down(size_t n) {  // n <= size()
+    if (n_ > kInline && n <= kInline) std::copy(heap_.begin(), heap_.begin() + n, buf_), heap_.clear();
+    else if (n_ > kInline) heap_.resize(n);
+    n_ = n;
+  }
+
+ private:
+  static constexpr size_t kInline = 32;
+  double* data() { return n_ > kInline ? heap_.data() : buf_; }
+  const double* data() const { return n_ > kInline ? heap_.data() : buf_; }
+  double buf_[kInline];
+  std::vector<double> heap_;
+  size_t n_ = 0;
+};
 
 /// A number as an exact sum of doubles (components in increasing magnitude, no zeros).
 class Expansion {
@@ -57,7 +95,7 @@ class Expansion {
   }
 
  private:
-  std::vector<double> c_;
+  Components c_;
 
   static void two_sum(double a, double b, double& x, double& y) {
     x = a + b;
@@ -66,17 +104,18 @@ class Expansion {
   }
   /// Adds one double (Shewchuk's GROW-EXPANSION with zero elimination).
   void grow(double b) {
-    std::vector<double> out;
-    out.reserve(c_.size() + 1);
+    // in place: the k-th output is written after the k-th input has been read
     double q = b;
-    for (double e : c_) {
+    size_t k = 0;
+    const size_t n = c_.size();
+    for (size_t i = 0; i < n; ++i) {
       double x, y;
-      two_sum(q, e, x, y);
-      if (y != 0) out.push_back(y);
+      two_sum(q, c_[i], x, y);
+      if (y != 0) c_[k++] = y;
       q = x;
     }
-    if (q != 0) out.push_back(q);
-    c_.swap(out);
+    c_.resize_down(k);
+    if (q != 0) c_.push_back(q);
     // keep components increasing and non-overlapping: grow preserves both
   }
   /// This expansion times one double (SCALE-EXPANSION via FMA products).

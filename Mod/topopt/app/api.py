@@ -37,6 +37,31 @@ def info(part, nondesign=None, tolerance=-1.0):
         raise TopOptError(str(e), getattr(e, "code", "Internal")) from None
 
 
+def surface_mesh(shape, size=0.0, doc=None, name="SurfaceMesh"):
+    """The native surface mesh of one shape (every solid closed and outward, each triangle
+    tagged with its FreeCAD face number) and its checks.
+
+    size: target edge length in mm (0: the shape's diagonal / 50). Returns the dict of the
+    native `surface_mesh` (nodes, triangles, faces, failed_faces, open_edges_per_solid,
+    self_intersecting_pairs, min_angle, share_below_20deg); with `doc`, also adds a Mesh
+    feature `name` to it and returns (dict, feature).
+    """
+    try:
+        result = native().surface_mesh(_brep(shape), float(size))
+    except native().TopOptError as e:
+        raise TopOptError(str(e), getattr(e, "code", "Internal")) from None
+    if doc is None:
+        return result
+    import FreeCAD
+    import Mesh
+    pts = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]  # Vectors: FreeCAD 0.20 needs them
+    tri = [tuple(int(i) for i in t) for t in result["triangles"]]
+    feature = doc.addObject("Mesh::Feature", name)
+    feature.Mesh = Mesh.Mesh([[pts[a], pts[b], pts[c]] for a, b, c in tri])
+    doc.recompute()
+    return result, feature
+
+
 # --- Studies -------------------------------------------------------------------------------
 
 def new_study(doc, part, nondesign=(), volume_fraction=0.3, mesh_size=0.0, name="TopOptStudy"):

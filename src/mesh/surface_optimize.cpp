@@ -1,0 +1,282 @@
+// Flips and smoothing of a face's triangles judged on the surface (see surface_optimize.h).
+#include "mesh/surface_optimize.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "mesh/predicates.h"
+
+namespace topopt::mesh {
+namespace {
+
+uint64_t ekey(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+}
+
+/// Smallest angle (degrees) of the 3D triangle abc.
+double min_angle(const MatX3d& X, int a, int b, int c) {
+  const Eigen::Vector3d p[3] = {X.row(a), X.row(b), X.row(c)};
+  double m = 180;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+    if (u.squaredNorm() == 0 || v.squaredNorm() == 0) return 180;  // collapsed onto an apex: not judged
+    m = std::min(m, std::atan2(u.cross(v).norm(), u.dot(v)));
+  }
+  return m * 180 / M_PI;
+}
+
+bool ccw(const MatX2d& P, int a, int b, int c) {
+  return predicates::orient2d(P.row(a).data(), P.row(b).data(), P.row(c).data()) > 0;
+}
+
+/// 3D normals of abc and of the surface agree (guards flips and moves against folds on
+/// surfaces that turn a lot within one triangle).
+bool faces_out(const MatX3d& X, const MatX3d& N, int a, int b, int c) {
+  const Eigen::Vector3d n = (Eigen::Vector3d(X.row(b)) - Eigen::Vector3d(X.row(a))).cross(Eigen::Vector3d(X.row(c)) - Eigen::Vector3d(X.row(a)));
+  const Eigen::Vector3d s = Eigen::Vector3d(N.row(a)) + Eigen::Vector3d(N.row(b)) + Eigen::Vector3d(N.row(c));
+  return n.dot(s) > 0.5 * n.norm() * s.norm();
+}
+
+}  // namespace
+
+SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fixed, const SurfaceEval& eval,
+                                         const std::vector<std::array<int, 2>>& constrained, int rounds) {
+  SurfaceOptimizeStats st;
+  const long n = P.rows();
+  long nt = T.rows();
+  X.resize(n, 3);
+  MatX3d N(n, 3);  // surface normals in the parameters' orientation (Xu × Xv)
+  std::vector<Eigen::Vector3d> Xu(n), Xv(n);
+  auto evaluate = [&](long i) {
+    double x[3], du[3], dv[3];
+    eval(P.row(i).data(), x, du, dv);
+    X.row(i) << x[0], x[1], x[2];
+    Xu[i] = Eigen::Vector3d(du[0], du[1], du[2]);
+    Xv[i] = Eigen::Vector3d(dv[0], dv[1], dv[2]);
+    const Eigen::Vector3d nn = Xu[i].cross(Xv[i]);
+    N.row(i) = nn.norm() > 0 ? Eigen::RowVector3d(nn.normalized()) : Eigen::RowVector3d::Zero();
+  };
+  for (long i = 0; i < n; ++i) evaluate(i);
+  st.min_angle_before = 180;
+  for (long t = 0; t < nt; ++t) st.min_angle_before = std::min(st.min_angle_before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+  std::unordered_set<uint64_t> locked;
+  for (const auto& e : constrained) locked.insert(ekey(e[0], e[1]));
+
+  auto flip_sweep = [&]() {
+    long flips = 0;
+    for (int sweep = 0; sweep < 6; ++sweep) {
+      std::unordered_map<uint64_t, std::array<int, 2>> edge_tris;  // edge -> (t0, t1); -1 if none
+      edge_tris.reserve(3 * nt);
+      for (int t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k) {
+          auto [it, fresh] = edge_tris.try_emplace(ekey(T(t, k), T(t, (k + 1) % 3)), std::array<int, 2>{t, -1});
+          if (!fresh) it->second[1] = t;
+        }
+      std::vector<char> touched(nt, 0);
+      long here = 0;
+      for (const auto& [key, tt] : edge_tris) {
+        const int t0 = tt[0], t1 = tt[1];
+        if (t1 < 0 || touched[t0] || touched[t1] || locked.count(key)) continue;
+        // t0 = (a, b, c) with the edge a->b, t1 holds b->a and d
+        int k0 = 0;
+        while (ekey(T(t0, k0), T(t0, (k0 + 1) % 3)) != key) ++k0;
+        const int a = T(t0, k0), b = T(t0, (k0 + 1) % 3), c = T(t0, (k0 + 2) % 3);
+        int d = -1;
+        for (int k = 0; k < 3; ++k)
+          if (T(t1, k) != a && T(t1, k) != b) d = T(t1, k);
+        if (d < 0 || d == c || locked.count(ekey(c, d))) continue;
+        // new pair (c, a, d) and (d, b, c): valid in the parameters, better on the surface
+        if (!ccw(P, c, a, d) || !ccw(P, d, b, c)) continue;
+        const double before = std::min(min_angle(X, a, b, c), min_angle(X, b, a, d));
+        const double after = std::min(min_angle(X, c, a, d), min_angle(X, d, b, c));
+        if (after <= before + 0.5) continue;
+        if (!faces_out(X, N, c, a, d) || !faces_out(X, N, d, b, c)) continue;
+        T.row(t0) << c, a, d;
+        T.row(t1) << d, b, c;
+        touched[t0] = touched[t1] = 1;
+        ++here;
+      }
+      flips += here;
+      if (!here) break;
+    }
+    return flips;
+  };
+
+  auto smooth_sweep = [&]() {
+    long moves = 0;
+    std::vector<std::vector<int>> star(n);
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) star[T(t, k)].push_back(t);
+    std::vector<int> nbr;
+    for (long i = fixed; i < n; ++i) {
+      if (star[i].empty()) continue;
+      nbr.clear();
+      for (int t : star[i])
+        for (int k = 0; k < 3; ++k)
+          if (T(t, k) != i) nbr.push_back(T(t, k));
+      std::sort(nbr.begin(), nbr.end());
+      nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
+      Eigen::Vector3d target = Eigen::Vector3d::Zero();
+      for (int j : nbr) target += Eigen::Vector3d(X.row(j));
+      target /= static_cast<double>(nbr.size());
+      // one Gauss-Newton step back onto the surface: [Xu Xv] d = target - X
+      Eigen::Matrix<double, 3, 2> J;
+      J << Xu[i], Xv[i];
+      const Eigen::Matrix2d JtJ = J.transpose() * J;
+      if (std::abs(JtJ.determinant()) < 1e-300) continue;
+      const Eigen::Vector2d dlt = JtJ.ldlt().solve(J.transpose() * (target - Eigen::Vector3d(X.row(i))));
+      double old_min = 180, old_sum = 0;
+      for (int t : star[i]) {
+        const double m = min_angle(X, T(t, 0), T(t, 1), T(t, 2));
+        old_min = std::min(old_min, m), old_sum += m;
+      }
+      const Eigen::RowVector2d old_p = P.row(i);
+      const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
+      const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
+      bool ok = false;
+      for (double step : {1.0, 0.5, 0.25}) {
+        P.row(i) = old_p + step * dlt.transpose();
+        bool valid = true;
+        for (int t : star[i]) valid &= ccw(P, T(t, 0), T(t, 1), T(t, 2));
+        if (!valid) continue;
+        evaluate(i);
+        double new_min = 180, new_sum = 0;
+        for (int t : star[i]) {
+          const double m = min_angle(X, T(t, 0), T(t, 1), T(t, 2));
+          new_min = std::min(new_min, m), new_sum += m;
+          valid &= faces_out(X, N, T(t, 0), T(t, 1), T(t, 2));
+        }
+        // the star's smallest angle rises, or its angles improve on the whole without the
+        // smallest dropping below min(before, 30°)
+        const bool better = new_min > old_min || (new_sum > old_sum && new_min >= std::min(old_min, 30.0));
+        if (valid && better) {
+          ok = true;
+          break;
+        }
+      }
+      if (ok) {
+        ++moves;
+      } else {
+        P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
+      }
+    }
+    return moves;
+  };
+
+  // Collapse of short edges that make needles (the front sometimes leaves an edge much
+  // shorter than its neighbours where fronts meet): the edge's movable end goes onto the other
+  // end (or both onto the middle), kept only if every triangle stays valid in the parameters
+  // and the smallest angle of the region rises.
+  std::vector<char> keep_node(n, 0);
+  for (long i = 0; i < fixed; ++i) keep_node[i] = 1;
+  for (const auto& e : constrained) keep_node[e[0]] = keep_node[e[1]] = 1;
+  std::vector<char> dead(nt, 0);
+  auto collapse_sweep = [&]() {
+    long done = 0;
+    std::vector<std::vector<int>> star(n);
+    for (int t = 0; t < nt; ++t)
+      if (!dead[t])
+        for (int k = 0; k < 3; ++k) star[T(t, k)].push_back(t);
+    std::vector<char> busy(n, 0);
+    std::vector<int> na, nb, region;
+    for (int t0 = 0; t0 < nt; ++t0) {
+      if (dead[t0]) continue;
+      // the triangle's shortest edge, if clearly shorter than the other two
+      double l[3];
+      for (int k = 0; k < 3; ++k) l[k] = (X.row(T(t0, k)) - X.row(T(t0, (k + 1) % 3))).norm();
+      const int k = l[0] <= l[1] && l[0] <= l[2] ? 0 : (l[1] <= l[2] ? 1 : 2);
+      if (l[k] > 0.7 * std::min(l[(k + 1) % 3], l[(k + 2) % 3])) continue;
+      int a = T(t0, k), b = T(t0, (k + 1) % 3);
+      if (keep_node[b]) std::swap(a, b);
+      if (keep_node[b] || busy[a] || busy[b]) continue;
+      // link condition: a and b share exactly the two apexes of the edge's triangles
+      auto neighbours = [&](int v, std::vector<int>& out) {
+        out.clear();
+        for (int t : star[v])
+          for (int j = 0; j < 3; ++j)
+            if (T(t, j) != v) out.push_back(T(t, j));
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+      };
+      neighbours(a, na), neighbours(b, nb);
+      int common = 0;
+      for (int v : na) common += std::binary_search(nb.begin(), nb.end(), v);
+      int shared = 0;
+      for (int t : star[b]) shared += (T(t, 0) == a || T(t, 1) == a || T(t, 2) == a);
+      if (common != 2 || shared != 2) continue;
+      region.assign(star[a].begin(), star[a].end());
+      region.insert(region.end(), star[b].begin(), star[b].end());
+      std::sort(region.begin(), region.end());
+      region.erase(std::unique(region.begin(), region.end()), region.end());
+      double before = 180;
+      for (int t : region) before = std::min(before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+      const Eigen::RowVector2d pa = P.row(a), pb = P.row(b);
+      const Eigen::RowVector3d xa = X.row(a), na_ = N.row(a);
+      const Eigen::Vector3d ua = Xu[a], va = Xv[a];
+      if (!keep_node[a]) {
+        P.row(a) = 0.5 * (pa + pb);
+        evaluate(a);
+      }
+      // b's triangles without a now use a
+      bool ok = true;
+      double after = 180;
+      for (int t : region) {
+        int v[3] = {T(t, 0), T(t, 1), T(t, 2)};
+        bool has_a = false, has_b = false;
+        for (int& x : v) has_a |= x == a, has_b |= x == b;
+        if (has_a && has_b) continue;  // removed
+        for (int& x : v)
+          if (x == b) x = a;
+        if (!ccw(P, v[0], v[1], v[2]) || !faces_out(X, N, v[0], v[1], v[2])) {
+          ok = false;
+          break;
+        }
+        after = std::min(after, min_angle(X, v[0], v[1], v[2]));
+      }
+      if (!ok || after <= before + 1) {
+        P.row(a) = pa, X.row(a) = xa, N.row(a) = na_, Xu[a] = ua, Xv[a] = va;
+        continue;
+      }
+      for (int t : region) {
+        bool has_a = false, has_b = false;
+        for (int j = 0; j < 3; ++j) has_a |= T(t, j) == a, has_b |= T(t, j) == b;
+        if (has_a && has_b) {
+          dead[t] = 1;
+          continue;
+        }
+        for (int j = 0; j < 3; ++j)
+          if (T(t, j) == b) T(t, j) = a;
+      }
+      busy[a] = busy[b] = 1;
+      for (int v : na) busy[v] = 1;
+      for (int v : nb) busy[v] = 1;
+      star[b].clear();
+      ++done;
+    }
+    // drop the removed triangles
+    if (done) {
+      long w = 0;
+      for (long t = 0; t < nt; ++t)
+        if (!dead[t]) T.row(w++) = T.row(t);
+      T.conservativeResize(w, 3);
+      nt = w;
+      dead.assign(nt, 0);
+    }
+    return done;
+  };
+
+  for (int r = 0; r < rounds; ++r) {
+    st.flips += flip_sweep();
+    st.collapses += collapse_sweep();
+    st.moves += smooth_sweep();
+  }
+  st.flips += flip_sweep();
+  st.min_angle_after = 180;
+  for (long t = 0; t < nt; ++t) st.min_angle_after = std::min(st.min_angle_after, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+  return st;
+}
+
+}  // namespace topopt::mesh
