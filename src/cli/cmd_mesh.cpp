@@ -13,6 +13,7 @@
 #include "io/vtu.h"
 #include "mesh/conformity.h"
 #include "mesh/gmsh_fragments.h"
+#include "mesh/native_mesher.h"
 #include "mesh/reorder.h"
 #include "mesh/tet_quality.h"
 
@@ -21,7 +22,7 @@ namespace topopt::cli {
 int cmd_mesh(const Args& args) {
   ArgReader a(args,
               "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] --out FILE\n"
-              "                   [--stats STATS.json] [--volume gmsh|native]\n"
+              "                   [--stats STATS.json] [--volume gmsh|native] [--mesher gmsh|native]\n"
               "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
               "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
               "  part's face numbers (FreeCAD's FaceN).\n"
@@ -30,6 +31,8 @@ int cmd_mesh(const Args& args) {
               "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
               "  --volume who fills the volumes: gmsh (default) or native (our advancing front on\n"
               "           Gmsh's surface mesh; experimental)\n"
+              "  --mesher native: our surface mesher and our volume front end to end (a part without\n"
+              "           non-design solids only, until the 14-step driver lands)\n"
               "  Meshing is currently done by Gmsh's OCC fragments (interim, see README).");
   if (a.wants_help()) {
     std::cout << a.usage() << "\n";
@@ -39,7 +42,8 @@ int cmd_mesh(const Args& args) {
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);
   mp.min_size = a.number("min-size", 0);
-  std::string volume = a.option("volume", "gmsh");
+  std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "gmsh");
+  if (mesher != "gmsh" && mesher != "native") throw Error(ErrorCode::InvalidParameter, "--mesher takes gmsh or native");
   if (volume != "gmsh" && volume != "native") throw Error(ErrorCode::InvalidParameter, "--volume takes gmsh or native");
   mp.native_volume = volume == "native";
   if (!a.positionals().empty() || part.empty() || out.empty())
@@ -56,7 +60,15 @@ int cmd_mesh(const Args& args) {
   auto t1 = clock::now();
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) { std::cerr << "[" << stage << "] " << msg << "\n"; };
-  TetMesh m = mesh::mesh_with_gmsh_fragments(model, mp, progress);
+  TetMesh m;
+  if (mesher == "native") {
+    mesh::NativeMeshParams np;
+    np.surface.size = mp.size;
+    np.surface.min_size = mp.min_size;
+    m = mesh::mesh_native(model, np, progress);
+  } else {
+    m = mesh::mesh_with_gmsh_fragments(model, mp, progress);
+  }
   mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
   auto t2 = clock::now();
   if (ext == ".msh") io::write_msh(out, m);
@@ -85,7 +97,8 @@ int cmd_mesh(const Args& args) {
     j["quality"] = q.to_json();
     j["conformity"] = conf.to_json();
     j["seconds"] = {{"read_and_classify", sec(t0, t1)}, {"mesh", sec(t1, t2)}, {"write", sec(t2, t3)}};
-    j["mesher"] = mp.native_volume ? "gmsh surfaces + native advancing front" : "gmsh-fragments (interim)";
+    j["mesher"] = mesher == "native" ? "native surface + native advancing front"
+                  : mp.native_volume ? "gmsh surfaces + native advancing front" : "gmsh-fragments (interim)";
     std::ofstream f(stats);
     f << j.dump(2) << "\n";
     if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);

@@ -74,9 +74,26 @@ class Expansion {
     if (x != 0) e.c_.push_back(x);
     return e;
   }
+  /// Sum in linear time: the components of both merged by increasing magnitude, then one
+  /// chain of error-free additions (Shewchuk's FAST-EXPANSION-SUM with zero elimination).
   Expansion operator+(const Expansion& o) const {
-    Expansion r = *this;
-    for (double b : o.c_) r.grow(b);
+    if (c_.empty()) return o;
+    if (o.c_.empty()) return *this;
+    Expansion r;
+    size_t i = 0, j = 0;
+    const size_t n = c_.size(), m = o.c_.size();
+    auto next = [&]() {  // the smaller-magnitude head of the two sequences
+      if (j >= m || (i < n && std::abs(c_.begin()[i]) < std::abs(o.c_.begin()[j]))) return c_.begin()[i++];
+      return o.c_.begin()[j++];
+    };
+    double q = next();
+    while (i < n || j < m) {
+      double x, y;
+      two_sum(q, next(), x, y);
+      if (y != 0) r.c_.push_back(y);
+      q = x;
+    }
+    if (q != 0) r.c_.push_back(q);
     return r;
   }
   Expansion operator-() const {
@@ -118,14 +135,27 @@ class Expansion {
     if (q != 0) c_.push_back(q);
     // keep components increasing and non-overlapping: grow preserves both
   }
-  /// This expansion times one double (SCALE-EXPANSION via FMA products).
+  /// This expansion times one double in linear time (SCALE-EXPANSION with zero
+  /// elimination; exact products by FMA): each component's product is folded into a running
+  /// high part, emitting the low parts in increasing order.
   Expansion scaled(double b) const {
     Expansion r;
-    for (double e : c_) {
-      double x = e * b, y = std::fma(e, b, -x);
-      r.grow(y);
-      r.grow(x);
+    if (c_.empty() || b == 0) return r;
+    const double* e = c_.begin();
+    double q = e[0] * b, low = std::fma(e[0], b, -q);
+    if (low != 0) r.c_.push_back(low);
+    for (size_t i = 1; i < c_.size(); ++i) {
+      const double hi = e[i] * b, lo = std::fma(e[i], b, -hi);
+      double sum, err;
+      two_sum(q, lo, sum, err);
+      if (err != 0) r.c_.push_back(err);
+      // |hi| dominates |sum| here, so the fast two-sum is exact
+      const double x = hi + sum;
+      err = sum - (x - hi);
+      if (err != 0) r.c_.push_back(err);
+      q = x;
     }
+    if (q != 0) r.c_.push_back(q);
     return r;
   }
 };
@@ -148,6 +178,8 @@ int orient2d(const double* a, const double* b, const double* c) {
   double det = l - r, bound = kOrient2dBound * (std::abs(l) + std::abs(r));
   if (det > bound) return 1;
   if (-det > bound) return -1;
+  // on a line x = const or y = const: exactly collinear (see orient3d)
+  if ((a[0] == c[0] && b[0] == c[0]) || (a[1] == c[1] && b[1] == c[1])) return 0;
   ++fallbacks;
   Expansion ax = Expansion::diff(a[0], c[0]), ay = Expansion::diff(a[1], c[1]);
   Expansion bx = Expansion::diff(b[0], c[0]), by = Expansion::diff(b[1], c[1]);
@@ -168,6 +200,15 @@ int orient3d(const double* a, const double* b, const double* c, const double* d)
   double bound = kOrient3dBound * perm;
   if (det > bound) return -1;
   if (-det > bound) return 1;
+  // A zero column (all four points on a plane x, y or z = const, the common case on
+  // axis-aligned planar faces) makes the determinant exactly zero: a rounded difference of
+  // doubles is zero only when they are equal.
+  if ((adx == 0 && bdx == 0 && cdx == 0) || (ady == 0 && bdy == 0 && cdy == 0) || (adz == 0 && bdz == 0 && cdz == 0))
+    return 0;
+  // two equal points (a zero row, or two equal rows): the meshers ask this often, e.g. for a
+  // segment against a triangle that shares one of its nodes
+  auto same = [](const double* p, const double* q) { return p[0] == q[0] && p[1] == q[1] && p[2] == q[2]; };
+  if (same(a, d) || same(b, d) || same(c, d) || same(a, b) || same(a, c) || same(b, c)) return 0;
   ++fallbacks;
   Expansion m[3][3];
   const double* p[3] = {a, b, c};

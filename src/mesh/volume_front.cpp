@@ -49,14 +49,27 @@ class Grid {
       for (long y = a[1]; y <= b[1]; ++y)
         for (long z = a[2]; z <= b[2]; ++z) buckets_[key(x, y, z)].push_back(id);
   }
-  /// Appends the ids in the cells overlapping [lo, hi] (with duplicates) to out.
-  void query(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+  /// Appends the live ids (keep(id)) in the cells overlapping [lo, hi] to out, each once
+  /// (`stamp` marks ids already taken in this query: sized to the id range by the caller,
+  /// holding values < `ticket`). Dead ids are dropped from the cells visited on the way.
+  template <class Keep>
+  void query(const Vec3& lo, const Vec3& hi, std::vector<int>& out, Keep&& keep, std::vector<unsigned>& stamp,
+             unsigned ticket) {
     auto a = cell(lo), b = cell(hi);
     for (long x = a[0]; x <= b[0]; ++x)
       for (long y = a[1]; y <= b[1]; ++y)
         for (long z = a[2]; z <= b[2]; ++z) {
           auto it = buckets_.find(key(x, y, z));
-          if (it != buckets_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+          if (it == buckets_.end()) continue;
+          std::vector<int>& ids = it->second;
+          size_t w = 0;
+          for (size_t r = 0; r < ids.size(); ++r) {
+            const int id = ids[r];
+            if (!keep(id)) continue;
+            ids[w++] = id;
+            if (stamp[id] != ticket) stamp[id] = ticket, out.push_back(id);
+          }
+          ids.resize(w);
         }
   }
 
@@ -161,18 +174,17 @@ class Front {
   long size() const { return count_; }
   int& fails(int id) { return fails_[id]; }
   bool active(int v) const { return v < static_cast<int>(active_.size()) && active_[v] > 0; }
-  void faces_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+  void faces_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) {
     out.clear();
-    faces_grid_.query(lo, hi, out);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    out.erase(std::remove_if(out.begin(), out.end(), [&](int f) { return !alive_[f]; }), out.end());
+    if (face_stamp_.size() < faces_.size()) face_stamp_.resize(faces_.size() + faces_.size() / 2 + 16, 0);
+    faces_grid_.query(lo, hi, out, [&](int f) { return alive_[f] != 0; }, face_stamp_, ++face_ticket_);
   }
-  void nodes_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) const {
+  /// Active front nodes in the box. A node that left the front may come back (a removed
+  /// tet), so nodes stay in the grid and are filtered here, not dropped.
+  void nodes_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) {
     out.clear();
-    nodes_grid_.query(lo, hi, out);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (node_stamp_.size() < P_.size()) node_stamp_.resize(P_.size() + P_.size() / 2 + 16, 0);
+    nodes_grid_.query(lo, hi, out, [&](int v) { return in_grid_keep(v); }, node_stamp_, ++node_ticket_);
     out.erase(std::remove_if(out.begin(), out.end(), [&](int v) { return !active(v); }), out.end());
   }
   int any_alive() const {
@@ -192,6 +204,9 @@ class Front {
   std::vector<char> in_grid_;
   Grid faces_grid_, nodes_grid_;
   long count_ = 0;
+  std::vector<unsigned> face_stamp_, node_stamp_;
+  unsigned face_ticket_ = 0, node_ticket_ = 0;
+  bool in_grid_keep(int v) const { return v < static_cast<int>(in_grid_.size()) && in_grid_[v]; }
 };
 
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
