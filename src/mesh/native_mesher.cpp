@@ -23,6 +23,11 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
   }
   progress.say("mesh", 0.3, "volume mesh");
   VolumeFillParams vp = params.volume;
+  if (!vp.size) {
+    // the surface's target size inside; the front grades towards it from finer boundary parts
+    const double h = params.surface.size > 0 ? params.surface.size : model.part.diagonal() / 50;
+    vp.size = [h](const double*) { return h; };
+  }
   VolumeFillResult r = fill_volume(s.V, s.F, MatX4i(), vp, progress);
   TetMesh m;
   m.V = std::move(r.V);

@@ -211,6 +211,130 @@ class Front {
 
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
 
+
+uint64_t edge_id(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+}
+
+/// Flips among the new tets (the input's tets and boundary are never touched: a face is only
+/// flipped when two new tets share it, an edge only when exactly three new tets close a ring
+/// around it). 3-2: an edge surrounded by three tets becomes the triangle of its ring; 2-3:
+/// a face shared by two tets becomes the edge joining their apexes. A flip is kept only when
+/// it is valid (exact orientation tests) and raises the worst radius ratio of the tets
+/// involved. Only tets below `bad` are worked on. Returns the number of flips.
+long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& tets, double bad) {
+  long flips = 0;
+  auto positive = [&](std::array<int, 4>& t) {  // orients t; false if flat
+    const int o = orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data());
+    if (o == 0) return false;
+    if (o < 0) std::swap(t[2], t[3]);
+    return true;
+  };
+  auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
+  for (int sweep = 0; sweep < 4; ++sweep) {
+    long here = 0;
+    std::unordered_map<uint64_t, std::vector<int>> around;  // edge -> tets
+    std::unordered_map<TriKey, std::vector<int>, TriKeyHash> sharing;  // face -> tets
+    around.reserve(tets.size() * 7);
+    sharing.reserve(tets.size() * 2);
+    for (size_t t = 0; t < tets.size(); ++t) {
+      const auto& v = tets[t];
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) around[edge_id(v[i], v[j])].push_back(static_cast<int>(t));
+      for (const auto& f : kFace) sharing[key_of(v[f[0]], v[f[1]], v[f[2]])].push_back(static_cast<int>(t));
+    }
+    std::vector<char> touched(tets.size(), 0);
+    // the maps above go stale where a flip happened: nodes of flipped tets are not used
+    // again in this sweep
+    std::vector<char> locked(P.size(), 0);
+    auto lock = [&](std::initializer_list<int> vs) {
+      for (int x : vs) locked[x] = 1;
+    };
+    auto any_locked = [&](std::initializer_list<int> vs) {
+      for (int x : vs)
+        if (locked[x]) return true;
+      return false;
+    };
+    const size_t n0 = tets.size();
+    for (size_t t = 0; t < n0; ++t) {
+      if (touched[t] || rho(tets[t]) >= bad) continue;
+      const std::array<int, 4> v = tets[t];
+      bool done = false;
+      // 3-2 on each edge of t
+      for (int i = 0; i < 4 && !done; ++i)
+        for (int j = i + 1; j < 4 && !done; ++j) {
+          const auto it = around.find(edge_id(v[i], v[j]));
+          if (it == around.end() || it->second.size() != 3) continue;
+          const auto& ring_tets = it->second;
+          bool free = true;
+          for (int r : ring_tets) free &= !touched[r];
+          if (!free) continue;
+          const int u = v[i], w = v[j];
+          std::vector<int> ring;
+          for (int r : ring_tets)
+            for (int x : tets[r])
+              if (x != u && x != w) ring.push_back(x);
+          std::sort(ring.begin(), ring.end());
+          // closed ring: every ring vertex appears in exactly two of the three tets
+          if (ring.size() != 6 || ring[0] != ring[1] || ring[2] != ring[3] || ring[4] != ring[5]) continue;
+          const int p = ring[0], q = ring[2], r = ring[4];
+          if (any_locked({u, w, p, q, r})) continue;
+          const int s1 = orient3d(P[u].data(), P[w].data(), P[p].data(), P[q].data());
+          const int s2 = orient3d(P[u].data(), P[w].data(), P[q].data(), P[r].data());
+          const int s3 = orient3d(P[u].data(), P[w].data(), P[r].data(), P[p].data());
+          if (s1 == 0 || s1 != s2 || s2 != s3) continue;
+          // and the segment, not only its line, crosses the ring's triangle
+          if (orient3d(P[p].data(), P[q].data(), P[r].data(), P[u].data()) *
+                  orient3d(P[p].data(), P[q].data(), P[r].data(), P[w].data()) >= 0)
+            continue;
+          std::array<int, 4> n1{p, q, r, u}, n2{p, q, r, w};
+          if (!positive(n1) || !positive(n2)) continue;
+          double before = 1;
+          for (int rt : ring_tets) before = std::min(before, rho(tets[rt]));
+          if (std::min(rho(n1), rho(n2)) <= before) continue;
+          tets[ring_tets[0]] = n1, tets[ring_tets[1]] = n2, tets[ring_tets[2]] = {-1, -1, -1, -1};
+          for (int rt : ring_tets) touched[rt] = 1;
+          lock({u, w, p, q, r});
+          ++here, done = true;
+        }
+      // 2-3 on each face of t
+      for (int fi = 0; fi < 4 && !done; ++fi) {
+        const int a = v[kFace[fi][0]], b = v[kFace[fi][1]], c = v[kFace[fi][2]], d = v[fi];
+        const auto it = sharing.find(key_of(a, b, c));
+        if (it == sharing.end() || it->second.size() != 2) continue;
+        const int t2 = it->second[0] == static_cast<int>(t) ? it->second[1] : it->second[0];
+        if (touched[t2]) continue;
+        int e = -1;
+        for (int x : tets[t2])
+          if (x != a && x != b && x != c) e = x;
+        if (e < 0 || around.count(edge_id(d, e))) continue;  // the new edge must not exist yet
+        if (any_locked({a, b, c, d, e})) continue;
+        const int s1 = orient3d(P[d].data(), P[e].data(), P[a].data(), P[b].data());
+        const int s2 = orient3d(P[d].data(), P[e].data(), P[b].data(), P[c].data());
+        const int s3 = orient3d(P[d].data(), P[e].data(), P[c].data(), P[a].data());
+        if (s1 == 0 || s1 != s2 || s2 != s3) continue;
+        if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[d].data()) *
+                orient3d(P[a].data(), P[b].data(), P[c].data(), P[e].data()) >= 0)
+          continue;
+        std::array<int, 4> n1{a, b, d, e}, n2{b, c, d, e}, n3{c, a, d, e};
+        if (!positive(n1) || !positive(n2) || !positive(n3)) continue;
+        const double before = std::min(rho(tets[t]), rho(tets[t2]));
+        if (std::min({rho(n1), rho(n2), rho(n3)}) <= before) continue;
+        tets[t] = n1, tets[t2] = n2, tets.push_back(n3);
+        touched[t] = touched[t2] = 1;
+        touched.push_back(1);
+        lock({a, b, c, d, e});
+        ++here, done = true;
+      }
+    }
+    tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& x) { return x[0] < 0; }), tets.end());
+    flips += here;
+    if (!here) break;
+  }
+  return flips;
+}
+
 }  // namespace
 
 VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
@@ -518,9 +642,12 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   }
 
   tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }), tets.end());
-  // ---- node smoothing of the new nodes: move to the neighbours' centroid when that
-  // improves the worst radius ratio around the node and keeps every tet positive
+  // ---- quality: flips of the bad tets, then node smoothing, twice
   const int first_new = static_cast<int>(V.rows());
+  for (int round = 0; round < 2; ++round) {
+  if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
+  // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
+  // worst radius ratio around the node and keeps every tet positive
   if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
     std::vector<std::vector<int>> around(P.size() - first_new);
     for (size_t t = 0; t < tets.size(); ++t)
@@ -552,6 +679,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
         }
         if (!ok || now < worst) P[v] = old;
       }
+  }
   }
   VolumeFillResult out;
   out.V.resize(P.size(), 3);
