@@ -212,11 +212,6 @@ class Front {
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
 
 
-uint64_t edge_id(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
-}
-
 /// Flips among the new tets (the input's tets and boundary are never touched: a face is only
 /// flipped when two new tets share it, an edge only when exactly three new tets close a ring
 /// around it). 3-2: an edge surrounded by three tets becomes the triangle of its ring; 2-3:
@@ -234,16 +229,28 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
   for (int sweep = 0; sweep < 4; ++sweep) {
     long here = 0;
-    std::unordered_map<uint64_t, std::vector<int>> around;  // edge -> tets
-    std::unordered_map<TriKey, std::vector<int>, TriKeyHash> sharing;  // face -> tets
-    around.reserve(tets.size() * 7);
-    sharing.reserve(tets.size() * 2);
-    for (size_t t = 0; t < tets.size(); ++t) {
-      const auto& v = tets[t];
-      for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) around[edge_id(v[i], v[j])].push_back(static_cast<int>(t));
-      for (const auto& f : kFace) sharing[key_of(v[f[0]], v[f[1]], v[f[2]])].push_back(static_cast<int>(t));
+    // node stars (CSR): the tets around an edge or a face are found by filtering a star
+    std::vector<int> start(P.size() + 1, 0), star(4 * tets.size());
+    for (const auto& v : tets)
+      for (int x : v) ++start[x + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    {
+      std::vector<int> fill(start.begin(), start.end() - 1);
+      for (size_t t = 0; t < tets.size(); ++t)
+        for (int x : tets[t]) star[fill[x]++] = static_cast<int>(t);
     }
+    auto has = [&](int t, int x) {
+      const auto& v = tets[t];
+      return v[0] == x || v[1] == x || v[2] == x || v[3] == x;
+    };
+    std::vector<int> ring_tets, face_tets;
+    auto tets_with = [&](int u, int w, int x, std::vector<int>& out) {  // x < 0: edge (u, w) only
+      out.clear();
+      for (int k = start[u]; k < start[u + 1]; ++k) {
+        const int t = star[k];
+        if (has(t, w) && (x < 0 || has(t, x))) out.push_back(t);
+      }
+    };
     std::vector<char> touched(tets.size(), 0);
     // the maps above go stale where a flip happened: nodes of flipped tets are not used
     // again in this sweep
@@ -261,54 +268,98 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
       if (touched[t] || rho(tets[t]) >= bad) continue;
       const std::array<int, 4> v = tets[t];
       bool done = false;
-      // 3-2 on each edge of t
+      // edge removal on each edge of t: the k = 3..7 tets around an inner edge (u, w) are
+      // replaced by 2(k - 2) tets over a triangulation of their ring (fans from each ring
+      // vertex tried, the best kept); k = 3 is the 3-2 flip
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j) {
-          const auto it = around.find(edge_id(v[i], v[j]));
-          if (it == around.end() || it->second.size() != 3) continue;
-          const auto& ring_tets = it->second;
+          tets_with(v[i], v[j], -1, ring_tets);
+          const int k = static_cast<int>(ring_tets.size());
+          if (k < 3 || k > 7) continue;
           bool free = true;
           for (int r : ring_tets) free &= !touched[r];
           if (!free) continue;
-          const int u = v[i], w = v[j];
-          std::vector<int> ring;
-          for (int r : ring_tets)
+          int u = v[i], w = v[j];
+          // the ring in cyclic order: each tet gives the pair of its other two nodes
+          std::vector<std::array<int, 2>> pairs;
+          for (int r : ring_tets) {
+            std::array<int, 2> pr{-1, -1};
+            int m = 0;
             for (int x : tets[r])
-              if (x != u && x != w) ring.push_back(x);
-          std::sort(ring.begin(), ring.end());
-          // closed ring: every ring vertex appears in exactly two of the three tets
-          if (ring.size() != 6 || ring[0] != ring[1] || ring[2] != ring[3] || ring[4] != ring[5]) continue;
-          const int p = ring[0], q = ring[2], r = ring[4];
-          if (any_locked({u, w, p, q, r})) continue;
-          const int s1 = orient3d(P[u].data(), P[w].data(), P[p].data(), P[q].data());
-          const int s2 = orient3d(P[u].data(), P[w].data(), P[q].data(), P[r].data());
-          const int s3 = orient3d(P[u].data(), P[w].data(), P[r].data(), P[p].data());
-          if (s1 == 0 || s1 != s2 || s2 != s3) continue;
-          // and the segment, not only its line, crosses the ring's triangle
-          if (orient3d(P[p].data(), P[q].data(), P[r].data(), P[u].data()) *
-                  orient3d(P[p].data(), P[q].data(), P[r].data(), P[w].data()) >= 0)
-            continue;
-          std::array<int, 4> n1{p, q, r, u}, n2{p, q, r, w};
-          if (!positive(n1) || !positive(n2)) continue;
+              if (x != u && x != w) pr[m++] = x;
+            pairs.push_back(pr);
+          }
+          std::vector<int> ring{pairs[0][0], pairs[0][1]};
+          std::vector<char> used(k, 0);
+          used[0] = 1;
+          bool closed = true;
+          for (int step = 1; step < k && closed; ++step) {
+            closed = false;
+            for (int q = 0; q < k; ++q) {
+              if (used[q]) continue;
+              int nxt = pairs[q][0] == ring.back() ? pairs[q][1] : (pairs[q][1] == ring.back() ? pairs[q][0] : -1);
+              if (nxt < 0) continue;
+              used[q] = 1, closed = true;
+              if (step < k - 1) ring.push_back(nxt);
+              else closed = nxt == ring.front();
+              break;
+            }
+          }
+          if (!closed || static_cast<int>(ring.size()) != k) continue;
+          bool any = any_locked({u, w});
+          for (int x : ring) any |= locked[x] != 0;
+          if (any) continue;
+          // orient the ring so that (u, w, r_i, r_i+1) are the positive tets
+          if (orient3d(P[u].data(), P[w].data(), P[ring[0]].data(), P[ring[1]].data()) < 0) std::reverse(ring.begin(), ring.end());
           double before = 1;
           for (int rt : ring_tets) before = std::min(before, rho(tets[rt]));
-          if (std::min(rho(n1), rho(n2)) <= before) continue;
-          tets[ring_tets[0]] = n1, tets[ring_tets[1]] = n2, tets[ring_tets[2]] = {-1, -1, -1, -1};
+          std::vector<std::array<int, 4>> best, cand;
+          double best_q = before;
+          for (int apex = 0; apex < k; ++apex) {
+            cand.clear();
+            double worst = 1;
+            bool ok = true;
+            for (int m = 1; m + 1 < k && ok; ++m) {
+              const int x = ring[apex], y = ring[(apex + m) % k], z = ring[(apex + m + 1) % k];
+              // (x, y, z) runs around the edge like the ring: w above it, u below
+              std::array<int, 4> up{x, y, z, w}, down{x, z, y, u};
+              ok = orient3d(P[x].data(), P[y].data(), P[z].data(), P[w].data()) > 0 &&
+                   orient3d(P[x].data(), P[z].data(), P[y].data(), P[u].data()) > 0;
+              if (ok) {
+                worst = std::min({worst, rho(up), rho(down)});
+                cand.push_back(up), cand.push_back(down);
+              }
+            }
+            if (ok && worst > best_q) best_q = worst, best = cand;
+          }
+          if (best.empty()) continue;
+          for (size_t m = 0; m < best.size(); ++m) {
+            if (m < ring_tets.size()) {
+              tets[ring_tets[m]] = best[m];
+            } else {
+              tets.push_back(best[m]);
+              touched.push_back(1);
+            }
+          }
+          for (size_t m = best.size(); m < ring_tets.size(); ++m) tets[ring_tets[m]] = {-1, -1, -1, -1};
           for (int rt : ring_tets) touched[rt] = 1;
-          lock({u, w, p, q, r});
+          lock({u, w});
+          for (int x : ring) locked[x] = 1;
           ++here, done = true;
         }
       // 2-3 on each face of t
       for (int fi = 0; fi < 4 && !done; ++fi) {
         const int a = v[kFace[fi][0]], b = v[kFace[fi][1]], c = v[kFace[fi][2]], d = v[fi];
-        const auto it = sharing.find(key_of(a, b, c));
-        if (it == sharing.end() || it->second.size() != 2) continue;
-        const int t2 = it->second[0] == static_cast<int>(t) ? it->second[1] : it->second[0];
+        tets_with(a, b, c, face_tets);
+        if (face_tets.size() != 2) continue;
+        const int t2 = face_tets[0] == static_cast<int>(t) ? face_tets[1] : face_tets[0];
         if (touched[t2]) continue;
         int e = -1;
         for (int x : tets[t2])
           if (x != a && x != b && x != c) e = x;
-        if (e < 0 || around.count(edge_id(d, e))) continue;  // the new edge must not exist yet
+        if (e < 0) continue;
+        tets_with(d, e, -1, ring_tets);
+        if (!ring_tets.empty()) continue;  // the new edge must not exist yet
         if (any_locked({a, b, c, d, e})) continue;
         const int s1 = orient3d(P[d].data(), P[e].data(), P[a].data(), P[b].data());
         const int s2 = orient3d(P[d].data(), P[e].data(), P[b].data(), P[c].data());
@@ -644,7 +695,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }), tets.end());
   // ---- quality: flips of the bad tets, then node smoothing, twice
   const int first_new = static_cast<int>(V.rows());
-  for (int round = 0; round < 2; ++round) {
+  for (int round = 0; round < 3; ++round) {
   if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
   // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
   // worst radius ratio around the node and keeps every tet positive
@@ -679,6 +730,45 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
         }
         if (!ok || now < worst) P[v] = old;
       }
+    // the new nodes of the tets still bad: a compass search for the position that maximises
+    // the worst radius ratio around the node (steps of a tenth of the local edge length,
+    // halved when no direction helps)
+    std::vector<char> seen(P.size(), 0);
+    for (size_t t = 0; t < tets.size(); ++t) {
+      if (tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]) >= params.flip_below) continue;
+      for (int v : tets[t]) {
+        if (v < first_new || seen[v]) continue;
+        seen[v] = 1;
+        const auto& ts = around[v - first_new];
+        auto worst_around = [&]() {
+          double w = 1;
+          for (int q : ts) {
+            const auto& x = tets[q];
+            if (orient3d(P[x[0]].data(), P[x[1]].data(), P[x[2]].data(), P[x[3]].data()) <= 0) return -1.0;
+            w = std::min(w, tet_rho(P, x[0], x[1], x[2], x[3]));
+          }
+          return w;
+        };
+        double len = 0;
+        int cnt = 0;
+        for (int q : ts)
+          for (int x : tets[q])
+            if (x != v) len += (P[x] - P[v]).norm(), ++cnt;
+        if (!cnt) continue;
+        double step = 0.1 * len / cnt, best = worst_around();
+        for (int it = 0; it < 40 && step > 1e-3 * len / cnt; ++it) {
+          bool moved = false;
+          for (int d = 0; d < 6 && !moved; ++d) {
+            const Vec3 old = P[v];
+            P[v][d / 2] += (d % 2 ? -step : step);
+            const double now = worst_around();
+            if (now > best) best = now, moved = true;
+            else P[v] = old;
+          }
+          if (!moved) step *= 0.5;
+        }
+      }
+    }
   }
   }
   VolumeFillResult out;

@@ -23,7 +23,7 @@ struct VolumeFillParams {
   int passes = 4;               ///< widening passes over faces that failed
   long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
   int smoothing_iterations = 5; ///< node smoothing sweeps after filling (quality never drops)
-  double flip_below = 0.3;      ///< 3-2 and 2-3 flips on new tets whose radius ratio is below this (0: none)
+  double flip_below = 0.4;      ///< new tets below this radius ratio get edge removal, 2-3 flips and a compass search on their nodes (0: none)
 };
 
 struct VolumeFillResult {
