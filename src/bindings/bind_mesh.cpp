@@ -10,6 +10,9 @@
 #include "mesh/conformity.h"
 #include "mesh/surface_check.h"
 #include "mesh/surface_mesher.h"
+#include "mesh/volume_front.h"
+
+#include <chrono>
 #include "mesh/tet_quality.h"
 #include "pipeline/solve_job.h"
 
@@ -81,6 +84,30 @@ Returns a dict: nodes #V x 3, triangles #F x 3 (outward), faces #F (FreeCAD face
 failed_faces with failure_reasons, open_edges_per_solid (0 = closed and oriented),
 self_intersecting_pairs (within each solid, at most 100 counted), min_angle (degrees) and
 share_below_20deg.)doc");
+
+  m.def(
+      "volume_mesh",
+      [](const MatX3d& nodes, const MatX3i& triangles, double size) {
+        mesh::VolumeFillResult r;
+        double seconds = 0;
+        {
+          pybind11::gil_scoped_release release;
+          mesh::VolumeFillParams p;
+          if (size > 0) p.size = [size](const double*) { return size; };
+          const auto t0 = std::chrono::steady_clock::now();
+          r = mesh::fill_volume(nodes, triangles, MatX4i(), p);
+          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
+        pybind11::dict out;
+        out["nodes"] = r.V;
+        out["tets"] = r.T;
+        out["seconds"] = seconds;
+        return out;
+      },
+      pybind11::arg("nodes"), pybind11::arg("triangles"), pybind11::arg("size") = 0.0,
+      R"doc(Fills the closed surface (nodes #V x 3, triangles #F x 3 oriented outwards) with tets by
+the 3D advancing front, target size `size` inside (0: from the boundary). Returns a dict:
+nodes (the input nodes first, unchanged), tets #T x 4 (positive), seconds (the fill alone).)doc");
 }
 
 }  // namespace topopt::py

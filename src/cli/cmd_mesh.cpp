@@ -60,6 +60,7 @@ int cmd_mesh(const Args& args) {
   auto t1 = clock::now();
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) { std::cerr << "[" << stage << "] " << msg << "\n"; };
+  if (getenv("TOPOPT_VERBOSE")) progress.log = [](LogLevel, const std::string& msg) { std::cerr << "  " << msg << "\n"; };
   TetMesh m;
   if (mesher == "native") {
     mesh::NativeMeshParams np;

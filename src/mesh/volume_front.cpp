@@ -450,6 +450,15 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     for (int g : near_faces) {
       if (g == self) continue;
       const Tri& t = front.face(g);
+      // boxes apart: nothing to test (exact, on the input doubles)
+      {
+        bool apart = false;
+        for (int k = 0; k < 3 && !apart; ++k) {
+          const double flo = std::min({P[t[0]][k], P[t[1]][k], P[t[2]][k]}), fhi = std::max({P[t[0]][k], P[t[1]][k], P[t[2]][k]});
+          apart = fhi < tlo[k] || flo > thi[k];
+        }
+        if (apart) continue;
+      }
       TriKey kt = key_of(t[0], t[1], t[2]);
       for (int v : {a, b, c})
         if (segment_meets_triangle(P, v, p, t[0], t[1], t[2])) {
@@ -480,25 +489,38 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   const double reach[] = {1.0, 1.6, 2.5, 4.0, 6.0};
   // Rounds: advance (with widening passes), fill what is left from single points, and if a
   // stuck region remains, remove the new tets around it and advance again.
-  for (int round = 0; round < 4 && front.size() > 0; ++round) {
+  for (int round = 0; round < 10 && front.size() > 0; ++round) {
     if (round > 0) {
-      std::unordered_map<TriKey, int, TriKeyHash> owner;
-      for (size_t t = 0; t < tets.size(); ++t) {
-        if (tets[t][0] < 0) continue;
-        for (const auto& o : kFace) owner[key_of(tets[t][o[0]], tets[t][o[1]], tets[t][o[2]])] = static_cast<int>(t);
+      // the new tets around the stuck front's nodes, widened by one ring of nodes every third
+      // round, go back to the front
+      std::vector<int> start(P.size() + 1, 0), star;
+      for (const auto& t : tets)
+        if (t[0] >= 0)
+          for (int x : t) ++start[x + 1];
+      for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+      star.resize(start.back());
+      {
+        std::vector<int> fill(start.begin(), start.end() - 1);
+        for (size_t t = 0; t < tets.size(); ++t)
+          if (tets[t][0] >= 0)
+            for (int x : tets[t]) star[fill[x]++] = static_cast<int>(t);
+      }
+      std::vector<char> in_region(P.size(), 0);
+      std::vector<int> region;
+      for (size_t id = 0; id < front.capacity(); ++id)
+        if (front.alive(static_cast<int>(id)))
+          for (int v : front.face(static_cast<int>(id)))
+            if (!in_region[v]) in_region[v] = 1, region.push_back(v);
+      for (int ring = 0; ring < (round - 1) / 3; ++ring) {
+        const size_t n = region.size();
+        for (size_t i = 0; i < n; ++i)
+          for (int k = start[region[i]]; k < start[region[i] + 1]; ++k)
+            for (int x : tets[star[k]])
+              if (!in_region[x]) in_region[x] = 1, region.push_back(x);
       }
       std::vector<int> doomed;
-      for (size_t id = 0; id < front.capacity(); ++id) {
-        if (!front.alive(static_cast<int>(id))) continue;
-        const Tri& f = front.face(static_cast<int>(id));
-        auto it = owner.find(key_of(f[0], f[1], f[2]));
-        if (it != owner.end()) doomed.push_back(it->second);
-        // and the tets around each of its nodes, for room to move
-        for (int v : f)
-          for (size_t t = 0; t < tets.size(); ++t)
-            if (tets[t][0] >= 0 && (tets[t][0] == v || tets[t][1] == v || tets[t][2] == v || tets[t][3] == v))
-              doomed.push_back(static_cast<int>(t));
-      }
+      for (int v : region)
+        for (int k = start[v]; k < start[v + 1]; ++k) doomed.push_back(star[k]);
       std::sort(doomed.begin(), doomed.end());
       doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
       for (int t : doomed) {
