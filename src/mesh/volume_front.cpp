@@ -434,7 +434,8 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   for (size_t id = 0; id < front.capacity(); ++id)
     if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
   std::vector<int> near_faces, near_nodes;
-  std::vector<std::pair<double, int>> candidates;  // (score, node; -1 = the ideal point)
+  std::vector<std::pair<double, int>> candidates;  // (score, node; -1 - k = new_points[k])
+  std::vector<Vec3> new_points;
   const double sqrt23 = std::sqrt(2.0 / 3.0);
 
   auto valid = [&](int a, int b, int c, int p, double qmin, int self) {
@@ -573,18 +574,24 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
           if (rho < qmins[ip]) continue;
           candidates.push_back({-rho + 0.25 * d / h - 10.0, q});
         }
-        if (!crowded || pass > 0) {
-          P.push_back(ideal);
+        // new points: the ideal one; for faces that failed before, also lower ones (a thin
+        // cavity, e.g. a twisted prism between the two sides of a thin wall, has room only
+        // close to the face)
+        new_points.clear();
+        if (!crowded || pass > 0) new_points.push_back(ideal);
+        if (ip >= 2) new_points.push_back(centre + n.normalized() * h * sqrt23 * 0.5);
+        for (size_t k = 0; k < new_points.size(); ++k) {
+          P.push_back(new_points[k]);
           double rho = tet_rho(P, a, b, c, static_cast<int>(P.size()) - 1);
           P.pop_back();
-          candidates.push_back({-rho, -1});
+          candidates.push_back({-rho + 0.01 * static_cast<double>(k), -1 - static_cast<int>(k)});
         }
         std::sort(candidates.begin(), candidates.end());
         int chosen = -2;
         for (const auto& [score, q] : candidates) {
           int p = q;
           if (q < 0) {
-            P.push_back(ideal);
+            P.push_back(new_points[-1 - q]);
             p = static_cast<int>(P.size()) - 1;
           }
           if (valid(a, b, c, p, qmins[ip], f)) {
@@ -642,6 +649,51 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
             cf.push_back(f);
             for (int v : front.face(f)) cn.push_back(v);
           }
+        const size_t first_piece_face = front.capacity();
+        for (int grow = 0; grow < 4; ++grow) {
+        if (grow > 0) {
+          // no point saw the whole cavity: it takes in the new tets behind its faces (a
+          // twisted prism between the two sides of a thin wall has no such point; the larger
+          // cavity usually has), then the front faces around its nodes are its faces again
+          std::unordered_map<TriKey, int, TriKeyHash> owner;
+          for (size_t t = 0; t < tets.size(); ++t)
+            if (tets[t][0] >= 0)
+              for (const auto& o : kFace) owner[key_of(tets[t][o[0]], tets[t][o[1]], tets[t][o[2]])] = static_cast<int>(t);
+          int absorbed = 0;
+          for (int f : cf) {
+            if (!front.alive(f)) continue;
+            const Tri& t = front.face(f);
+            auto it = owner.find(key_of(t[0], t[1], t[2]));
+            if (it == owner.end() || tets[it->second][0] < 0) continue;
+            const auto tv = tets[it->second];
+            for (const auto& o : kFace) front.add_face(tv[o[0]], tv[o[2]], tv[o[1]]);
+            tets[it->second][0] = -1;
+            ++absorbed;
+          }
+          if (!absorbed) break;
+          std::vector<char> near(P.size(), 0);
+          for (int v : cn) near[v] = 1;
+          for (bool more = true; more;) {  // close under shared nodes
+            more = false;
+            for (size_t id = 0; id < front.capacity(); ++id) {
+              if (!front.alive(static_cast<int>(id))) continue;
+              const Tri& t = front.face(static_cast<int>(id));
+              if (!(near[t[0]] || near[t[1]] || near[t[2]])) continue;
+              for (int v : t)
+                if (!near[v]) near[v] = 1, more = true;
+            }
+          }
+          cf.clear(), cn.clear();
+          for (size_t id = 0; id < front.capacity(); ++id) {
+            if (!front.alive(static_cast<int>(id))) continue;
+            const Tri& t = front.face(static_cast<int>(id));
+            if (near[t[0]] || near[t[1]] || near[t[2]]) {
+              cf.push_back(static_cast<int>(id));
+              for (int v : t) cn.push_back(v);
+            }
+          }
+          if (cf.empty()) break;
+        }
         std::sort(cn.begin(), cn.end());
         cn.erase(std::unique(cn.begin(), cn.end()), cn.end());
         auto sees_all = [&](int apex) {
@@ -690,17 +742,95 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
           P.push_back(best_point);
           apex = static_cast<int>(P.size()) - 1;
         }
-        if (apex < 0) continue;
-        for (int f : cf) {
-          const Tri t = front.face(f);
-          if (t[0] == apex || t[1] == apex || t[2] == apex) {
-            front.kill(f);
-            continue;
+        if (apex < 0) {
+          progress.info("advancing front: no point sees all " + std::to_string(cf.size()) + " faces of a cavity");
+          if (grow < 3) continue;
+          // last: fill the cavity in pieces, each from the point (a cavity node, its centroid
+          // or a sample of its box) with which the most faces make valid tets, every tet
+          // checked against the whole front as in the advancing loop
+          for (int piece = 0; piece < 10; ++piece) {
+            std::vector<int> live;
+            for (int f : cf)
+              if (front.alive(f)) live.push_back(f);
+            // faces born in this cavity join it
+            for (size_t id = first_piece_face; id < front.capacity(); ++id)
+              if (front.alive(static_cast<int>(id))) live.push_back(static_cast<int>(id));
+            std::sort(live.begin(), live.end());
+            live.erase(std::unique(live.begin(), live.end()), live.end());
+            if (live.empty()) break;
+            std::vector<int> nodes;
+            Vec3 lo3 = P[front.face(live[0])[0]], hi3 = lo3, mid3 = Vec3::Zero();
+            for (int f : live)
+              for (int v : front.face(f)) nodes.push_back(v), lo3 = lo3.cwiseMin(P[v]), hi3 = hi3.cwiseMax(P[v]), mid3 += P[v];
+            mid3 /= static_cast<double>(3 * live.size());
+            std::sort(nodes.begin(), nodes.end());
+            nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+            std::vector<Vec3> trial{mid3};
+            unsigned sd = 777u + static_cast<unsigned>(piece);
+            for (int q = 0; q < 30; ++q) {
+              Vec3 x;
+              for (int d = 0; d < 3; ++d) {
+                sd = sd * 1664525u + 1013904223u;
+                x[d] = lo3[d] + (hi3[d] - lo3[d]) * ((sd >> 8) & 0xFFFF) / 65535.0;
+              }
+              trial.push_back(x);
+            }
+            int best_count = 0, best_node = -1;
+            Vec3 best_x;
+            auto count_valid = [&](int p) {
+              int c = 0;
+              for (int f : live) {
+                const Tri& t = front.face(f);
+                if (t[0] != p && t[1] != p && t[2] != p && valid(t[0], t[1], t[2], p, 0.0, f)) ++c;
+              }
+              return c;
+            };
+            for (int v : nodes) {
+              const int c = count_valid(v);
+              if (c > best_count) best_count = c, best_node = v;
+            }
+            for (const Vec3& x : trial) {
+              P.push_back(x);
+              const int c = count_valid(static_cast<int>(P.size()) - 1);
+              P.pop_back();
+              if (c > best_count) best_count = c, best_node = -2, best_x = x;
+            }
+            if (best_count == 0) break;
+            int p = best_node;
+            if (p == -2) P.push_back(best_x), p = static_cast<int>(P.size()) - 1;
+            for (int f : live) {
+              if (!front.alive(f)) continue;
+              const Tri t = front.face(f);
+              if (t[0] == p || t[1] == p || t[2] == p || !valid(t[0], t[1], t[2], p, 0.0, f)) continue;
+              tets.push_back({t[0], t[1], t[2], p});
+              front.kill(f);
+              const int tv[4] = {t[0], t[1], t[2], p};
+              for (int kf = 0; kf < 3; ++kf) front.add_face(tv[kFace[kf][0]], tv[kFace[kf][1]], tv[kFace[kf][2]]);
+            }
           }
-          tets.push_back({t[0], t[1], t[2], apex});
-          front.kill(f);
+          break;
         }
-        progress.info("advancing front: closed a cavity of " + std::to_string(cf.size()) + " faces from one point");
+        // every tet checked against the whole front as it is made (the faces gathered for a
+        // grown cavity are not always one closed cavity); what is left goes to the next round
+        long made = 0;
+        for (bool more = true; more;) {
+          more = false;
+          for (int f : cf) {
+            if (!front.alive(f)) continue;
+            const Tri t = front.face(f);
+            if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
+            if (!valid(t[0], t[1], t[2], apex, 0.0, f)) continue;
+            tets.push_back({t[0], t[1], t[2], apex});
+            front.kill(f);
+            const int tv[4] = {t[0], t[1], t[2], apex};
+            for (int kf = 0; kf < 3; ++kf) front.add_face(tv[kFace[kf][0]], tv[kFace[kf][1]], tv[kFace[kf][2]]);
+            ++made, more = true;
+          }
+        }
+        progress.info("advancing front: filled " + std::to_string(made) + " of a cavity's " + std::to_string(cf.size()) +
+                      " faces from one point");
+        break;
+        }
       }
     }
   }

@@ -7,7 +7,12 @@
 // (FrontIndex, in the .cpp), the geometry of candidate points, and the driver loop
 // fill_volume() below: take the smallest front face, try candidates from the ideal point and
 // from nearby front nodes, accept the best valid tet, update the front; faces that fail are
-// retried with a wider search and a looser quality bound.
+// retried with a wider search, a looser quality bound and lower new points; then small
+// cavities are filled from one point (grown by the tets behind their faces when no point
+// sees them all, and filled in pieces as the last resort), every tet checked against the
+// whole front; then stuck regions are re-meshed with a widening neighbourhood. After
+// filling: edge removal (rings of 3-7 tets), 2-3 flips, smoothing and a compass search on
+// the nodes of bad tets.
 #pragma once
 #include <functional>
 
