@@ -3,10 +3,13 @@
 // edge share its nodes), then every face filled by the 2D advancing front (face_front.h) in
 // its parameter plane, scaled so that lengths there approximate lengths on the surface.
 //
-// Status (issue 3): sizes from a global size and the curvature of edges and faces (no
-// proximity refinement or gradation limit yet); the parameter scaling is exact for planes and
-// cylinders and approximate on other surfaces (triangles near a sphere's pole or a cone's
-// apex come out stretched); a collapsed edge becomes a fan of triangles around its apex.
+// Sizes: a global size (default diagonal / 50) refined by the curvature of faces and edges
+// (max_angle of turning per element, floor min_size), graded along edges from their
+// vertices and inside faces from finer boundary pieces (gradation); boundary pieces are split
+// where a face's loops come close to each other (proximity) or run longer than the face's
+// graded size. The parameter scaling is exact for planes and cylinders and approximate on
+// other surfaces; the triangles are then improved on the surface itself (surface_optimize.h).
+// A collapsed edge (cone apex, sphere pole) becomes a fan of triangles around its apex.
 #pragma once
 #include <string>
 #include <vector>

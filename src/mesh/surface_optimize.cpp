@@ -40,6 +40,33 @@ bool faces_out(const MatX3d& X, const MatX3d& N, int a, int b, int c) {
   return n.dot(s) > 0.5 * n.norm() * s.norm();
 }
 
+/// The triangles around each node as one flat array (CSR), rebuilt per sweep.
+class Stars {
+ public:
+  struct Range {
+    const int *b, *e;
+    const int* begin() const { return b; }
+    const int* end() const { return e; }
+    bool empty() const { return b == e; }
+  };
+  void build(const MatX3i& T, long nt, long n, const std::vector<char>& dead) {
+    start_.assign(n + 1, 0);
+    for (long t = 0; t < nt; ++t)
+      if (dead.empty() || !dead[t])
+        for (int k = 0; k < 3; ++k) ++start_[T(t, k) + 1];
+    for (long i = 0; i < n; ++i) start_[i + 1] += start_[i];
+    items_.resize(start_[n]);
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (long t = 0; t < nt; ++t)
+      if (dead.empty() || !dead[t])
+        for (int k = 0; k < 3; ++k) items_[fill[T(t, k)]++] = static_cast<int>(t);
+  }
+  Range operator[](long v) const { return {items_.data() + start_[v], items_.data() + start_[v + 1]}; }
+
+ private:
+  std::vector<int> start_, items_;
+};
+
 }  // namespace
 
 SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fixed, const SurfaceEval& eval,
@@ -107,9 +134,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
 
   auto smooth_sweep = [&]() {
     long moves = 0;
-    std::vector<std::vector<int>> star(n);
-    for (int t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) star[T(t, k)].push_back(t);
+    Stars star;
+    star.build(T, nt, n, {});
     std::vector<int> nbr;
     for (long i = fixed; i < n; ++i) {
       if (star[i].empty()) continue;
@@ -176,10 +202,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
   std::vector<char> dead(nt, 0);
   auto collapse_sweep = [&]() {
     long done = 0;
-    std::vector<std::vector<int>> star(n);
-    for (int t = 0; t < nt; ++t)
-      if (!dead[t])
-        for (int k = 0; k < 3; ++k) star[T(t, k)].push_back(t);
+    Stars star;
+    star.build(T, nt, n, dead);
     std::vector<char> busy(n, 0);
     std::vector<int> na, nb, region;
     for (int t0 = 0; t0 < nt; ++t0) {
@@ -253,7 +277,6 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       busy[a] = busy[b] = 1;
       for (int v : na) busy[v] = 1;
       for (int v : nb) busy[v] = 1;
-      star[b].clear();
       ++done;
     }
     // drop the removed triangles
