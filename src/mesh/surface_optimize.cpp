@@ -291,12 +291,67 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     return done;
   };
 
+  // The nodes of the triangles still worst (smallest angle below 40°): a compass search in
+  // the parameters for the position that maximises the smallest angle of the node's star on
+  // the surface (the centroid rule cannot lift a triangle that leans on a boundary segment)
+  auto compass_sweep = [&]() {
+    long moves = 0;
+    Stars star;
+    star.build(T, nt, n, {});
+    for (long t = 0; t < nt; ++t) {
+      if (min_angle(X, T(t, 0), T(t, 1), T(t, 2)) >= 40) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int i = T(t, k);
+        if (i < fixed || keep_node[i]) continue;
+        auto worst = [&]() {
+          double w = 180;
+          for (int q : star[i]) {
+            if (!ccw(P, T(q, 0), T(q, 1), T(q, 2)) || !faces_out(X, N, T(q, 0), T(q, 1), T(q, 2))) return -1.0;
+            w = std::min(w, min_angle(X, T(q, 0), T(q, 1), T(q, 2)));
+          }
+          return w;
+        };
+        double len = 0;
+        int cnt = 0;
+        for (int q : star[i])
+          for (int j = 0; j < 3; ++j)
+            if (T(q, j) != i) len += (P.row(T(q, j)) - P.row(i)).norm(), ++cnt;
+        if (!cnt) continue;
+        double step = 0.1 * len / cnt, best = worst();
+        bool any = false;
+        for (int it = 0; it < 30 && step > 1e-3 * len / cnt; ++it) {
+          bool moved = false;
+          for (int d = 0; d < 4 && !moved; ++d) {
+            const Eigen::RowVector2d old_p = P.row(i);
+            const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
+            const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
+            P(i, d / 2) += d % 2 ? -step : step;
+            evaluate(i);
+            const double now = worst();
+            if (now > best) {
+              best = now, moved = any = true;
+            } else {
+              P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
+            }
+          }
+          if (!moved) step *= 0.5;
+        }
+        moves += any;
+      }
+    }
+    return moves;
+  };
+
   for (int r = 0; r < rounds; ++r) {
     st.flips += flip_sweep();
     st.collapses += collapse_sweep();
     st.moves += smooth_sweep();
   }
   st.flips += flip_sweep();
+  for (int r = 0; r < std::min(rounds, 2); ++r) {
+    st.moves += compass_sweep();
+    st.flips += flip_sweep();
+  }
   st.min_angle_after = 180;
   for (long t = 0; t < nt; ++t) st.min_angle_after = std::min(st.min_angle_after, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
   return st;
