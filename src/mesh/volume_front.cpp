@@ -923,11 +923,21 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     }
   }
   }
+  // Output: the input nodes as they were, then only the new nodes some tet uses (tets removed
+  // by the re-meshing rounds leave theirs behind, and a later point may land on one)
+  std::vector<int> renum(P.size(), -1);
+  int kept = static_cast<int>(V.rows());
+  for (int i = 0; i < kept; ++i) renum[i] = i;
+  for (const auto& t : tets)
+    for (int x : t)
+      if (renum[x] < 0) renum[x] = kept++;
   VolumeFillResult out;
-  out.V.resize(P.size(), 3);
-  for (size_t i = 0; i < P.size(); ++i) out.V.row(i) = P[i].transpose();
+  out.V.resize(kept, 3);
+  for (size_t i = 0; i < P.size(); ++i)
+    if (renum[i] >= 0) out.V.row(renum[i]) = P[i].transpose();
   out.T.resize(tets.size(), 4);
-  for (size_t t = 0; t < tets.size(); ++t) out.T.row(t) << tets[t][0], tets[t][1], tets[t][2], tets[t][3];
+  for (size_t t = 0; t < tets.size(); ++t)
+    out.T.row(t) << renum[tets[t][0]], renum[tets[t][1]], renum[tets[t][2]], renum[tets[t][3]];
   return out;
 }
 

@@ -32,7 +32,7 @@ struct VolumeFillParams {
 };
 
 struct VolumeFillResult {
-  MatX3d V;   ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones
+  MatX3d V;   ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones the tets use
   MatX4i T;   ///< #T' by 4: the new tets only, positively oriented
 };
 
