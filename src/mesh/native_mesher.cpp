@@ -17,7 +17,7 @@ namespace {
 /// fine boundary parts (bores refined by curvature) to the full size in one layer.
 class BackgroundSize {
  public:
-  BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g) : h_(h) {
+  BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g) {
     lo_ = V.colwise().minCoeff().transpose();
     const Eigen::Vector3d hi = V.colwise().maxCoeff().transpose();
     cell_ = h / 2;
@@ -62,7 +62,7 @@ class BackgroundSize {
     for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>((x[d] - lo_[d]) / cell_), 0L, n_[d] - 1);
     return (c[0] * n_[1] + c[1]) * n_[2] + c[2];
   }
-  double h_, cell_;
+  double cell_;
   Eigen::Vector3d lo_;
   long n_[3];
   std::vector<float> size_;

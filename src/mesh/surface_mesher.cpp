@@ -317,13 +317,20 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
   // closer than a third of their length (thin strips, nearly tangent edges), the polygon the
   // front starts from would cross itself or leave no room; those pieces of their edges are
   // split at their middle, locally, until no face has such a pair (or the floor is reached).
+  // Each round looks again only at the faces one of whose edges was split; the loops of the
+  // last look are the ones the faces are meshed from.
   const double floor_len = hmin / 8;
+  std::vector<Loops> loops_of(nf);
+  std::vector<char> stale(nf, 1);
   for (int round = 0; round < 10; ++round) {
     std::vector<std::vector<int>> split(ne);  // pieces of each edge to split
     bool any = false;
     for (int f = 0; f < nf; ++f) {
+      if (!stale[f]) continue;
       progress.check_cancel("surface meshing");
-      Loops L = face_loops(f);
+      loops_of[f] = face_loops(f);
+      stale[f] = 0;
+      const Loops& L = loops_of[f];
       const size_t ns = L.segs.size();
       std::vector<int> order(ns);
       std::vector<double> xlo(ns), xhi(ns), ylo(ns), yhi(ns), len(ns);
@@ -398,6 +405,9 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
         edge_node[e].insert(edge_node[e].begin() + k + 1, static_cast<int>(nodes.size()) - 1);
       }
     }
+    for (int f = 0; f < nf; ++f)
+      for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f) && !stale[f]; ++e)
+        stale[f] = !split[*e].empty();
   }
 
   // ---- faces (step 9 for one model): the front fills each face's loops, faces in parallel
@@ -413,7 +423,7 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
     FaceOut& fo = face_out[f];
     const TopoDS_Face fwd = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
     const FaceGeometry& g = geo[f];
-    Loops loops = face_loops(f);
+    Loops loops = stale[f] ? face_loops(f) : std::move(loops_of[f]);
     const std::vector<std::array<double, 2>>& uv = loops.uv;
     const std::vector<std::array<int, 2>>& segs = loops.segs;
     fo.global = std::move(loops.global);
@@ -517,8 +527,8 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
     }
     fo = FaceOut();
   }
-  // Nodes: the vertices, then those the triangles use (edges re-discretised by the proximity
-  // rounds left their first nodes unused).
+  // Nodes: the vertices, then those the triangles use (the nodes of an edge whose faces all
+  // failed stay unused).
   std::vector<int> renum(nodes.size(), -1);
   int kept = 0;
   for (int v = 0; v < nv; ++v) renum[v] = kept++;

@@ -67,6 +67,16 @@ class Stars {
   std::vector<int> start_, items_;
 };
 
+/// The nodes sharing a triangle with v (sorted, once each).
+void neighbours(const MatX3i& T, const Stars& star, int v, std::vector<int>& out) {
+  out.clear();
+  for (int t : star[v])
+    for (int j = 0; j < 3; ++j)
+      if (T(t, j) != v) out.push_back(T(t, j));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
 }  // namespace
 
 SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fixed, const SurfaceEval& eval,
@@ -139,12 +149,7 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     std::vector<int> nbr;
     for (long i = fixed; i < n; ++i) {
       if (star[i].empty()) continue;
-      nbr.clear();
-      for (int t : star[i])
-        for (int k = 0; k < 3; ++k)
-          if (T(t, k) != i) nbr.push_back(T(t, k));
-      std::sort(nbr.begin(), nbr.end());
-      nbr.erase(std::unique(nbr.begin(), nbr.end()), nbr.end());
+      neighbours(T, star, static_cast<int>(i), nbr);
       Eigen::Vector3d target = Eigen::Vector3d::Zero();
       for (int j : nbr) target += Eigen::Vector3d(X.row(j));
       target /= static_cast<double>(nbr.size());
@@ -217,15 +222,7 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       if (keep_node[b]) std::swap(a, b);
       if (keep_node[b] || busy[a] || busy[b]) continue;
       // link condition: a and b share exactly the two apexes of the edge's triangles
-      auto neighbours = [&](int v, std::vector<int>& out) {
-        out.clear();
-        for (int t : star[v])
-          for (int j = 0; j < 3; ++j)
-            if (T(t, j) != v) out.push_back(T(t, j));
-        std::sort(out.begin(), out.end());
-        out.erase(std::unique(out.begin(), out.end()), out.end());
-      };
-      neighbours(a, na), neighbours(b, nb);
+      neighbours(T, star, a, na), neighbours(T, star, b, nb);
       int common = 0;
       for (int v : na) common += std::binary_search(nb.begin(), nb.end(), v);
       int shared = 0;

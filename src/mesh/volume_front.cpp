@@ -212,6 +212,31 @@ class Front {
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
 
 
+/// The tets around each node as one flat array (CSR): tets of node v are
+/// items[start[v] .. start[v + 1]). Removed tets (first index < 0) are left out.
+struct NodeStars {
+  std::vector<int> start, items;
+  NodeStars(size_t nodes, const std::vector<std::array<int, 4>>& tets) : start(nodes + 1, 0) {
+    for (const auto& t : tets)
+      if (t[0] >= 0)
+        for (int x : t) ++start[x + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    items.resize(start.back());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (size_t t = 0; t < tets.size(); ++t)
+      if (tets[t][0] >= 0)
+        for (int x : tets[t]) items[fill[x]++] = static_cast<int>(t);
+  }
+  const int* begin(int v) const { return items.data() + start[v]; }
+  const int* end(int v) const { return items.data() + start[v + 1]; }
+  struct Range {
+    const int *b, *e;
+    const int* begin() const { return b; }
+    const int* end() const { return e; }
+  };
+  Range of(int v) const { return {begin(v), end(v)}; }
+};
+
 /// Flips among the new tets (the input's tets and boundary are never touched: a face is only
 /// flipped when two new tets share it, an edge only when exactly three new tets close a ring
 /// around it). 3-2: an edge surrounded by three tets becomes the triangle of its ring; 2-3:
@@ -230,15 +255,7 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   for (int sweep = 0; sweep < 4; ++sweep) {
     long here = 0;
     // node stars (CSR): the tets around an edge or a face are found by filtering a star
-    std::vector<int> start(P.size() + 1, 0), star(4 * tets.size());
-    for (const auto& v : tets)
-      for (int x : v) ++start[x + 1];
-    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-    {
-      std::vector<int> fill(start.begin(), start.end() - 1);
-      for (size_t t = 0; t < tets.size(); ++t)
-        for (int x : tets[t]) star[fill[x]++] = static_cast<int>(t);
-    }
+    const NodeStars stars(P.size(), tets);
     auto has = [&](int t, int x) {
       const auto& v = tets[t];
       return v[0] == x || v[1] == x || v[2] == x || v[3] == x;
@@ -246,10 +263,8 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
     std::vector<int> ring_tets, face_tets;
     auto tets_with = [&](int u, int w, int x, std::vector<int>& out) {  // x < 0: edge (u, w) only
       out.clear();
-      for (int k = start[u]; k < start[u + 1]; ++k) {
-        const int t = star[k];
-        if (has(t, w) && (x < 0 || has(t, x))) out.push_back(t);
-      }
+      for (const int* t = stars.begin(u); t != stars.end(u); ++t)
+        if (has(*t, w) && (x < 0 || has(*t, x))) out.push_back(*t);
     };
     std::vector<char> touched(tets.size(), 0);
     // the maps above go stale where a flip happened: nodes of flipped tets are not used
@@ -494,18 +509,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     if (round > 0) {
       // the new tets around the stuck front's nodes, widened by one ring of nodes every third
       // round, go back to the front
-      std::vector<int> start(P.size() + 1, 0), star;
-      for (const auto& t : tets)
-        if (t[0] >= 0)
-          for (int x : t) ++start[x + 1];
-      for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-      star.resize(start.back());
-      {
-        std::vector<int> fill(start.begin(), start.end() - 1);
-        for (size_t t = 0; t < tets.size(); ++t)
-          if (tets[t][0] >= 0)
-            for (int x : tets[t]) star[fill[x]++] = static_cast<int>(t);
-      }
+      const NodeStars stars(P.size(), tets);
       std::vector<char> in_region(P.size(), 0);
       std::vector<int> region;
       for (size_t id = 0; id < front.capacity(); ++id)
@@ -515,13 +519,13 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
       for (int ring = 0; ring < (round - 1) / 3; ++ring) {
         const size_t n = region.size();
         for (size_t i = 0; i < n; ++i)
-          for (int k = start[region[i]]; k < start[region[i] + 1]; ++k)
-            for (int x : tets[star[k]])
+          for (const int* t = stars.begin(region[i]); t != stars.end(region[i]); ++t)
+            for (int x : tets[*t])
               if (!in_region[x]) in_region[x] = 1, region.push_back(x);
       }
       std::vector<int> doomed;
       for (int v : region)
-        for (int k = start[v]; k < start[v + 1]; ++k) doomed.push_back(star[k]);
+        doomed.insert(doomed.end(), stars.begin(v), stars.end(v));
       std::sort(doomed.begin(), doomed.end());
       doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
       for (int t : doomed) {
@@ -852,13 +856,10 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
   // worst radius ratio around the node and keeps every tet positive
   if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
-    std::vector<std::vector<int>> around(P.size() - first_new);
-    for (size_t t = 0; t < tets.size(); ++t)
-      for (int v : tets[t])
-        if (v >= first_new) around[v - first_new].push_back(static_cast<int>(t));
+    const NodeStars stars(P.size(), tets);
     for (int it = 0; it < params.smoothing_iterations; ++it)
       for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
-        const auto& ts = around[v - first_new];
+        const NodeStars::Range ts = stars.of(v);
         Vec3 sum = Vec3::Zero();
         int n = 0;
         double worst = 1;
@@ -891,7 +892,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
       for (int v : tets[t]) {
         if (v < first_new || seen[v]) continue;
         seen[v] = 1;
-        const auto& ts = around[v - first_new];
+        const NodeStars::Range ts = stars.of(v);
         auto worst_around = [&]() {
           double w = 1;
           for (int q : ts) {
