@@ -1,7 +1,14 @@
 // Native single-model meshing: surface mesher + 3D advancing front (see native_mesher.h).
 #include "mesh/native_mesher.h"
 
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepClass_FaceClassifier.hxx>
+#include <TopoDS.hxx>
 #include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+#include <string>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -68,38 +75,367 @@ class BackgroundSize {
   std::vector<float> size_;
 };
 
+/// What the 14 steps share: one node pool, the surface meshes of the two models on it, and
+/// the tets made so far.
+struct Steps {
+  const brep::TwoBReps& in;
+  const NativeMeshParams& params;
+  const Progress& progress;
+  std::vector<std::array<double, 3>> nodes;
+  ModelSurface part, nd;  // Ω and Ω̄
+  std::vector<std::array<int, 4>> tets;
+  std::vector<int> domain;
+  std::map<std::array<int, 3>, int> nd_face_of;  // Ω triangle (sorted nodes) -> Ω̄ face (1-based)
+  double tol;
+  std::shared_ptr<BackgroundSize> background;
+
+  Steps(const brep::TwoBReps& model, const NativeMeshParams& p, const SurfaceMeshParams& sp, const Progress& prog)
+      : in(model), params(p), progress(prog), part(model.part, nodes, sp), nd(model.nondesign, nodes, sp),
+        tol(1e-6 * model.part.diagonal()) {}
+};
+
+std::string face_list(const std::vector<int>& faces, const std::vector<std::string>& reasons, const char* model) {
+  std::ostringstream m;
+  for (size_t k = 0; k < faces.size() && k < 5; ++k) m << (k ? ", " : " ") << "Face" << faces[k];
+  m << " of the " << model << " (" << reasons[0] << ")";
+  return m.str();
+}
+
+// Steps 1-3: nodes on Ω's vertices; Ω̄'s vertices that lie on them take those nodes; the
+// rest of Ω̄'s vertices get their own (shared between non-design solids that touch there).
+void step1_part_vertex_nodes(Steps& s) { s.part.create_vertex_nodes(); }
+void step2_transfer_vertex_nodes(Steps& s) {
+  for (int v = 0; v < s.in.nondesign.num_vertices(); ++v) {
+    const brep::Location& at = s.in.nd_on_part.vertex[v];
+    if (at.on == brep::On::Vertex) s.nd.set_vertex_node(v, s.part.vertex_node(at.index));
+  }
+}
+void step3_nondesign_vertex_nodes(Steps& s) { s.nd.create_vertex_nodes(s.tol); }
+
+// Step 4: Ω̄'s vertex nodes that lie on edges of Ω must be nodes of those edges' meshes.
+void step4_transfer_nodes_to_part_edges(Steps& s) {
+  for (int v = 0; v < s.in.nondesign.num_vertices(); ++v) {
+    const brep::Location& at = s.in.nd_on_part.vertex[v];
+    if (at.on == brep::On::Edge) s.part.fix_edge_node(at.index, s.nd.vertex_node(v));
+  }
+}
+// Step 5: Ω's edges, through those nodes.
+void step5_mesh_part_edges(Steps& s) { s.part.mesh_edges(s.progress); }
+
+// Step 6: an edge of Ω̄ lying on an edge of Ω takes the run of that edge's nodes between its
+// own end nodes, walking in the direction of its curve (around, for closed edges).
+void step6_transfer_edge_segments(Steps& s) {
+  for (int e = 0; e < s.in.nondesign.num_edges(); ++e) {
+    const brep::Location& at = s.in.nd_on_part.edge[e];
+    if (at.on != brep::On::Edge || s.in.nondesign.edge_degenerate[e]) continue;
+    std::vector<int> ids = s.part.edge_nodes(at.index);
+    const bool closed = ids.size() > 2 && ids.front() == ids.back();
+    if (closed) ids.pop_back();
+    const int n = static_cast<int>(ids.size());
+    const int a = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 0));
+    const int b = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 1));
+    const int ia = static_cast<int>(std::find(ids.begin(), ids.end(), a) - ids.begin());
+    std::vector<int> best;
+    double best_score = 1e300;
+    for (int dir : {1, -1}) {
+      std::vector<int> run{a};
+      for (int i = ia + dir, steps = 0; steps < n; i += dir, ++steps) {
+        if (!closed && (i < 0 || i >= n)) {
+          run.clear();
+          break;
+        }
+        const int k = ids[((i % n) + n) % n];
+        run.push_back(k);
+        if (k == b) break;
+      }
+      if (ia >= n || run.size() < 2 || run.back() != b) continue;
+      // the run must follow Ω̄'s edge from its start: the first node's parameter nearest
+      // the curve's start, on the curve
+      double d = 0;
+      const double t = s.nd.edge_parameter(e, s.nodes[run[1]].data(), &d);
+      BRepAdaptor_Curve c(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD)));
+      const double score = std::abs(t - c.FirstParameter()) + (d > 1e-3 * s.part.size() + s.tol ? 1e200 : 0.0);
+      if (score < best_score) best_score = score, best = run;
+    }
+    if (best.empty() || best_score >= 1e200) {
+      std::ostringstream m;
+      m << "non-design Edge" << e + 1 << " lies on the part's Edge" << at.index + 1
+        << " but its ends are not nodes of that edge's mesh";
+      throw Error(ErrorCode::MeshingFailed, m.str());
+    }
+    s.nd.set_edge_mesh(e, best);
+  }
+}
+
+// Step 7: the rest of Ω̄'s edges (an edge of one non-design solid lying on an edge of
+// another, where they touch, is meshed once and shared).
+void step7_mesh_nondesign_edges(Steps& s) {
+  const brep::TopologyIndex& t = s.in.nondesign;
+  std::vector<int> solid_of(t.num_edges(), -1);
+  for (int f = 0; f < t.num_faces(); ++f)
+    for (const int* e = t.face_edges.begin(f); e != t.face_edges.end(f); ++e) solid_of[*e] = t.face_solid[f];
+  auto point_at = [&](int e, double w) {
+    BRepAdaptor_Curve c(TopoDS::Edge(t.edges(e + 1).Oriented(TopAbs_FORWARD)));
+    const gp_Pnt p = c.Value(c.FirstParameter() + w * (c.LastParameter() - c.FirstParameter()));
+    return std::array<double, 3>{p.X(), p.Y(), p.Z()};
+  };
+  for (int e2 = 0; e2 < t.num_edges(); ++e2) {
+    if (t.edge_degenerate[e2] || s.nd.edge_given(e2)) continue;
+    const int a2 = s.nd.vertex_node(t.edge_vertices(e2, 0)), b2 = s.nd.vertex_node(t.edge_vertices(e2, 1));
+    for (int e1 = 0; e1 < e2; ++e1) {
+      if (t.edge_degenerate[e1] || s.nd.edge_given(e1) || solid_of[e1] == solid_of[e2]) continue;
+      const int a1 = s.nd.vertex_node(t.edge_vertices(e1, 0)), b1 = s.nd.vertex_node(t.edge_vertices(e1, 1));
+      if (std::minmax(a1, b1) != std::minmax(a2, b2)) continue;
+      double d = 0;
+      const std::array<double, 3> q = point_at(e2, 0.25);
+      const double tq = s.nd.edge_parameter(e1, q.data(), &d);
+      if (d > 1e-3 * s.part.size() + s.tol) continue;
+      BRepAdaptor_Curve c1(TopoDS::Edge(t.edges(e1 + 1).Oriented(TopAbs_FORWARD)));
+      const bool reversed = a1 != b1 ? a1 != a2 : (tq - c1.FirstParameter()) > 0.5 * (c1.LastParameter() - c1.FirstParameter());
+      s.nd.alias_edge(e2, e1, reversed);
+      break;
+    }
+  }
+  s.nd.mesh_edges(s.progress);
+}
+
+// Step 8: Ω̄'s segments (and lone vertex nodes) lying on faces of Ω constrain those faces.
+void step8_transfer_segments_to_part_faces(Steps& s) {
+  const brep::TopologyIndex& t = s.in.nondesign;
+  for (int e = 0; e < t.num_edges(); ++e) {
+    const brep::Location& at = s.in.nd_on_part.edge[e];
+    if (at.on != brep::On::Face) continue;
+    const std::vector<int>& ids = s.nd.edge_nodes(e);
+    for (size_t i = 0; i + 1 < ids.size(); ++i) s.part.constrain_face(at.index, ids[i], ids[i + 1]);
+  }
+  for (int v = 0; v < t.num_vertices(); ++v) {
+    const brep::Location& at = s.in.nd_on_part.vertex[v];
+    if (at.on == brep::On::Face) s.part.add_face_node(at.index, s.nd.vertex_node(v));
+  }
+}
+
+// Step 9: Ω's faces, honouring those segments.
+void step9_mesh_part_faces(Steps& s) {
+  s.part.mesh_faces(s.progress);
+  if (!s.part.failed_faces().empty())
+    throw Error(ErrorCode::MeshingFailed, "the surface mesher could not mesh" +
+                                              face_list(s.part.failed_faces(), s.part.failure_reasons(), "part"));
+}
+
+// Step 10: the triangles of a face of Ω that lie on a face of Ω̄ become that face's mesh.
+// The constraint segments cut Ω's face mesh into regions; each region is given to the Ω̄
+// face that contains it (judged by the B-Rep classifier on a few of its triangles).
+void step10_transfer_triangles(Steps& s) {
+  const brep::TopologyIndex& t = s.in.nondesign;
+  std::map<int, std::vector<int>> on_face;  // Ω face -> Ω̄ faces on it
+  for (int f = 0; f < t.num_faces(); ++f)
+    if (s.in.nd_on_part.face[f].on == brep::On::Face) on_face[s.in.nd_on_part.face[f].index].push_back(f);
+  for (const auto& [pf, nd_faces] : on_face) {
+    const auto& tris = s.part.face_triangles(pf);
+    std::set<std::pair<int, int>> cuts;
+    for (const auto& c : s.part.face_constraints(pf)) cuts.insert(std::minmax(c[0], c[1]));
+    // regions: triangles joined across edges that are not constraint segments
+    std::map<std::pair<int, int>, std::vector<int>> by_edge;
+    for (size_t k = 0; k < tris.size(); ++k)
+      for (int j = 0; j < 3; ++j) by_edge[std::minmax(tris[k][j], tris[k][(j + 1) % 3])].push_back(static_cast<int>(k));
+    std::vector<int> region(tris.size(), -1);
+    int nreg = 0;
+    for (size_t k0 = 0; k0 < tris.size(); ++k0) {
+      if (region[k0] >= 0) continue;
+      std::vector<int> stack{static_cast<int>(k0)};
+      region[k0] = nreg;
+      while (!stack.empty()) {
+        const int k = stack.back();
+        stack.pop_back();
+        for (int j = 0; j < 3; ++j) {
+          const auto key = std::minmax(tris[k][j], tris[k][(j + 1) % 3]);
+          if (cuts.count(key)) continue;
+          for (int o : by_edge[key])
+            if (region[o] < 0) region[o] = nreg, stack.push_back(o);
+        }
+      }
+      ++nreg;
+    }
+    std::vector<std::vector<int>> members(nreg);
+    for (size_t k = 0; k < tris.size(); ++k) members[region[k]].push_back(static_cast<int>(k));
+    for (int f : nd_faces) {
+      const TopoDS_Face face = TopoDS::Face(t.faces(f + 1));
+      BRepClass_FaceClassifier classifier;
+      std::vector<std::array<int, 3>> mine;
+      for (int r = 0; r < nreg; ++r) {
+        const auto& m = members[r];
+        int in = 0, votes = 0;
+        for (int i = 0; i < 5 && i < static_cast<int>(m.size()); ++i) {
+          const auto& tri = tris[m[(m.size() * (2 * i + 1)) / 10]];
+          gp_XYZ c(0, 0, 0);
+          for (int v : tri) c += gp_XYZ(s.nodes[v][0], s.nodes[v][1], s.nodes[v][2]);
+          classifier.Perform(face, gp_Pnt(c / 3), 1e-3 * s.part.size());
+          const TopAbs_State st = classifier.State();
+          in += st == TopAbs_IN || st == TopAbs_ON;
+          ++votes;
+        }
+        if (2 * in > votes)
+          for (int k : m) {
+            mine.push_back(tris[k]);
+            std::array<int, 3> key = tris[k];
+            std::sort(key.begin(), key.end());
+            s.nd_face_of[key] = f + 1;
+          }
+      }
+      if (mine.empty()) {
+        std::ostringstream m;
+        m << "non-design Face" << f + 1 << " lies on the part's Face" << pf + 1
+          << " but no region of that face's mesh falls inside it";
+        throw Error(ErrorCode::MeshingFailed, m.str());
+      }
+      s.nd.set_face_mesh(f, std::move(mine));
+    }
+  }
+}
+
+// Step 11: the rest of Ω̄'s faces (a face where two non-design solids touch is meshed once
+// and shared, reversed); then every non-design solid's surface must be closed.
+void step11_mesh_nondesign_faces(Steps& s) {
+  for (const brep::Contact& c : s.in.relations.contacts)
+    for (const auto& [fa, fb] : c.faces) s.nd.alias_face(fb, fa, true);
+  s.nd.mesh_faces(s.progress);
+  if (!s.nd.failed_faces().empty())
+    throw Error(ErrorCode::MeshingFailed, "the surface mesher could not mesh" +
+                                              face_list(s.nd.failed_faces(), s.nd.failure_reasons(), "non-design solids"));
+  for (int i = 0; i < s.in.nondesign.num_solids(); ++i) {
+    std::map<std::pair<int, int>, int> directed;
+    for (const auto& t : s.nd.solid_triangles(i))
+      for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+    long open = 0;
+    for (const auto& [e, n] : directed) {
+      auto rev = directed.find({e.second, e.first});
+      if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
+    }
+    if (open) {
+      std::ostringstream m;
+      m << "the surface mesh of non-design solid " << i + 1 << " is not closed (" << open
+        << " edges); a face of it may lie partly on the part's boundary or on another solid";
+      throw Error(ErrorCode::MeshingFailed, m.str());
+    }
+  }
+}
+
+MatX3d pool_matrix(const std::vector<std::array<double, 3>>& nodes) {
+  MatX3d V(static_cast<long>(nodes.size()), 3);
+  for (size_t i = 0; i < nodes.size(); ++i) V.row(static_cast<long>(i)) << nodes[i][0], nodes[i][1], nodes[i][2];
+  return V;
+}
+
+MatX3i rows_of(const std::vector<std::array<int, 3>>& tris) {
+  MatX3i F(static_cast<long>(tris.size()), 3);
+  for (size_t i = 0; i < tris.size(); ++i) F.row(static_cast<long>(i)) << tris[i][0], tris[i][1], tris[i][2];
+  return F;
+}
+
+/// One fill by the 3D front; the new nodes join the pool, the new tets the mesh.
+void fill(Steps& s, const std::vector<std::array<int, 3>>& boundary, int dom, const char* what) {
+  MatX4i T0(static_cast<long>(s.tets.size()), 4);
+  for (size_t i = 0; i < s.tets.size(); ++i) T0.row(static_cast<long>(i)) << s.tets[i][0], s.tets[i][1], s.tets[i][2], s.tets[i][3];
+  VolumeFillParams vp = s.params.volume;
+  if (!vp.size) {
+    auto bg = s.background;
+    vp.size = [bg](const double* x) { return bg->at(x); };
+  }
+  VolumeFillResult r;
+  try {
+    r = fill_volume(pool_matrix(s.nodes), rows_of(boundary), dom == 0 ? T0 : MatX4i(), vp, s.progress);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::MeshingFailed) throw;
+    throw Error(ErrorCode::MeshingFailed, std::string(what) + ": " + e.what());
+  }
+  for (long i = static_cast<long>(s.nodes.size()); i < r.V.rows(); ++i) s.nodes.push_back({r.V(i, 0), r.V(i, 1), r.V(i, 2)});
+  for (long i = 0; i < r.T.rows(); ++i) {
+    s.tets.push_back({r.T(i, 0), r.T(i, 1), r.T(i, 2), r.T(i, 3)});
+    s.domain.push_back(dom);
+  }
+}
+
+// Step 12: each non-design solid filled from its closed surface.
+void step12_fill_nondesign(Steps& s) {
+  for (int i = 0; i < s.in.nondesign.num_solids(); ++i) {
+    s.progress.check_cancel("volume meshing");
+    fill(s, s.nd.solid_triangles(i), i + 1, ("non-design solid " + std::to_string(i + 1)).c_str());
+  }
+}
+// Step 13: those tets are Ω's too: the front of step 14 starts from their free faces. (They
+// already live in the shared pool and tet list; nothing moves.)
+void step13_transfer_tets(Steps&) {}
+// Step 14: the rest of Ω, from its boundary triangles plus the free faces of Ω̄'s tets.
+void step14_fill_design(Steps& s) { fill(s, s.part.solid_triangles(0), 0, "design domain"); }
+
 }  // namespace
 
 TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params, const Progress& progress) {
-  if (model.nondesign.num_solids() > 0)
-    throw Error(ErrorCode::InvalidParameter,
-                "the native mesher does not take non-design solids yet (the 14-step driver is issue 5); "
-                "use the default mesher for a part with non-design solids");
-  progress.say("mesh", 0.05, "surface mesh");
-  SurfaceMesh s = mesh_surface(model.part, params.surface, progress);
-  if (!s.failed_faces.empty()) {
-    std::ostringstream m;
-    m << "the surface mesher could not mesh";
-    for (size_t k = 0; k < s.failed_faces.size() && k < 5; ++k) m << (k ? ", " : " ") << "Face" << s.failed_faces[k];
-    m << " (" << s.reasons[0] << ")";
-    throw Error(ErrorCode::MeshingFailed, m.str());
+  // both models on the part's size, so that what one transfers suits the other
+  SurfaceMeshParams sp = params.surface;
+  if (sp.size <= 0) sp.size = model.part.diagonal() / 50;
+  if (sp.min_size <= 0) sp.min_size = sp.size / 10;
+  Steps s(model, params, sp, progress);
+  progress.say("mesh", 0.02, "edges");
+  step1_part_vertex_nodes(s);
+  step2_transfer_vertex_nodes(s);
+  step3_nondesign_vertex_nodes(s);
+  step4_transfer_nodes_to_part_edges(s);
+  step5_mesh_part_edges(s);
+  step6_transfer_edge_segments(s);
+  step7_mesh_nondesign_edges(s);
+  progress.say("mesh", 0.05, "faces");
+  step8_transfer_segments_to_part_faces(s);
+  step9_mesh_part_faces(s);
+  step10_transfer_triangles(s);
+  step11_mesh_nondesign_faces(s);
+  progress.say("mesh", 0.3, "volumes");
+  {
+    // graded volume size from every surface triangle (Ω's and Ω̄'s)
+    std::vector<std::array<int, 3>> all = s.part.solid_triangles(0);
+    for (int i = 0; i < model.nondesign.num_solids(); ++i) {
+      const auto t = s.nd.solid_triangles(i);
+      all.insert(all.end(), t.begin(), t.end());
+    }
+    s.background = std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1);
   }
-  progress.say("mesh", 0.3, "volume mesh");
-  VolumeFillParams vp = params.volume;
-  std::shared_ptr<BackgroundSize> background;
-  if (!vp.size) {
-    // the surface's target size inside, graded from finer boundary parts
-    const double h = params.surface.size > 0 ? params.surface.size : model.part.diagonal() / 50;
-    background = std::make_shared<BackgroundSize>(s.V, s.F, h, params.surface.gradation - 1);
-    vp.size = [background](const double* x) { return background->at(x); };
-  }
-  VolumeFillResult r = fill_volume(s.V, s.F, MatX4i(), vp, progress);
+  step12_fill_nondesign(s);
+  step13_transfer_tets(s);
+  step14_fill_design(s);
+
+  // output: the nodes the tets use, Ω's boundary with its face numbers (and Ω̄'s where a
+  // triangle also lies on a non-design face)
+  std::vector<int> renum(s.nodes.size(), -1);
+  int kept = 0;
+  for (const auto& t : s.tets)
+    for (int v : t)
+      if (renum[v] < 0) renum[v] = kept++;
   TetMesh m;
-  m.V = std::move(r.V);
-  m.T = std::move(r.T);
-  m.domain = VecXi::Zero(m.T.rows());
-  m.F = s.F;
-  m.face = s.face;
+  m.V.resize(kept, 3);
+  for (size_t i = 0; i < s.nodes.size(); ++i)
+    if (renum[i] >= 0) m.V.row(renum[i]) << s.nodes[i][0], s.nodes[i][1], s.nodes[i][2];
+  m.T.resize(static_cast<long>(s.tets.size()), 4);
+  m.domain.resize(static_cast<long>(s.tets.size()));
+  for (size_t i = 0; i < s.tets.size(); ++i) {
+    m.T.row(static_cast<long>(i)) << renum[s.tets[i][0]], renum[s.tets[i][1]], renum[s.tets[i][2]], renum[s.tets[i][3]];
+    m.domain[static_cast<long>(i)] = s.domain[i];
+  }
+  long nb = 0;
+  for (int f = 0; f < model.part.num_faces(); ++f) nb += static_cast<long>(s.part.face_triangles(f).size());
+  m.F.resize(nb, 3);
+  m.face.resize(nb);
+  m.nd_face = VecXi::Zero(nb);
+  long row = 0;
+  for (int f = 0; f < model.part.num_faces(); ++f)
+    for (const auto& t : s.part.face_triangles(f)) {
+      m.F.row(row) << renum[t[0]], renum[t[1]], renum[t[2]];
+      m.face[row] = f + 1;
+      std::array<int, 3> key = t;
+      std::sort(key.begin(), key.end());
+      auto it = s.nd_face_of.find(key);
+      if (it != s.nd_face_of.end()) m.nd_face[row] = it->second;
+      ++row;
+    }
   return m;
 }
 

@@ -6,7 +6,12 @@
 #include <BRepLProp_CLProps.hxx>
 #include <BRepLProp_SLProps.hxx>
 #include <BRepTools.hxx>
+#include <BRepClass_FaceClassifier.hxx>
 #include <BRep_Tool.hxx>
+#include <ShapeAnalysis_Curve.hxx>
+#include <ShapeAnalysis_Surface.hxx>
+#include <Geom_Curve.hxx>
+#include <Geom_Surface.hxx>
 #include <Geom2d_Curve.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
@@ -21,6 +26,8 @@
 #include <thread>
 #include <cmath>
 #include <map>
+#include <set>
+#include <sstream>
 #include <unordered_map>
 
 #include "common/error.h"
@@ -33,12 +40,12 @@ namespace {
 
 /// What the faces need to know about a face's parametrisation: a per-direction scale making
 /// lengths in (su·u, sv·v) approximate lengths on the surface, and the largest curvature.
-struct FaceGeometry {
+struct Scales {
   double su = 1, sv = 1, kmax = 0;
 };
 
-FaceGeometry face_geometry(const TopoDS_Face& f) {
-  FaceGeometry g;
+Scales face_geometry(const TopoDS_Face& f) {
+  Scales g;
   double u0, u1, v0, v1;
   BRepTools::UVBounds(f, u0, u1, v0, v1);
   BRepAdaptor_Surface s(f, Standard_True);
@@ -137,41 +144,48 @@ double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
 
 }  // namespace
 
-SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParams& params, const Progress& progress) {
-  SurfaceMesh out;
-  const double h = params.size > 0 ? params.size : topo.diagonal() / 50;
-  const double hmin = params.min_size > 0 ? params.min_size : h / 10;
+// ============================================================================ ModelSurface
+
+ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::array<double, 3>>& nodes,
+                           const SurfaceMeshParams& params)
+    : topo_(topo), nodes_(nodes), params_(params) {
+  h_ = params.size > 0 ? params.size : topo.diagonal() / 50;
+  hmin_ = params.min_size > 0 ? params.min_size : h_ / 10;
+  grade_ = params.gradation - 1;
   const int nv = topo.num_vertices(), ne = topo.num_edges(), nf = topo.num_faces();
-  std::vector<std::array<double, 3>> nodes;
-  for (int v = 0; v < nv; ++v) nodes.push_back({topo.vertex_point(v, 0), topo.vertex_point(v, 1), topo.vertex_point(v, 2)});
+  vertex_node_.assign(nv, -1);
+  edge_kind_.assign(ne, EdgeKind::Free);
+  alias_of_.assign(ne, {-1, 0});
+  fixed_.resize(ne);
+  edge_param_.resize(ne);
+  edge_node_.resize(ne);
+  constraint_.resize(nf);
+  face_extra_nodes_.resize(nf);
+  face_given_.assign(nf, 0);
+  face_alias_.assign(nf, {-1, 0});
+  face_tris_.resize(nf);
 
   // ---- per face: parameter scaling and the size its curvature allows
-  std::vector<FaceGeometry> geo(nf);
-  std::vector<double> face_size(nf, h);
+  geo_.resize(nf);
+  face_size_.assign(nf, h_);
   for (int f = 0; f < nf; ++f) {
-    geo[f] = face_geometry(TopoDS::Face(topo.faces(f + 1)));
-    if (geo[f].kmax > 0) face_size[f] = std::clamp(params.max_angle / geo[f].kmax, hmin, h);
+    const Scales g = face_geometry(TopoDS::Face(topo.faces(f + 1)));
+    geo_[f] = {g.su, g.sv, g.kmax};
+    if (g.kmax > 0) face_size_[f] = std::clamp(params.max_angle / g.kmax, hmin_, h_);
   }
-  // ---- edges (step 5 for one model): each discretised once, vertices at its ends
-  std::vector<double> edge_size(ne, h);
+  // ---- each edge sampled finely once: parameters, arc length, and the size allowed there
+  // (its faces' sizes and its own local curvature)
+  std::vector<double> edge_size(ne, h_);
   for (int f = 0; f < nf; ++f)
     for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e)
-      edge_size[*e] = std::min(edge_size[*e], face_size[f]);
-  std::vector<std::vector<double>> edge_param(ne);
-  std::vector<std::vector<int>> edge_node(ne);
-  // Each edge sampled finely once: parameters, arc length, and the size allowed there (its
-  // faces' sizes and its own local curvature).
-  struct EdgeSamples {
-    std::vector<double> t, s, size;
-    int va = -1, vb = -1;
-  };
-  std::vector<EdgeSamples> samples(ne);
+      edge_size[*e] = std::min(edge_size[*e], face_size_[f]);
+  samples_.resize(ne);
   for (int e = 0; e < ne; ++e) {
     if (topo.edge_degenerate[e]) continue;
     const TopoDS_Edge E = TopoDS::Edge(topo.edges(e + 1).Oriented(TopAbs_FORWARD));
     TopoDS_Vertex va, vb;
     TopExp::Vertices(E, va, vb);
-    EdgeSamples& S = samples[e];
+    EdgeSamples& S = samples_[e];
     S.va = topo.vertices.FindIndex(va) - 1, S.vb = topo.vertices.FindIndex(vb) - 1;
     BRepAdaptor_Curve c(E);
     BRepLProp_CLProps props(c, 2, 1e-9);
@@ -186,151 +200,243 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
       prev = p;
       props.SetParameter(t);
       double k = props.IsTangentDefined() ? std::abs(props.Curvature()) : 0.0;
-      S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin, params.max_angle / k)) : edge_size[e]);
+      S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin_, params.max_angle / k)) : edge_size[e]);
     }
   }
   // Vertex sizes: no larger than the sizes along their edges nor their short edges' lengths,
   // then limited by the gradation across edges (relaxed to a fixed point).
-  const double grade = params.gradation - 1;
-  std::vector<double> vsize(nv, h);
+  vsize_.assign(nv, h_);
   for (int e = 0; e < ne; ++e) {
-    const EdgeSamples& S = samples[e];
+    const EdgeSamples& S = samples_[e];
     if (S.va < 0) continue;
     const double len = S.s.back();
-    vsize[S.va] = std::min({vsize[S.va], S.size.front(), std::max(len, hmin / 8)});
-    vsize[S.vb] = std::min({vsize[S.vb], S.size.back(), std::max(len, hmin / 8)});
+    vsize_[S.va] = std::min({vsize_[S.va], S.size.front(), std::max(len, hmin_ / 8)});
+    vsize_[S.vb] = std::min({vsize_[S.vb], S.size.back(), std::max(len, hmin_ / 8)});
   }
   for (bool changed = true; changed;) {
     changed = false;
     for (int e = 0; e < ne; ++e) {
-      const EdgeSamples& S = samples[e];
+      const EdgeSamples& S = samples_[e];
       if (S.va < 0) continue;
       const double len = S.s.back();
       for (auto [x, y] : {std::pair<int, int>{S.va, S.vb}, std::pair<int, int>{S.vb, S.va}})
-        if (vsize[x] > vsize[y] + grade * len * 1.0000001) vsize[x] = vsize[y] + grade * len, changed = true;
+        if (vsize_[x] > vsize_[y] + grade_ * len * 1.0000001) vsize_[x] = vsize_[y] + grade_ * len, changed = true;
     }
   }
-  // Nodes along edge e: spacing = the smallest of the local size and the sizes growing from
-  // both vertices at the gradation rate, placed at equal steps of ∫ ds / size.
-  auto discretise = [&](int e) {
-    const EdgeSamples& S = samples[e];
-    const int m = static_cast<int>(S.t.size()) - 1;
-    const double len = S.s.back();
-    std::vector<double> size(m + 1), phi(m + 1, 0.0);
-    for (int i = 0; i <= m; ++i) {
-      size[i] = std::min({S.size[i], vsize[S.va] + grade * S.s[i], vsize[S.vb] + grade * (len - S.s[i])});
-      size[i] = std::max(size[i], 1e-12);
-    }
-    // size also graded along the edge (a local curvature peak spreads out)
-    for (int i = 1; i <= m; ++i) size[i] = std::min(size[i], size[i - 1] + grade * (S.s[i] - S.s[i - 1]));
-    for (int i = m - 1; i >= 0; --i) size[i] = std::min(size[i], size[i + 1] + grade * (S.s[i + 1] - S.s[i]));
-    for (int i = 1; i <= m; ++i) phi[i] = phi[i - 1] + (S.s[i] - S.s[i - 1]) * 0.5 * (1 / size[i] + 1 / size[i - 1]);
-    int n = std::max(1, static_cast<int>(std::ceil(phi[m] - 0.3)));
-    if (S.va == S.vb) n = std::max(n, 3);
-    std::vector<double>& par = edge_param[e];
-    par.assign(1, S.t.front());
-    int j = 0;
-    for (int k = 1; k < n; ++k) {
-      const double target = phi[m] * k / n;
-      while (j < m && phi[j + 1] < target) ++j;
-      const double w = phi[j + 1] > phi[j] ? (target - phi[j]) / (phi[j + 1] - phi[j]) : 0.5;
-      par.push_back(S.t[j] + w * (S.t[j + 1] - S.t[j]));
-    }
-    par.push_back(S.t.back());
-    BRepAdaptor_Curve c(TopoDS::Edge(topo.edges(e + 1).Oriented(TopAbs_FORWARD)));
-    std::vector<int>& ids = edge_node[e];
-    ids.assign(1, S.va);
-    for (int i = 1; i < n; ++i) {
-      gp_Pnt p = c.Value(par[i]);
-      nodes.push_back({p.X(), p.Y(), p.Z()});
-      ids.push_back(static_cast<int>(nodes.size()) - 1);
-    }
-    ids.push_back(S.vb);
-  };
-  for (int e = 0; e < ne; ++e)
-    if (!topo.edge_degenerate[e]) discretise(e);
+}
 
-  // The boundary of face f in its scaled parameters: local nodes (a seam's nodes appear
-  // twice, at both ends of the period), their global numbers, directed segments with the
-  // face on their left, and the B-Rep edge of each segment.
-  struct Loops {
-    std::vector<std::array<double, 2>> uv;
-    std::vector<int> global;
-    std::vector<std::array<int, 2>> segs;
-    std::vector<int> seg_edge;
-    std::vector<int> seg_piece;  ///< which piece of the edge's discretisation (-1: collapsed edge)
+int ModelSurface::new_node(double x, double y, double z) {
+  nodes_.push_back({x, y, z});
+  return static_cast<int>(nodes_.size()) - 1;
+}
+
+void ModelSurface::set_vertex_node(int v, int node) { vertex_node_[v] = node; }
+
+void ModelSurface::create_vertex_nodes(double merge_tolerance) {
+  for (int v = 0; v < topo_.num_vertices(); ++v) {
+    if (vertex_node_[v] >= 0) continue;
+    const std::array<double, 3> p{topo_.vertex_point(v, 0), topo_.vertex_point(v, 1), topo_.vertex_point(v, 2)};
+    if (merge_tolerance > 0)
+      for (int u = 0; u < v && vertex_node_[v] < 0; ++u)
+        if (vertex_node_[u] >= 0 && sqdist(nodes_[vertex_node_[u]], p) <= merge_tolerance * merge_tolerance)
+          vertex_node_[v] = vertex_node_[u];
+    if (vertex_node_[v] < 0) vertex_node_[v] = new_node(p[0], p[1], p[2]);
+  }
+}
+
+double ModelSurface::edge_parameter(int e, const double* x, double* distance) const {
+  const TopoDS_Edge E = TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD));
+  double first, last;
+  Handle(Geom_Curve) curve = BRep_Tool::Curve(E, first, last);
+  if (curve.IsNull()) {
+    if (distance) *distance = 1e300;
+    return first;
+  }
+  gp_Pnt proj;
+  double t = first;
+  const double d = ShapeAnalysis_Curve().Project(curve, gp_Pnt(x[0], x[1], x[2]), 1e-9, proj, t, first, last, Standard_False);
+  if (distance) *distance = d;
+  return std::clamp(t, std::min(first, last), std::max(first, last));
+}
+
+void ModelSurface::fix_edge_node(int e, int node) {
+  const double t = edge_parameter(e, nodes_[node].data());
+  for (const auto& [s, n] : fixed_[e])
+    if (n == node) return;
+  fixed_[e].push_back({t, node});
+}
+
+void ModelSurface::set_edge_mesh(int e, const std::vector<int>& ids) {
+  const TopoDS_Edge E = TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD));
+  BRepAdaptor_Curve c(E);
+  std::vector<double> par(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i)
+    par[i] = i == 0 ? c.FirstParameter() : i + 1 == ids.size() ? c.LastParameter() : edge_parameter(e, nodes_[ids[i]].data());
+  edge_param_[e] = std::move(par);
+  edge_node_[e] = ids;
+  edge_kind_[e] = EdgeKind::Given;
+}
+
+void ModelSurface::alias_edge(int e, int rep, bool reversed) {
+  edge_kind_[e] = EdgeKind::Alias;
+  alias_of_[e] = {rep, reversed ? 1 : 0};
+}
+
+void ModelSurface::refresh_alias(int e) {
+  const auto [rep, reversed] = alias_of_[e];
+  std::vector<int> ids = edge_node_[rep];
+  if (reversed) std::reverse(ids.begin(), ids.end());
+  const EdgeKind keep = edge_kind_[e];
+  set_edge_mesh(e, ids);
+  edge_kind_[e] = keep;
+}
+
+// Nodes along edge e: spacing = the smallest of the local size and the sizes growing from
+// both vertices at the gradation rate, placed at equal steps of ∫ ds / size between the
+// vertices and the fixed nodes (step 5: nodes transferred from the other model are kept).
+void ModelSurface::discretise(int e) {
+  const EdgeSamples& S = samples_[e];
+  const int m = static_cast<int>(S.t.size()) - 1;
+  const double len = S.s.back();
+  std::vector<double> size(m + 1), phi(m + 1, 0.0);
+  for (int i = 0; i <= m; ++i) {
+    size[i] = std::min({S.size[i], vsize_[S.va] + grade_ * S.s[i], vsize_[S.vb] + grade_ * (len - S.s[i])});
+    size[i] = std::max(size[i], 1e-12);
+  }
+  // size also graded along the edge (a local curvature peak spreads out)
+  for (int i = 1; i <= m; ++i) size[i] = std::min(size[i], size[i - 1] + grade_ * (S.s[i] - S.s[i - 1]));
+  for (int i = m - 1; i >= 0; --i) size[i] = std::min(size[i], size[i + 1] + grade_ * (S.s[i + 1] - S.s[i]));
+  for (int i = 1; i <= m; ++i) phi[i] = phi[i - 1] + (S.s[i] - S.s[i - 1]) * 0.5 * (1 / size[i] + 1 / size[i - 1]);
+  const bool increasing = S.t.back() >= S.t.front();
+  auto phi_at = [&](double t) {  // phi at parameter t, linear between samples
+    double x = (t - S.t.front()) / (S.t.back() - S.t.front()) * m;
+    if (!increasing) x = (S.t.front() - t) / (S.t.front() - S.t.back()) * m;
+    x = std::clamp(x, 0.0, static_cast<double>(m));
+    const int i = std::min(m - 1, static_cast<int>(x));
+    return phi[i] + (x - i) * (phi[i + 1] - phi[i]);
   };
-  auto face_loops = [&](int f) {
-    Loops L;
-    const TopoDS_Face fwd = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
-    const FaceGeometry& g = geo[f];
-    double u0, u1, v0, v1;
-    BRepTools::UVBounds(fwd, u0, u1, v0, v1);
-    const double tol = 1e-6 * std::hypot((u1 - u0) * g.su, (v1 - v0) * g.sv);
-    std::unordered_map<int, std::vector<int>> locals;  // global node -> its local copies (seams)
-    auto local_node = [&](int gid, double u, double v) {
-      for (int l : locals[gid])
-        if (std::hypot(L.uv[l][0] - u, L.uv[l][1] - v) <= std::max(tol, 1e-3 * face_size[f])) return l;
-      L.uv.push_back({u, v});
-      L.global.push_back(gid);
-      locals[gid].push_back(static_cast<int>(L.uv.size()) - 1);
-      return static_cast<int>(L.uv.size()) - 1;
-    };
-    for (TopExp_Explorer ex(fwd, TopAbs_EDGE); ex.More(); ex.Next()) {
-      const TopoDS_Edge E = TopoDS::Edge(ex.Current());
-      const int e = topo.edges.FindIndex(E) - 1;
-      double pf, pl;
-      Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(E, fwd, pf, pl);
-      if (pc.IsNull() || e < 0) continue;
-      std::vector<double> par = edge_param[e];
-      std::vector<int> ids = edge_node[e];
-      if (topo.edge_degenerate[e]) {
-        // A collapsed edge (cone apex, sphere pole): a segment in the parameters, one node
-        // in space. Its pieces all carry the vertex's node; the triangles that collapse onto
-        // it are dropped below, which leaves a fan around the apex.
-        TopoDS_Vertex va, vb;
-        TopExp::Vertices(E, va, vb);
-        const int vid = topo.vertices.FindIndex(va) - 1;
-        const gp_Pnt2d qa = pc->Value(pf), qb = pc->Value(pl);
-        const double uvlen = std::hypot((qb.X() - qa.X()) * g.su, (qb.Y() - qa.Y()) * g.sv);
-        const int n = std::max(2, static_cast<int>(std::ceil(uvlen / face_size[f])));
-        par.clear();
-        ids.assign(n + 1, vid);
-        for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
-      }
-      std::vector<int> loc(par.size());
-      for (size_t i = 0; i < par.size(); ++i) {
-        gp_Pnt2d q = pc->Value(par[i]);
-        loc[i] = local_node(ids[i], q.X() * g.su, q.Y() * g.sv);
-      }
-      const bool forward = E.Orientation() == TopAbs_FORWARD;
-      for (size_t i = 0; i + 1 < loc.size(); ++i) {
-        L.segs.push_back(forward ? std::array<int, 2>{loc[i], loc[i + 1]} : std::array<int, 2>{loc[i + 1], loc[i]});
-        L.seg_edge.push_back(e);
-        L.seg_piece.push_back(topo.edge_degenerate[e] ? -1 : static_cast<int>(i));
-      }
+  auto t_at = [&](double target) {  // inverse of phi
+    int j = static_cast<int>(std::upper_bound(phi.begin(), phi.end(), target) - phi.begin()) - 1;
+    j = std::clamp(j, 0, m - 1);
+    const double w = phi[j + 1] > phi[j] ? (target - phi[j]) / (phi[j + 1] - phi[j]) : 0.5;
+    return S.t[j] + std::clamp(w, 0.0, 1.0) * (S.t[j + 1] - S.t[j]);
+  };
+  // break points: the ends and the fixed nodes, in order along the edge
+  std::vector<std::pair<double, int>> breaks{{S.t.front(), vertex_node_[S.va]}};
+  std::vector<std::pair<double, int>> fixed = fixed_[e];
+  std::sort(fixed.begin(), fixed.end(), [&](const auto& a, const auto& b) { return increasing ? a.first < b.first : a.first > b.first; });
+  for (const auto& fx : fixed)
+    if (fx.second != vertex_node_[S.va] && fx.second != vertex_node_[S.vb]) breaks.push_back(fx);
+  breaks.push_back({S.t.back(), vertex_node_[S.vb]});
+  const int pieces = static_cast<int>(breaks.size()) - 1;
+  std::vector<int> count(pieces);
+  int total = 0;
+  for (int k = 0; k < pieces; ++k) {
+    const double dphi = phi_at(breaks[k + 1].first) - phi_at(breaks[k].first);
+    count[k] = std::max(1, static_cast<int>(std::ceil(dphi - 0.3)));
+    total += count[k];
+  }
+  if (S.va == S.vb)  // a closed edge needs at least three segments
+    for (; total < 3; ++total) ++*std::max_element(count.begin(), count.end());
+  BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
+  std::vector<double>& par = edge_param_[e];
+  std::vector<int>& ids = edge_node_[e];
+  par.assign(1, breaks[0].first);
+  ids.assign(1, breaks[0].second);
+  for (int k = 0; k < pieces; ++k) {
+    const double p0 = phi_at(breaks[k].first), p1 = phi_at(breaks[k + 1].first);
+    for (int i = 1; i < count[k]; ++i) {
+      const double t = t_at(p0 + (p1 - p0) * i / count[k]);
+      const gp_Pnt p = c.Value(t);
+      par.push_back(t);
+      ids.push_back(new_node(p.X(), p.Y(), p.Z()));
     }
-    return L;
+    par.push_back(breaks[k + 1].first);
+    ids.push_back(breaks[k + 1].second);
+  }
+}
+
+// The boundary of face f in its scaled parameters: local nodes (a seam's nodes appear twice,
+// at both ends of the period), their global numbers, directed segments with the face on
+// their left, and the B-Rep edge of each segment.
+ModelSurface::Loops ModelSurface::face_loops(int f) const {
+  Loops L;
+  const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
+  const FaceGeometry& g = geo_[f];
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(fwd, u0, u1, v0, v1);
+  const double tol = 1e-6 * std::hypot((u1 - u0) * g.su, (v1 - v0) * g.sv);
+  std::unordered_map<int, std::vector<int>> locals;  // global node -> its local copies (seams)
+  auto local_node = [&](int gid, double u, double v) {
+    for (int l : locals[gid])
+      if (std::hypot(L.uv[l][0] - u, L.uv[l][1] - v) <= std::max(tol, 1e-3 * face_size_[f])) return l;
+    L.uv.push_back({u, v});
+    L.global.push_back(gid);
+    locals[gid].push_back(static_cast<int>(L.uv.size()) - 1);
+    return static_cast<int>(L.uv.size()) - 1;
   };
+  for (TopExp_Explorer ex(fwd, TopAbs_EDGE); ex.More(); ex.Next()) {
+    const TopoDS_Edge E = TopoDS::Edge(ex.Current());
+    const int e = topo_.edges.FindIndex(E) - 1;
+    double pf, pl;
+    Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(E, fwd, pf, pl);
+    if (pc.IsNull() || e < 0) continue;
+    std::vector<double> par = edge_param_[e];
+    std::vector<int> ids = edge_node_[e];
+    if (topo_.edge_degenerate[e]) {
+      // A collapsed edge (cone apex, sphere pole): a segment in the parameters, one node
+      // in space. Its pieces all carry the vertex's node; the triangles that collapse onto
+      // it are dropped, which leaves a fan around the apex.
+      TopoDS_Vertex va, vb;
+      TopExp::Vertices(E, va, vb);
+      const int vid = vertex_node_[topo_.vertices.FindIndex(va) - 1];
+      const gp_Pnt2d qa = pc->Value(pf), qb = pc->Value(pl);
+      const double uvlen = std::hypot((qb.X() - qa.X()) * g.su, (qb.Y() - qa.Y()) * g.sv);
+      const int n = std::max(2, static_cast<int>(std::ceil(uvlen / face_size_[f])));
+      par.clear();
+      ids.assign(n + 1, vid);
+      for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
+    }
+    std::vector<int> loc(par.size());
+    for (size_t i = 0; i < par.size(); ++i) {
+      gp_Pnt2d q = pc->Value(par[i]);
+      loc[i] = local_node(ids[i], q.X() * g.su, q.Y() * g.sv);
+    }
+    const bool forward = E.Orientation() == TopAbs_FORWARD;
+    for (size_t i = 0; i + 1 < loc.size(); ++i) {
+      L.segs.push_back(forward ? std::array<int, 2>{loc[i], loc[i + 1]} : std::array<int, 2>{loc[i + 1], loc[i]});
+      L.seg_edge.push_back(e);
+      L.seg_piece.push_back(topo_.edge_degenerate[e] ? -1 : static_cast<int>(i));
+    }
+  }
+  return L;
+}
+
+void ModelSurface::mesh_edges(const Progress& progress) {
+  const int ne = topo_.num_edges(), nf = topo_.num_faces();
+  for (int v = 0; v < topo_.num_vertices(); ++v)
+    if (vertex_node_[v] < 0) throw Error(ErrorCode::Internal, "mesh_edges: a vertex has no node yet");
+  for (int e = 0; e < ne; ++e)
+    if (!topo_.edge_degenerate[e] && edge_kind_[e] == EdgeKind::Free) discretise(e);
+  for (int e = 0; e < ne; ++e)
+    if (edge_kind_[e] == EdgeKind::Alias) refresh_alias(e);
 
   // ---- proximity: where two boundary segments of a face cross in its parameters or come
   // closer than a third of their length (thin strips, nearly tangent edges), the polygon the
   // front starts from would cross itself or leave no room; those pieces of their edges are
   // split at their middle, locally, until no face has such a pair (or the floor is reached).
-  // Each round looks again only at the faces one of whose edges was split; the loops of the
-  // last look are the ones the faces are meshed from.
-  const double floor_len = hmin / 8;
-  std::vector<Loops> loops_of(nf);
+  // Given edges are never split; a piece of an aliased edge is split on the edge it copies.
+  // Each round looks again only at the faces one of whose edges was split.
+  const double floor_len = hmin_ / 8;
   std::vector<char> stale(nf, 1);
   for (int round = 0; round < 10; ++round) {
     std::vector<std::vector<int>> split(ne);  // pieces of each edge to split
     bool any = false;
     for (int f = 0; f < nf; ++f) {
-      if (!stale[f]) continue;
+      if (!stale[f] || face_given_[f]) continue;
       progress.check_cancel("surface meshing");
-      loops_of[f] = face_loops(f);
       stale[f] = 0;
-      const Loops& L = loops_of[f];
+      const Loops L = face_loops(f);
       const size_t ns = L.segs.size();
       std::vector<int> order(ns);
       std::vector<double> xlo(ns), xhi(ns), ylo(ns), yhi(ns), len(ns);
@@ -349,22 +455,28 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
         return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
       };
       auto mark = [&](int s) {
-        const int e = L.seg_edge[s], piece = L.seg_piece[s];
-        if (piece < 0) return;
-        const auto& ids = edge_node[e];
-        const double l3 = std::sqrt(sqdist(nodes[ids[piece]], nodes[ids[piece + 1]]));
+        int e = L.seg_edge[s], piece = L.seg_piece[s];
+        if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return;
+        if (edge_kind_[e] == EdgeKind::Alias) {
+          const auto [rep, reversed] = alias_of_[e];
+          if (edge_kind_[rep] != EdgeKind::Free) return;
+          if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
+          e = rep;
+        }
+        const auto& ids = edge_node_[e];
+        const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
         if (l3 > floor_len) split[e].push_back(piece), any = true;
       };
       // pieces longer than the face's size field there (finer features nearby in the face,
       // e.g. a small hole close to a long straight edge) are split too
       {
-        const std::vector<std::array<double, 3>> fine = fine_points(L.uv, L.segs, face_size[f]);
-        const PointGrid grid(fine, face_size[f], grade);
+        const std::vector<std::array<double, 3>> fine = fine_points(L.uv, L.segs, face_size_[f]);
+        const PointGrid grid(fine, face_size_[f], grade_);
         for (size_t i = 0; i < ns; ++i) {
           const auto& A = L.uv[L.segs[i][0]];
           const auto& B = L.uv[L.segs[i][1]];
           const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
-          if (len[i] > 1.5 * grid.size_at(mid, face_size[f])) mark(static_cast<int>(i));
+          if (len[i] > 1.5 * grid.size_at(mid, face_size_[f])) mark(static_cast<int>(i));
         }
       }
       for (size_t oi = 0; oi < ns; ++oi) {
@@ -391,87 +503,175 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
       }
     }
     if (!any) break;
+    std::vector<char> changed(ne, 0);
     for (int e = 0; e < ne; ++e) {
       if (split[e].empty()) continue;
+      changed[e] = 1;
       std::sort(split[e].begin(), split[e].end());
       split[e].erase(std::unique(split[e].begin(), split[e].end()), split[e].end());
-      BRepAdaptor_Curve c(TopoDS::Edge(topo.edges(e + 1).Oriented(TopAbs_FORWARD)));
+      BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
       for (auto it = split[e].rbegin(); it != split[e].rend(); ++it) {
         const int k = *it;
-        const double t = 0.5 * (edge_param[e][k] + edge_param[e][k + 1]);
+        const double t = 0.5 * (edge_param_[e][k] + edge_param_[e][k + 1]);
         const gp_Pnt p = c.Value(t);
-        nodes.push_back({p.X(), p.Y(), p.Z()});
-        edge_param[e].insert(edge_param[e].begin() + k + 1, t);
-        edge_node[e].insert(edge_node[e].begin() + k + 1, static_cast<int>(nodes.size()) - 1);
+        edge_param_[e].insert(edge_param_[e].begin() + k + 1, t);
+        edge_node_[e].insert(edge_node_[e].begin() + k + 1, new_node(p.X(), p.Y(), p.Z()));
       }
     }
+    for (int e = 0; e < ne; ++e)
+      if (edge_kind_[e] == EdgeKind::Alias && changed[alias_of_[e][0]]) refresh_alias(e), changed[e] = 1;
     for (int f = 0; f < nf; ++f)
-      for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f) && !stale[f]; ++e)
-        stale[f] = !split[*e].empty();
+      for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f) && !stale[f]; ++e)
+        stale[f] = changed[*e];
   }
+}
 
-  // ---- faces (step 9 for one model): the front fills each face's loops, faces in parallel
-  // (largest first), merged in face order so the result does not depend on the threads
-  struct FaceOut {
-    std::vector<int> global;  // boundary nodes' global numbers (the first rows of X)
-    MatX3d X;                 // every node of the face's mesh
-    MatX3i T;
-    std::string error;
-  };
-  std::vector<FaceOut> face_out(nf);
-  auto mesh_face = [&](int f, const Progress& prog) {
-    FaceOut& fo = face_out[f];
-    const TopoDS_Face fwd = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
-    const FaceGeometry& g = geo[f];
-    Loops loops = stale[f] ? face_loops(f) : std::move(loops_of[f]);
-    const std::vector<std::array<double, 2>>& uv = loops.uv;
-    const std::vector<std::array<int, 2>>& segs = loops.segs;
-    fo.global = std::move(loops.global);
-    FaceFrontInput in;
-    in.P.resize(uv.size(), 2);
-    for (size_t i = 0; i < uv.size(); ++i) in.P.row(i) << uv[i][0], uv[i][1];
-    in.boundary.resize(segs.size(), 2);
-    for (size_t i = 0; i < segs.size(); ++i) in.boundary.row(i) << segs[i][0], segs[i][1];
-    FaceFrontParams fp = params.front;
-    // size: the face's, but near boundary pieces finer than that (split by proximity, or
-    // from a finer neighbour) it grows from their length at the gradation rate
-    const double hf = face_size[f];
-    const PointGrid grid(fine_points(uv, segs, hf), hf, grade);
-    fp.size = [hf, &grid](const double* q) { return grid.size_at(q, hf); };
-    FaceFrontResult r;
-    try {
-      r = fill_face(in, fp, prog);
-    } catch (const Error& err) {
-      if (err.code() == ErrorCode::Cancelled) throw;
-      fo.error = err.what();
-      return;
+void ModelSurface::constrain_face(int f, int a, int b) {
+  if (a == b) return;
+  for (const auto& s : constraint_[f])
+    if ((s[0] == a && s[1] == b) || (s[0] == b && s[1] == a)) return;
+  constraint_[f].push_back({a, b});
+}
+
+void ModelSurface::add_face_node(int f, int n) {
+  if (std::find(face_extra_nodes_[f].begin(), face_extra_nodes_[f].end(), n) == face_extra_nodes_[f].end())
+    face_extra_nodes_[f].push_back(n);
+}
+
+void ModelSurface::set_face_mesh(int f, std::vector<std::array<int, 3>> tris) {
+  face_tris_[f] = std::move(tris);
+  face_given_[f] = 1;
+}
+
+void ModelSurface::alias_face(int f, int src, bool reversed) { face_alias_[f] = {src, reversed ? 1 : 0}; }
+
+// Step 9 / 11 for one face: the front fills the face's loops in its scaled parameters,
+// honouring the constraint segments and nodes, then the triangles are improved on the
+// surface (constraint nodes and segments fixed).
+void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
+  const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
+  const FaceGeometry& g = geo_[f];
+  Loops loops = face_loops(f);
+  std::vector<std::array<double, 2>>& uv = loops.uv;
+  std::vector<int> global = std::move(loops.global);
+  // constraint nodes: a boundary node takes its local copy (the one nearest the segment's
+  // other end on a seam), any other node its parameters by projection onto the surface
+  std::unordered_map<int, std::vector<int>> locals;
+  for (size_t l = 0; l < global.size(); ++l) locals[global[l]].push_back(static_cast<int>(l));
+  ShapeAnalysis_Surface sas(BRep_Tool::Surface(fwd));
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(fwd, u0, u1, v0, v1);
+  auto project = [&](int n) {
+    const auto& x = nodes_[n];
+    gp_Pnt2d q = sas.ValueOfUV(gp_Pnt(x[0], x[1], x[2]), 1e-9);
+    double u = q.X(), v = q.Y();
+    const Handle(Geom_Surface)& s = sas.Surface();
+    if (s->IsUPeriodic()) {
+      const double T = s->UPeriod();
+      while (u < u0 - 1e-9 * T) u += T;
+      while (u > u1 + 1e-9 * T) u -= T;
     }
-    // local optimisation judged on the surface; triangles collapsed on an apex keep their edges
-    BRepAdaptor_Surface s(fwd, Standard_False);
-    const double su = g.su, sv = g.sv;
-    SurfaceEval eval = [&s, su, sv](const double* q, double* x, double* du, double* dv) {
-      gp_Pnt p;
-      gp_Vec a, b;
-      s.D1(q[0] / su, q[1] / sv, p, a, b);
-      x[0] = p.X(), x[1] = p.Y(), x[2] = p.Z();
-      du[0] = a.X() / su, du[1] = a.Y() / su, du[2] = a.Z() / su;
-      dv[0] = b.X() / sv, dv[1] = b.Y() / sv, dv[2] = b.Z() / sv;
-    };
-    std::vector<std::array<int, 2>> locked;
-    const long nin = static_cast<long>(fo.global.size());
-    for (long t = 0; t < r.T.rows(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int a = r.T(t, k), b = r.T(t, (k + 1) % 3), c = r.T(t, (k + 2) % 3);
-        if (a < nin && b < nin && fo.global[a] == fo.global[b]) locked.push_back({a, c}), locked.push_back({b, c});
-      }
-    optimize_on_surface(r.P, r.T, fo.X, static_cast<int>(nin), eval, locked, params.optimize_rounds);
-    fo.T = std::move(r.T);
+    if (s->IsVPeriodic()) {
+      const double T = s->VPeriod();
+      while (v < v0 - 1e-9 * T) v += T;
+      while (v > v1 + 1e-9 * T) v -= T;
+    }
+    uv.push_back({u * g.su, v * g.sv});
+    global.push_back(n);
+    locals[n].push_back(static_cast<int>(uv.size()) - 1);
+    return static_cast<int>(uv.size()) - 1;
   };
+  auto local_of = [&](int n, int near) {
+    auto it = locals.find(n);
+    if (it == locals.end() || it->second.empty()) return project(n);
+    int best = it->second[0];
+    if (near >= 0)
+      for (int l : it->second)
+        if (std::hypot(uv[l][0] - uv[near][0], uv[l][1] - uv[near][1]) <
+            std::hypot(uv[best][0] - uv[near][0], uv[best][1] - uv[near][1]))
+          best = l;
+    return best;
+  };
+  std::vector<std::array<int, 2>> csegs;
+  for (const auto& s : constraint_[f]) {
+    const bool a_unique = locals.count(s[0]) && locals[s[0]].size() == 1;
+    int a, b;
+    if (a_unique || !locals.count(s[1])) {
+      a = local_of(s[0], -1);
+      b = local_of(s[1], a);
+    } else {
+      b = local_of(s[1], -1);
+      a = local_of(s[0], b);
+    }
+    csegs.push_back({a, b});
+  }
+  std::vector<int> isolated;
+  for (int n : face_extra_nodes_[f])
+    if (!locals.count(n)) isolated.push_back(local_of(n, -1));
+
+  FaceFrontInput in;
+  in.P.resize(static_cast<long>(uv.size()), 2);
+  for (size_t i = 0; i < uv.size(); ++i) in.P.row(static_cast<long>(i)) << uv[i][0], uv[i][1];
+  in.boundary.resize(static_cast<long>(loops.segs.size()), 2);
+  for (size_t i = 0; i < loops.segs.size(); ++i) in.boundary.row(static_cast<long>(i)) << loops.segs[i][0], loops.segs[i][1];
+  in.segments.resize(static_cast<long>(csegs.size()), 2);
+  for (size_t i = 0; i < csegs.size(); ++i) in.segments.row(static_cast<long>(i)) << csegs[i][0], csegs[i][1];
+  in.isolated = isolated;
+  FaceFrontParams fp = params_.front;
+  // size: the face's, but near boundary and constraint pieces finer than that (split by
+  // proximity, from a finer neighbour, or from the other model) it grows from their length
+  // at the gradation rate
+  const double hf = face_size_[f];
+  std::vector<std::array<int, 2>> all_segs = loops.segs;
+  all_segs.insert(all_segs.end(), csegs.begin(), csegs.end());
+  const PointGrid grid(fine_points(uv, all_segs, hf), hf, grade_);
+  fp.size = [hf, &grid](const double* q) { return grid.size_at(q, hf); };
+  FaceFrontResult r;
+  try {
+    r = fill_face(in, fp, prog);
+  } catch (const Error& err) {
+    if (err.code() == ErrorCode::Cancelled) throw;
+    out.error = err.what();
+    return;
+  }
+  // local optimisation judged on the surface; triangles collapsed on an apex keep their edges
+  BRepAdaptor_Surface s(fwd, Standard_False);
+  const double su = g.su, sv = g.sv;
+  SurfaceEval eval = [&s, su, sv](const double* q, double* x, double* du, double* dv) {
+    gp_Pnt p;
+    gp_Vec a, b;
+    s.D1(q[0] / su, q[1] / sv, p, a, b);
+    x[0] = p.X(), x[1] = p.Y(), x[2] = p.Z();
+    du[0] = a.X() / su, du[1] = a.Y() / su, du[2] = a.Z() / su;
+    dv[0] = b.X() / sv, dv[1] = b.Y() / sv, dv[2] = b.Z() / sv;
+  };
+  std::vector<std::array<int, 2>> locked = csegs;
+  const long nin = static_cast<long>(global.size());
+  for (long t = 0; t < r.T.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = r.T(t, k), b = r.T(t, (k + 1) % 3), c = r.T(t, (k + 2) % 3);
+      if (a < nin && b < nin && global[a] == global[b]) locked.push_back({a, c}), locked.push_back({b, c});
+    }
+  optimize_on_surface(r.P, r.T, out.X, static_cast<int>(nin), eval, locked, params_.optimize_rounds);
+  out.global = std::move(global);
+  out.T = std::move(r.T);
+}
+
+void ModelSurface::mesh_faces(const Progress& progress) {
+  const int nf = topo_.num_faces();
+  // faces in parallel (largest first), merged in face order so the result does not depend
+  // on the threads
+  std::vector<int> order;
+  std::vector<double> work(nf, 0.0);
+  for (int f = 0; f < nf; ++f)
+    if (!face_given_[f] && face_alias_[f][0] < 0) {
+      order.push_back(f);
+      work[f] = topo_.face_area[f] / (face_size_[f] * face_size_[f]);
+    }
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return work[x] > work[y]; });
+  std::vector<FaceOut> face_out(nf);
   {
-    std::vector<int> order(nf);
-    std::vector<double> work(nf, 0.0);
-    for (int f = 0; f < nf; ++f) order[f] = f, work[f] = topo.face_area[f] / (face_size[f] * face_size[f]);
-    std::sort(order.begin(), order.end(), [&](int x, int y) { return work[x] > work[y]; });
+    const int n = static_cast<int>(order.size());
     std::atomic<int> next{0};
     std::atomic<bool> stop{false};
     std::exception_ptr failure;
@@ -481,9 +681,9 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
     auto worker = [&](bool main_thread) {
       const Progress& prog = main_thread ? progress : quiet;
       try {
-        for (int i; !stop.load() && (i = next.fetch_add(1)) < nf;) {
+        for (int i; !stop.load() && (i = next.fetch_add(1)) < n;) {
           if (main_thread) progress.check_cancel("surface meshing");
-          mesh_face(order[i], prog);
+          mesh_face(order[i], prog, face_out[order[i]]);
         }
       } catch (...) {
         std::lock_guard<std::mutex> lock(failure_mutex);
@@ -491,60 +691,112 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
         stop = true;
       }
     };
-    const int threads = std::min(thread_count(params.threads), std::max(1, nf));
+    const int threads = std::min(thread_count(params_.threads), std::max(1, n));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t) pool.emplace_back(worker, false);
     worker(true);
     for (auto& th : pool) th.join();
     if (failure) std::rethrow_exception(failure);
   }
-  std::vector<std::array<int, 3>> tris;
-  std::vector<int> tri_face;
   for (int f = 0; f < nf; ++f) {
+    if (face_given_[f] || face_alias_[f][0] >= 0) continue;
     FaceOut& fo = face_out[f];
     if (!fo.error.empty()) {
-      out.failed_faces.push_back(f + 1);
-      out.reasons.push_back(fo.error);
+      failed_.push_back(f + 1);
+      reasons_.push_back(fo.error);
       continue;
     }
     const long nin = static_cast<long>(fo.global.size());
     std::vector<int> to_global(fo.X.rows());
-    for (long i = 0; i < fo.X.rows(); ++i) {
-      if (i < nin) {
-        to_global[i] = fo.global[i];
-      } else {
-        nodes.push_back({fo.X(i, 0), fo.X(i, 1), fo.X(i, 2)});
-        to_global[i] = static_cast<int>(nodes.size()) - 1;
-      }
-    }
-    const bool flip = topo.faces(f + 1).Orientation() == TopAbs_REVERSED;
+    for (long i = 0; i < fo.X.rows(); ++i) to_global[i] = i < nin ? fo.global[i] : new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
+    const bool flip = topo_.faces(f + 1).Orientation() == TopAbs_REVERSED;
+    auto& tris = face_tris_[f];
+    tris.clear();
     for (long t = 0; t < fo.T.rows(); ++t) {
       std::array<int, 3> tri{to_global[fo.T(t, 0)], to_global[fo.T(t, 1)], to_global[fo.T(t, 2)]};
       if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;  // collapsed on an apex
       if (flip) std::swap(tri[1], tri[2]);
       tris.push_back(tri);
-      tri_face.push_back(f + 1);
     }
     fo = FaceOut();
   }
-  // Nodes: the vertices, then those the triangles use (the nodes of an edge whose faces all
-  // failed stay unused).
-  std::vector<int> renum(nodes.size(), -1);
-  int kept = 0;
-  for (int v = 0; v < nv; ++v) renum[v] = kept++;
-  for (const auto& t : tris)
-    for (int v : t)
-      if (renum[v] < 0) renum[v] = kept++;
-  out.V.resize(kept, 3);
-  for (size_t i = 0; i < nodes.size(); ++i)
-    if (renum[i] >= 0) out.V.row(renum[i]) << nodes[i][0], nodes[i][1], nodes[i][2];
-  out.F.resize(static_cast<long>(tris.size()), 3);
-  out.face.resize(static_cast<long>(tris.size()));
-  for (size_t t = 0; t < tris.size(); ++t) {
-    out.F.row(t) << renum[tris[t][0]], renum[tris[t][1]], renum[tris[t][2]];
-    out.face[t] = tri_face[t];
+  // aliased faces (solids that touch): the source's triangles, after checking that their
+  // boundary is this face's boundary
+  for (int f = 0; f < nf; ++f) {
+    const auto [src, reversed] = face_alias_[f];
+    if (src < 0) continue;
+    std::vector<std::array<int, 3>> tris = face_tris_[src];
+    if (reversed)
+      for (auto& t : tris) std::swap(t[1], t[2]);
+    std::set<std::pair<int, int>> mine, theirs;
+    const Loops L = face_loops(f);
+    for (const auto& s : L.segs) mine.insert(std::minmax(L.global[s[0]], L.global[s[1]]));
+    std::map<std::pair<int, int>, int> uses;
+    for (const auto& t : tris)
+      for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+    for (const auto& [e, n] : uses)
+      if (n == 1) theirs.insert(e);
+    if (tris.empty() || mine != theirs) {
+      failed_.push_back(f + 1);
+      std::ostringstream m;
+      m << "Face" << f + 1 << " lies on Face" << src + 1
+        << " but their boundaries differ (only identical touching faces are supported)";
+      reasons_.push_back(m.str());
+      continue;
+    }
+    face_tris_[f] = std::move(tris);
   }
+}
+
+std::vector<std::array<int, 3>> ModelSurface::solid_triangles(int s) const {
+  std::vector<std::array<int, 3>> rows;
+  for (TopExp_Explorer ex(topo_.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
+    const int f = topo_.faces.FindIndex(ex.Current());
+    if (f <= 0) continue;
+    const bool flip = ex.Current().Orientation() != topo_.faces(f).Orientation();
+    for (auto t : face_tris_[f - 1]) {
+      if (flip) std::swap(t[1], t[2]);
+      rows.push_back(t);
+    }
+  }
+  return rows;
+}
+
+SurfaceMesh ModelSurface::result() const {
+  SurfaceMesh out;
+  out.failed_faces = failed_;
+  out.reasons = reasons_;
+  const int nv = topo_.num_vertices();
+  std::unordered_map<int, int> renum;
+  std::vector<int> used;
+  auto take = [&](int n) {
+    auto [it, inserted] = renum.emplace(n, static_cast<int>(used.size()));
+    if (inserted) used.push_back(n);
+    return it->second;
+  };
+  for (int v = 0; v < nv; ++v) take(vertex_node_[v]);
+  long nt = 0;
+  for (const auto& tris : face_tris_) nt += static_cast<long>(tris.size());
+  out.F.resize(nt, 3);
+  out.face.resize(nt);
+  long row = 0;
+  for (int f = 0; f < topo_.num_faces(); ++f)
+    for (const auto& t : face_tris_[f]) {
+      out.F.row(row) << take(t[0]), take(t[1]), take(t[2]);
+      out.face[row++] = f + 1;
+    }
+  out.V.resize(static_cast<long>(used.size()), 3);
+  for (size_t i = 0; i < used.size(); ++i) out.V.row(static_cast<long>(i)) << nodes_[used[i]][0], nodes_[used[i]][1], nodes_[used[i]][2];
   return out;
+}
+
+SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParams& params, const Progress& progress) {
+  std::vector<std::array<double, 3>> nodes;
+  ModelSurface model(topo, nodes, params);
+  model.create_vertex_nodes();
+  model.mesh_edges(progress);
+  model.mesh_faces(progress);
+  return model.result();
 }
 
 MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh, int s) {
