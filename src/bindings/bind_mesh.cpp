@@ -38,6 +38,7 @@ void bind_mesh(pybind11::module_& m) {
         out["domain"] = mesh.domain;
         out["boundary_triangles"] = mesh.F;
         out["boundary_faces"] = mesh.face;
+        out["boundary_nondesign_faces"] = mesh.nd_face;
         out["min_radius_ratio"] = q.min_radius_ratio;
         out["mean_radius_ratio"] = q.mean_radius_ratio;
         return out;
@@ -45,7 +46,9 @@ void bind_mesh(pybind11::module_& m) {
       pybind11::arg("job_json"), pybind11::arg("part_brep"), pybind11::arg("nondesign_brep") = "",
       R"doc(The conformal tagged tet mesh of a job's shapes (BREP strings) at the job's mesh size.
 Returns a dict: nodes #V x 3, tets #T x 4, domain #T (0 design, i non-design solid i),
-boundary_triangles #F x 3 with boundary_faces #F (FreeCAD face numbers), quality figures.)doc");
+boundary_triangles #F x 3 with boundary_faces #F (FreeCAD face numbers of the part) and
+boundary_nondesign_faces #F (the non-design compound's face a triangle also lies on, 0: none),
+quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "auto").)doc");
 
   m.def(
       "surface_mesh",

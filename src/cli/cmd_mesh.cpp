@@ -22,18 +22,18 @@ namespace topopt::cli {
 int cmd_mesh(const Args& args) {
   ArgReader a(args,
               "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] --out FILE\n"
-              "                   [--stats STATS.json] [--volume gmsh|native] [--mesher gmsh|native]\n"
+              "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
               "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
               "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
               "  part's face numbers (FreeCAD's FaceN).\n"
               "  --out    FILE.msh (Gmsh MSH 4.1), FILE.vtu (ParaView) or FILE.inp (CalculiX mesh)\n"
               "  --size   target element size in mm (default: part diagonal / 50)\n"
               "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
-              "  --volume who fills the volumes: gmsh (default) or native (our advancing front on\n"
-              "           Gmsh's surface mesh; experimental)\n"
-              "  --mesher native: our surface mesher and our volume front end to end (a part without\n"
-              "           non-design solids only, until the 14-step driver lands)\n"
-              "  Meshing is currently done by Gmsh's OCC fragments (interim, see README).");
+              "  --mesher native: the two-B-Rep advancing front (the 14 steps: no boolean of the part\n"
+              "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh;\n"
+              "           auto (default): native, and gmsh with a warning where native fails\n"
+              "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
+              "           (a comparison aid)");
   if (a.wants_help()) {
     std::cout << a.usage() << "\n";
     return 0;
@@ -42,8 +42,9 @@ int cmd_mesh(const Args& args) {
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);
   mp.min_size = a.number("min-size", 0);
-  std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "gmsh");
-  if (mesher != "gmsh" && mesher != "native") throw Error(ErrorCode::InvalidParameter, "--mesher takes gmsh or native");
+  std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "auto");
+  if (mesher != "auto" && mesher != "gmsh" && mesher != "native")
+    throw Error(ErrorCode::InvalidParameter, "--mesher takes auto, native or gmsh");
   if (volume != "gmsh" && volume != "native") throw Error(ErrorCode::InvalidParameter, "--volume takes gmsh or native");
   mp.native_volume = volume == "native";
   if (!a.positionals().empty() || part.empty() || out.empty())
@@ -60,16 +61,16 @@ int cmd_mesh(const Args& args) {
   auto t1 = clock::now();
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) { std::cerr << "[" << stage << "] " << msg << "\n"; };
-  if (getenv("TOPOPT_VERBOSE")) progress.log = [](LogLevel, const std::string& msg) { std::cerr << "  " << msg << "\n"; };
+  const bool verbose = getenv("TOPOPT_VERBOSE") != nullptr;
+  progress.log = [verbose](LogLevel level, const std::string& msg) {
+    if (verbose || level == LogLevel::Warning) std::cerr << (level != LogLevel::Warning ? "  " : "warning: ") << msg << "\n";
+  };
   TetMesh m;
-  if (mesher == "native") {
-    mesh::NativeMeshParams np;
-    np.surface.size = mp.size;
-    np.surface.min_size = mp.min_size;
-    m = mesh::mesh_native(model, np, progress);
-  } else {
-    m = mesh::mesh_with_gmsh_fragments(model, mp, progress);
-  }
+  if (mesher != "gmsh" && mp.native_volume)
+    throw Error(ErrorCode::InvalidParameter, "--volume native goes with --mesher gmsh (the native mesher fills its volumes itself)");
+  mesh::MeshRun run;
+  if (mp.native_volume) m = mesh::mesh_with_gmsh_fragments(model, mp, progress), run.mesher = "gmsh surfaces + native volumes";
+  else m = mesh::mesh_two_breps(model, mesher, mp.size, mp.min_size, progress, &run);
   mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
   auto t2 = clock::now();
   if (ext == ".msh") io::write_msh(out, m);
@@ -98,8 +99,9 @@ int cmd_mesh(const Args& args) {
     j["quality"] = q.to_json();
     j["conformity"] = conf.to_json();
     j["seconds"] = {{"read_and_classify", sec(t0, t1)}, {"mesh", sec(t1, t2)}, {"write", sec(t2, t3)}};
-    j["mesher"] = mesher == "native" ? "native surface + native advancing front"
-                  : mp.native_volume ? "gmsh surfaces + native advancing front" : "gmsh-fragments (interim)";
+    j["mesher"] = run.mesher;
+    if (!run.fallback_reason.empty()) j["native_failed"] = run.fallback_reason;
+    for (const auto& [stage, t] : run.seconds) j["seconds_per_stage"][stage] = t;
     std::ofstream f(stats);
     f << j.dump(2) << "\n";
     if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);

@@ -38,7 +38,9 @@ int cmd_optimize(const Args& args) {
   progress.report = [quiet](const std::string& stage, double, const std::string& msg) {
     if (!quiet || stage != "simp") std::cerr << "[" << stage << "] " << msg << "\n";
   };
-  if (verbose) progress.log = [](LogLevel, const std::string& msg) { std::cerr << "  " << msg << "\n"; };
+  progress.log = [verbose](LogLevel level, const std::string& msg) {
+    if (verbose || level == LogLevel::Warning) std::cerr << (level != LogLevel::Warning ? "  " : "warning: ") << msg << "\n";
+  };
   auto t0 = std::chrono::steady_clock::now();
   TetMesh mesh = pipeline::job_mesh(job, progress);
   double t_mesh = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

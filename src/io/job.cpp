@@ -91,6 +91,11 @@ Job parse_job(const std::string& text, const std::string& base_dir) {
     job.mesh_file = resolve(str(m, "file"), base_dir);
     job.mesh_size = number(m, "size", 0, "mesh.");
     job.mesh_min_size = number(m, "min_size", 0, "mesh.");
+    if (m.contains("mesher")) {
+      if (!m["mesher"].is_string() || (m["mesher"] != "auto" && m["mesher"] != "native" && m["mesher"] != "gmsh"))
+        bad("mesh.mesher", "must be \"auto\", \"native\" (the two-B-Rep advancing front) or \"gmsh\"");
+      job.mesher = m["mesher"].get<std::string>();
+    }
     if (job.mesh_size < 0) bad("mesh.size", "must be positive (mm), or 0 for automatic");
     if (job.mesh_min_size < 0) bad("mesh.min_size", "must be positive (mm), or 0 for automatic");
   }

@@ -22,6 +22,9 @@ struct Job {
   std::string mesh_file;          ///< a ready MSH 4.1 mesh, or ""
   double mesh_size = 0;           ///< target element size (mm); 0 = automatic
   double mesh_min_size = 0;       ///< smallest size (mm); 0 = automatic
+  /// "native": the two-B-Rep advancing front (14 steps); "gmsh": OCC fragments + Gmsh;
+  /// "auto": native, falling back to gmsh with a warning where native cannot close a mesh.
+  std::string mesher = "auto";
   fem::Material material;
   std::vector<fem::SupportSpec> supports;
   std::vector<fem::LoadCase> load_cases;

@@ -5,6 +5,7 @@
 #include <BRepClass_FaceClassifier.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
+#include <chrono>
 #include <array>
 #include <map>
 #include <set>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "mesh/gmsh_fragments.h"
 
 namespace topopt::mesh {
 namespace {
@@ -370,7 +372,16 @@ void step14_fill_design(Steps& s) { fill(s, s.part.solid_triangles(0), 0, "desig
 
 }  // namespace
 
-TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params, const Progress& progress) {
+TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params, const Progress& progress,
+                    MeshRun* run) {
+  using clock = std::chrono::steady_clock;
+  auto t0 = clock::now();
+  auto lap = [&](const char* stage) {
+    const auto t1 = clock::now();
+    if (run) run->seconds.push_back({stage, std::chrono::duration<double>(t1 - t0).count()});
+    t0 = t1;
+  };
+  if (run) run->mesher = "native", run->seconds.clear();
   // both models on the part's size, so that what one transfers suits the other
   SurfaceMeshParams sp = params.surface;
   if (sp.size <= 0) sp.size = model.part.diagonal() / 50;
@@ -384,11 +395,13 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
   step5_mesh_part_edges(s);
   step6_transfer_edge_segments(s);
   step7_mesh_nondesign_edges(s);
+  lap("steps 1-7: vertices and edges");
   progress.say("mesh", 0.05, "faces");
   step8_transfer_segments_to_part_faces(s);
   step9_mesh_part_faces(s);
   step10_transfer_triangles(s);
   step11_mesh_nondesign_faces(s);
+  lap("steps 8-11: faces");
   progress.say("mesh", 0.3, "volumes");
   {
     // graded volume size from every surface triangle (Ω's and Ω̄'s)
@@ -400,8 +413,10 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
     s.background = std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1);
   }
   step12_fill_nondesign(s);
+  lap("step 12: non-design volumes");
   step13_transfer_tets(s);
   step14_fill_design(s);
+  lap("steps 13-14: design volume");
 
   // output: the nodes the tets use, Ω's boundary with its face numbers (and Ω̄'s where a
   // triangle also lies on a non-design face)
@@ -436,6 +451,35 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
       if (it != s.nd_face_of.end()) m.nd_face[row] = it->second;
       ++row;
     }
+  return m;
+}
+
+TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, double size, double min_size,
+                       const Progress& progress, MeshRun* run) {
+  if (mesher != "auto" && mesher != "native" && mesher != "gmsh")
+    throw Error(ErrorCode::InvalidParameter, "the mesher is \"auto\", \"native\" or \"gmsh\", not \"" + mesher + "\"");
+  if (mesher != "gmsh") {
+    NativeMeshParams np;
+    np.surface.size = size;
+    np.surface.min_size = min_size;
+    try {
+      return mesh_native(model, np, progress, run);
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::MeshingFailed || mesher == "native") throw;
+      if (run) run->fallback_reason = e.what();
+      progress.warn(std::string("the native mesher could not mesh this part (") + e.what() +
+                    "); meshing with Gmsh's OCC fragments instead");
+    }
+  }
+  FragmentMeshParams mp;
+  mp.size = size;
+  mp.min_size = min_size;
+  const auto t0 = std::chrono::steady_clock::now();
+  TetMesh m = mesh_with_gmsh_fragments(model, mp, progress);
+  if (run) {
+    run->mesher = "gmsh";
+    run->seconds = {{"gmsh fragments, surface and volume", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
+  }
   return m;
 }
 

@@ -1,8 +1,14 @@
-// The native mesher, as far as it goes today: one model meshed by our own surface mesher
-// (steps 1, 5, 9 for a single B-Rep) and filled by our 3D advancing front (step 12 for a
-// single B-Rep). The part with non-design solids needs the 14-step driver (issue 5); until it
-// lands this takes a part without non-design solids and says so otherwise.
+// The native mesher: the part Ω and the non-design solids Ω̄ meshed as two B-Reps by the 14
+// steps of DESIGN.md into one conformal tagged tet mesh. Both models' surface meshes are
+// built stage by stage on one node pool (ModelSurface), and nodes, segments, triangles and
+// tets move between them by the classification of Ω̄ against Ω (brep/classify.h); the
+// volumes are filled by the 3D advancing front (Ω̄'s solids first, then Ω around their tets).
+// Non-design solids that touch each other share their vertices, edges and touching faces.
 #pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "brep/two_breps.h"
 #include "common/progress.h"
 #include "common/types.h"
@@ -19,9 +25,24 @@ struct NativeMeshParams {
   VolumeFillParams volume;  ///< its size is set from the surface size and the gradation if empty
 };
 
-/// A tagged tet mesh of the part (domain 0; boundary triangles tagged with its FreeCAD face
-/// numbers). Throws InvalidParameter when non-design solids are given, MeshingFailed naming
-/// the faces or the region that could not be meshed.
-TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params = {}, const Progress& progress = {});
+/// What a run did: the mesher that made the mesh and the seconds of each stage.
+struct MeshRun {
+  std::string mesher;  ///< "native" or "gmsh"
+  std::vector<std::pair<std::string, double>> seconds;  ///< (stage, seconds) in order
+  std::string fallback_reason;  ///< why "auto" fell back to Gmsh, if it did
+};
+
+/// The 14 steps: one conformal tet mesh of Ω, every tet tagged 0 (design, Ω − Ω̄) or i (the
+/// i-th non-design solid, input order); boundary triangles = Ω's boundary with Ω's FreeCAD
+/// face numbers, and nd_face = the face of Ω̄ a triangle also lies on (load pads).
+/// Throws MeshingFailed naming the face, edge, solid or region that could not be meshed.
+TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params = {}, const Progress& progress = {},
+                    MeshRun* run = nullptr);
+
+/// The product's choice of mesher: "native" (mesh_native), "gmsh" (OCC fragments and Gmsh,
+/// gmsh_fragments.h) or "auto" (native; where it cannot close a mesh, a warning through
+/// `progress` and Gmsh). size, min_size in mm, 0 = automatic.
+TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, double size, double min_size,
+                       const Progress& progress = {}, MeshRun* run = nullptr);
 
 }  // namespace topopt::mesh

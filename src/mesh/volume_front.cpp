@@ -401,6 +401,160 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   return flips;
 }
 
+/// Sliver removal by point insertion: each new tet below `bad` is taken out with its new
+/// neighbours across its faces (and, when that is not enough, one more layer of them), and
+/// the cavity is filled again as a star from one new point: the point that maximises the
+/// worst radius ratio of the star (a compass search from the cavity's centroid), kept only
+/// where it sees every cavity face (so the star tiles the cavity exactly) and the star's worst
+/// tet is better than the cavity's. Removes what flips cannot: a tet with two faces on the
+/// boundary. Input tets and boundary faces stay (they are faces of the star). Returns the
+/// number of cavities re-filled.
+long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 4>>& tets, double bad) {
+  long done = 0;
+  auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
+  for (int sweep = 0; sweep < 2; ++sweep) {
+    const NodeStars stars(P.size(), tets);
+    std::vector<char> locked(P.size(), 0), gone(tets.size(), 0);
+    std::vector<std::array<int, 4>> added;
+    const size_t n0 = tets.size();
+    auto neighbours_of = [&](int t, std::vector<int>& out) {
+      const auto& v = tets[t];
+      for (const auto& o : kFace) {
+        const int a = v[o[0]], b = v[o[1]], c = v[o[2]];
+        for (const int* q = stars.begin(a); q != stars.end(a); ++q) {
+          if (*q == t) continue;
+          const auto& w = tets[*q];
+          const bool hb = w[0] == b || w[1] == b || w[2] == b || w[3] == b;
+          const bool hc = w[0] == c || w[1] == c || w[2] == c || w[3] == c;
+          if (hb && hc) out.push_back(*q);
+        }
+      }
+    };
+    for (size_t t = 0; t < n0; ++t) {
+      if (gone[t] || rho(tets[t]) >= bad) continue;
+      bool skip = false;
+      for (int x : tets[t]) skip |= locked[x] != 0;
+      if (skip) continue;
+      // candidate cavities: the tets around each of its edges, then the tet with its face
+      // neighbours, then one more layer; the best star over all of them is kept
+      std::vector<std::vector<int>> options;
+      const auto v = tets[t];
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          std::vector<int> ring;
+          for (const int* q = stars.begin(v[i]); q != stars.end(v[i]); ++q) {
+            const auto& w = tets[*q];
+            if (w[0] == v[j] || w[1] == v[j] || w[2] == v[j] || w[3] == v[j]) ring.push_back(*q);
+          }
+          options.push_back(ring);
+        }
+      {
+        std::vector<int> layer{static_cast<int>(t)};
+        for (int l = 0; l < 2; ++l) {
+          std::vector<int> more;
+          for (int c : layer) neighbours_of(c, more);
+          layer.insert(layer.end(), more.begin(), more.end());
+          std::sort(layer.begin(), layer.end());
+          layer.erase(std::unique(layer.begin(), layer.end()), layer.end());
+          options.push_back(layer);
+        }
+      }
+      double best_gain = 0, best_score = -1;
+      std::vector<int> best_cavity;
+      std::vector<Tri> best_faces;
+      Vec3 best_x;
+      for (std::vector<int>& cavity : options) {
+        std::sort(cavity.begin(), cavity.end());
+        bool usable = !cavity.empty();
+        double old_worst = 1;
+        for (int c : cavity) {
+          usable &= !gone[c];
+          for (int x : tets[c]) usable &= !locked[x];
+          old_worst = std::min(old_worst, rho(tets[c]));
+        }
+        if (!usable) continue;
+        // the cavity's faces (outward), those used by one of its tets
+        std::unordered_map<TriKey, std::pair<int, Tri>, TriKeyHash> count;
+        for (int c : cavity)
+          for (const auto& o : kFace) {
+            const Tri f{tets[c][o[0]], tets[c][o[1]], tets[c][o[2]]};
+            auto [it, fresh] = count.emplace(key_of(f[0], f[1], f[2]), std::make_pair(1, f));
+            if (!fresh) ++it->second.first;
+          }
+        std::vector<Tri> faces;
+        Vec3 centre = Vec3::Zero();
+        double len = 0;
+        for (const auto& [k, cf] : count)
+          if (cf.first == 1) {
+            faces.push_back(cf.second);
+            for (int x : cf.second) centre += P[x];
+            len += (P[cf.second[0]] - P[cf.second[1]]).norm();
+          }
+        if (faces.empty()) continue;
+        centre /= 3.0 * static_cast<double>(faces.size());
+        len /= static_cast<double>(faces.size());
+        // score of the star from x: its worst radius ratio where x sees every face (kFace gives
+        // each face outward from its tet, so a star tet (f, x) is positive when x is inside);
+        // elsewhere -1 plus the most negative height of x over a face (in units of the mean
+        // edge), which leads the search into the cavity's kernel
+        P.push_back(centre);
+        const int id = static_cast<int>(P.size()) - 1;
+        auto star_score = [&]() {
+          double w = 1, hmin = 0;
+          bool sees = true;
+          for (const Tri& f : faces) {
+            if (orient3d(P[f[0]].data(), P[f[2]].data(), P[f[1]].data(), P[id].data()) <= 0) {
+              const Vec3 n = (P[f[2]] - P[f[0]]).cross(P[f[1]] - P[f[0]]);
+              const double nn = n.norm();
+              hmin = std::min(hmin, nn > 0 ? n.dot(P[id] - P[f[0]]) / nn : -len);
+              sees = false;
+            } else if (sees) {
+              w = std::min(w, tet_rho(P, f[0], f[2], f[1], id));
+            }
+          }
+          return sees ? w : -1 + std::min(hmin, 0.0) / len - 1e-9;
+        };
+        double best = star_score();
+        double step = 0.15 * len;
+        for (int it = 0; it < 100 && step > 1e-3 * len; ++it) {
+          bool moved = false;
+          for (int d = 0; d < 6 && !moved; ++d) {
+            const Vec3 old = P[id];
+            P[id][d / 2] += (d % 2 ? -step : step);
+            const double now = star_score();
+            if (now > best) best = now, moved = true;
+            else P[id] = old;
+          }
+          if (!moved) step *= 0.5;
+        }
+        if (best > old_worst && best - old_worst > best_gain) {
+          best_gain = best - old_worst, best_score = best;
+          best_cavity = cavity, best_faces = faces, best_x = P[id];
+        }
+        P.pop_back();
+      }
+      if (best_cavity.empty()) continue;
+      P.push_back(best_x);
+      const int id = static_cast<int>(P.size()) - 1;
+      for (int c : best_cavity) {
+        gone[c] = 1;
+        for (int x : tets[c]) locked[x] = 1;
+      }
+      for (const Tri& f : best_faces) added.push_back({f[0], f[2], f[1], id});
+      (void)best_score;
+      ++done;
+    }
+    if (added.empty()) break;
+    std::vector<std::array<int, 4>> kept;
+    kept.reserve(tets.size() + added.size());
+    for (size_t t = 0; t < tets.size(); ++t)
+      if (!gone[t] && tets[t][0] >= 0) kept.push_back(tets[t]);
+    kept.insert(kept.end(), added.begin(), added.end());
+    tets.swap(kept);
+  }
+  return done;
+}
+
 }  // namespace
 
 VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
@@ -924,6 +1078,9 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     }
   }
   }
+  // ---- slivers the flips and moves left (e.g. with two faces on the boundary): re-filled
+  // from a new point, then one more round of flips
+  if (params.flip_below > 0 && insert_points_at_slivers(P, tets, 0.1) > 0) flip_bad_tets(P, tets, params.flip_below);
   // Output: the input nodes as they were, then only the new nodes some tet uses (tets removed
   // by the re-meshing rounds leave theirs behind, and a later point may land on one)
   std::vector<int> renum(P.size(), -1);

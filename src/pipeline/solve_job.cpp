@@ -8,6 +8,7 @@
 #include "brep/topology_index.h"
 #include "brep/two_breps.h"
 #include "mesh/gmsh_fragments.h"
+#include "mesh/native_mesher.h"
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "io/inp.h"
@@ -52,12 +53,9 @@ TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const Topo
   progress.say("mesh", -1, "checking the part and the non-design solids");
   brep::TwoBReps model = brep::load_two_breps(part, nondesign, {}, progress);
   io::check_faces(job, model.part.num_faces(), model.nondesign.num_faces());
-  mesh::FragmentMeshParams mp;
-  mp.size = job.mesh_size;
-  mp.min_size = job.mesh_min_size;
-  TetMesh mesh = mesh::mesh_with_gmsh_fragments(model, mp, progress);
-  // Gmsh numbers nodes entity by entity; the solver, filter and surface run faster on a
-  // numbering that follows space (bench/simp: see BENCHMARKS.md).
+  TetMesh mesh = mesh::mesh_two_breps(model, job.mesher, job.mesh_size, job.mesh_min_size, progress);
+  // The fronts and Gmsh number nodes in the order they make them; the solver, filter and
+  // surface run faster on a numbering that follows space (bench/simp: see BENCHMARKS.md).
   mesh::reorder_for_locality(mesh);
   return mesh;
 }

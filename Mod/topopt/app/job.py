@@ -120,7 +120,8 @@ def study_to_job(study):
         raise errors.TopOptError("volume fraction %g is out of range: give a value between 0 and 1" % vf,
                                  "InvalidParameter")
     job = {
-        "mesh": {"size": float(study.MeshSize)} if float(study.MeshSize) > 0 else {},
+        "mesh": dict({"mesher": str(getattr(study, "Mesher", "auto"))},
+                     **({"size": float(study.MeshSize)} if float(study.MeshSize) > 0 else {})),
         "material": {"E": study.YoungsModulus, "nu": study.PoissonRatio, "density": study.Density},
         "supports": supports,
         "load_cases": [{"name": "loads", "weight": 1.0, "loads": loads}],

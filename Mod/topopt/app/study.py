@@ -35,6 +35,11 @@ class Study:
         _add(obj, "App::PropertyFloat", "PoissonRatio", "Material", "Poisson's ratio", 0.3)
         _add(obj, "App::PropertyFloat", "Density", "Material", "Mass density (t/mm³), for self weight", 7.85e-9)
         _add(obj, "App::PropertyLength", "MeshSize", "Mesh", "Target element size; 0 = automatic", 0.0)
+        if "Mesher" not in obj.PropertiesList:
+            obj.addProperty("App::PropertyEnumeration", "Mesher", "Mesh",
+                            "auto: the two-B-Rep advancing front, Gmsh where it fails; native: the "
+                            "advancing front only; gmsh: OCC fragments meshed by Gmsh")
+            obj.Mesher = ["auto", "native", "gmsh"]
         if "VolumeFraction" not in obj.PropertiesList:
             obj.addProperty("App::PropertyFloatConstraint", "VolumeFraction", "Optimization",
                             "Share of the design domain's volume to keep, in (0, 1)")

@@ -1,10 +1,14 @@
-// The native path end to end on the shared examples (a part without non-design solids): our
-// surface mesh filled by our advancing front is conformal, has no inverted tet, its boundary
-// is the surface mesh and its volume is the B-Rep's within 0.5 %; non-design input is refused
-// with a message until the 14-step driver lands.
+// The native mesher end to end on the shared examples: a part alone (our surface mesh filled
+// by our advancing front), and the part with its non-design solids through the 14 steps —
+// one conformal tagged mesh (no duplicate nodes, interior faces shared by two tets, boundary
+// equal to the surface mesh, interface between domains on Ω̄'s faces, every domain's volume
+// within 0.5 % of the B-Rep's), the bracket's touching clamp pads conformal across their
+// shared face, a load pad's face tagged on the part's boundary.
 #include "mesh/native_mesher.h"
 
 #include <gtest/gtest.h>
+
+#include <map>
 
 #include "brep/shape_io.h"
 #include "common/error.h"
@@ -20,13 +24,21 @@ brep::TwoBReps load(const std::string& name, bool with_nd = false) {
                               with_nd ? brep::read_shape_file(dir + name + "_nondesign.step") : TopoDS_Shape());
 }
 
-TEST(NativeMesher, ExamplesAreConformalWithTheBRepVolume) {
+TetMesh mesh_at(const brep::TwoBReps& model, double factor) {
+  NativeMeshParams p;
+  p.surface.size = factor * model.part.diagonal() / 50;
+  return mesh_native(model, p);
+}
+
+double triangle_area(const TetMesh& m, int a, int b, int c) {
+  return 0.5 * (m.V.row(b) - m.V.row(a)).cross(m.V.row(c) - m.V.row(a)).norm();
+}
+
+TEST(NativeMesher, PartsAloneAreConformalWithTheBRepVolume) {
   for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0}, {"bracket", 1.0}}) {
     SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
     const brep::TwoBReps model = load(name);
-    NativeMeshParams p;
-    p.surface.size = factor * model.part.diagonal() / 50;
-    const TetMesh m = mesh_native(model, p);
+    const TetMesh m = mesh_at(model, factor);
     const ConformityReport c = check_conformity(m, &model);
     EXPECT_TRUE(c.ok()) << c.to_json().dump();
     EXPECT_LT(c.max_volume_error, 0.005);
@@ -36,13 +48,90 @@ TEST(NativeMesher, ExamplesAreConformalWithTheBRepVolume) {
   }
 }
 
-TEST(NativeMesher, NonDesignSolidsAreRefusedWithAMessage) {
+TEST(TwoBRepSteps, ExamplesMeshIntoOneConformalTaggedMesh) {
+  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0},
+                              {"cantilever", 0.6}, {"bracket", 1.0}, {"bracket", 0.75}}) {
+    SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
+    const brep::TwoBReps model = load(name, true);
+    const TetMesh m = mesh_at(model, factor);
+    const ConformityReport c = check_conformity(m, &model);
+    // duplicates, over-shared faces, boundary = surface mesh, interface on Ω̄, volumes
+    EXPECT_TRUE(c.ok()) << c.to_json().dump();
+    EXPECT_EQ(c.duplicate_nodes, 0);
+    EXPECT_EQ(c.interface_off_nondesign, 0);
+    EXPECT_GT(c.interface_sampled, 0);
+    ASSERT_EQ(c.domain_volume.size(), static_cast<size_t>(model.nondesign.num_solids() + 1));
+    for (size_t d = 0; d < c.domain_volume.size(); ++d) {
+      ASSERT_LT(d, c.expected_volume.size());
+      EXPECT_NEAR(c.domain_volume[d], c.expected_volume[d], 0.005 * c.expected_volume[d]) << "domain " << d;
+    }
+    const QualityReport q = tet_quality(m);
+    EXPECT_GT(q.min_radius_ratio, 0.02);
+    EXPECT_GT(q.mean_radius_ratio, 0.7);
+    // every boundary triangle carries one of Ω's faces
+    EXPECT_GE(m.face.minCoeff(), 1);
+    EXPECT_LE(m.face.maxCoeff(), model.part.num_faces());
+  }
+}
+
+TEST(TwoBRepSteps, TouchingClampPadsAreConformalAcrossTheirSharedFace) {
+  // bracket: pads 6 and 7 (domains 6, 7) share the square x = 52, 0 <= y, z <= 10
+  const brep::TwoBReps model = load("bracket", true);
+  ASSERT_EQ(model.relations.contacts.size(), 1u);
+  const TetMesh m = mesh_at(model, 1.0);
+  std::map<std::array<int, 3>, std::vector<int>> owners;  // face on the plane -> domains of its tets
+  static const int kF[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (const auto& f : kF) {
+      std::array<int, 3> k{m.T(t, f[0]), m.T(t, f[1]), m.T(t, f[2])};
+      bool on = true;
+      for (int v : k) on &= std::abs(m.V(v, 0) - 52) < 1e-9;
+      if (!on) continue;
+      std::sort(k.begin(), k.end());
+      owners[k].push_back(m.domain[t]);
+    }
+  double shared_area = 0;
+  for (const auto& [k, doms] : owners) {
+    double ymax = 0, zmax = 0;
+    for (int v : k) ymax = std::max(ymax, m.V(v, 1)), zmax = std::max(zmax, m.V(v, 2));
+    if (ymax > 10 + 1e-9 || zmax > 10 + 1e-9) continue;  // the plane x = 52 elsewhere
+    // inside the square: one tet of each pad, nothing else
+    ASSERT_EQ(doms.size(), 2u);
+    EXPECT_EQ(std::min(doms[0], doms[1]), 6);
+    EXPECT_EQ(std::max(doms[0], doms[1]), 7);
+    shared_area += triangle_area(m, k[0], k[1], k[2]);
+  }
+  EXPECT_NEAR(shared_area, 100.0, 1e-9);
+}
+
+TEST(TwoBRepSteps, LoadPadFaceIsTaggedOnThePartBoundary) {
+  // cantilever: the pad's top face (Face12 of Ω̄, 4 x 6 mm) lies on Ω's top face (Face6)
+  const brep::TwoBReps model = load("cantilever", true);
+  const TetMesh m = mesh_at(model, 1.0);
+  ASSERT_EQ(m.nd_face.size(), m.F.rows());
+  double area = 0;
+  for (long t = 0; t < m.F.rows(); ++t)
+    if (m.nd_face[t] == 12) {
+      EXPECT_EQ(m.face[t], 6);
+      area += triangle_area(m, m.F(t, 0), m.F(t, 1), m.F(t, 2));
+    }
+  EXPECT_NEAR(area, 24.0, 1e-9);
+}
+
+TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
+  const brep::TwoBReps model = load("cantilever", true);
+  MeshRun run;
+  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
+  EXPECT_EQ(run.mesher, "native");
+  EXPECT_TRUE(run.fallback_reason.empty());
+  ASSERT_EQ(run.seconds.size(), 4u);
+  EXPECT_TRUE(check_conformity(m, &model).ok());
   try {
-    mesh_native(load("rocker", true));
+    mesh_two_breps(model, "netgen", 0, 0);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);
-    EXPECT_NE(std::string(e.what()).find("non-design"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("native"), std::string::npos);
   }
 }
 

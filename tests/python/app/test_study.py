@@ -58,6 +58,28 @@ class StudyFromScript(unittest.TestCase):
                                     "value": -0.5})
         self.assertAlmostEqual(job["optimization"]["volume_fraction"], 0.35)
         self.assertEqual(job["mesh"]["size"], 3.0)
+        self.assertEqual(job["mesh"]["mesher"], "auto")
+
+    def test_native_mesh_is_tagged_with_the_brep_volumes(self):
+        # the 14-step mesher through the study: every domain's tet volume is its solid's
+        # (FreeCAD's own figure) within 0.5 %, and the pad faces on the part's boundary are tagged
+        from topopt.app import runner
+        import numpy as np
+        study = self.make()
+        study.Mesher = "native"
+        result = runner.mesh_only(study)
+        X, T, dom = result["nodes"], result["tets"], result["domain"]
+        a, b, c = (X[T[:, k]] - X[T[:, 0]] for k in (1, 2, 3))
+        vol = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
+        self.assertGreater(vol.min(), 0.0)
+        expected = [self.part.Shape.Volume - sum(o.Shape.Volume for o in self.nd)] + [o.Shape.Volume for o in self.nd]
+        self.assertEqual(sorted(set(dom.tolist())), list(range(len(expected))))
+        for d, v in enumerate(expected):
+            self.assertAlmostEqual(vol[dom == d].sum() / v, 1.0, delta=0.005, msg="domain %d" % d)
+        nd_faces = result["boundary_nondesign_faces"]
+        self.assertEqual(len(nd_faces), len(result["boundary_triangles"]))
+        self.assertGreater((nd_faces > 0).sum(), 0)
+        self.assertLessEqual(nd_faces.max(), sum(len(o.Shape.Faces) for o in self.nd))
 
     def test_save_and_reload(self):
         study = self.make()
