@@ -20,9 +20,9 @@
 namespace topopt::mesh {
 namespace {
 
-/// Graded size inside a closed surface: a uniform background grid (cells of h/2) holding
-/// min(h, s_i + g·d) for the boundary nodes' spacings s_i, relaxed by a two-pass chamfer
-/// sweep (6-neighbour steps), looked up at the nearest cell. Without it the front jumps from
+/// Graded size inside a closed surface: a uniform background grid (cells of h/2) holding at
+/// each cell centre min(h, s_i + g·d) for the boundary nodes' spacings s_i, relaxed by a
+/// two-pass chamfer sweep (6-neighbour steps), interpolated trilinearly. Without it the front jumps from
 /// fine boundary parts (bores refined by curvature) to the full size in one layer.
 class BackgroundSize {
  public:
@@ -45,11 +45,22 @@ class BackgroundSize {
         const double l = (V.row(a) - V.row(b)).norm();
         sum[a] += l, ++cnt[a], sum[b] += l, ++cnt[b];
       }
-    for (long i = 0; i < V.rows(); ++i)
-      if (cnt[i]) {
-        float& c = size_[index(V.row(i).transpose())];
-        c = std::min(c, static_cast<float>(sum[i] / cnt[i]));
-      }
+    // a node's spacing seeds the cells around it at their centres (s + g·distance), so a
+    // tiny edge does not impose its size on a whole cell
+    for (long i = 0; i < V.rows(); ++i) {
+      if (!cnt[i]) continue;
+      const Eigen::Vector3d x = V.row(i).transpose();
+      long c[3];
+      for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>(std::floor((x[d] - lo_[d]) / cell_ - 0.5)), 0L, n_[d] - 1);
+      for (long di = 0; di < 2; ++di)
+        for (long dj = 0; dj < 2; ++dj)
+          for (long dk = 0; dk < 2; ++dk) {
+            const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
+            const Eigen::Vector3d centre = lo_ + cell_ * Eigen::Vector3d(ci + 0.5, cj + 0.5, ck + 0.5);
+            float& v = size_[(ci * n_[1] + cj) * n_[2] + ck];
+            v = std::min(v, static_cast<float>(sum[i] / cnt[i] + g * (centre - x).norm()));
+          }
+    }
     const float step = static_cast<float>(g * cell_);
     for (int pass = 0; pass < 2; ++pass) {
       const long dir = pass == 0 ? 1 : -1;
@@ -63,14 +74,26 @@ class BackgroundSize {
           }
     }
   }
-  double at(const double* x) const { return size_[index(Eigen::Vector3d(x[0], x[1], x[2]))]; }
+  /// Trilinear between the cell centres.
+  double at(const double* x) const {
+    double w[3];
+    long c[3];
+    for (int d = 0; d < 3; ++d) {
+      const double u = std::clamp((x[d] - lo_[d]) / cell_ - 0.5, 0.0, static_cast<double>(n_[d] - 1));
+      c[d] = std::min(static_cast<long>(u), n_[d] - 2 >= 0 ? n_[d] - 2 : 0);
+      w[d] = std::clamp(u - c[d], 0.0, 1.0);
+    }
+    double s = 0;
+    for (int di = 0; di < 2; ++di)
+      for (int dj = 0; dj < 2; ++dj)
+        for (int dk = 0; dk < 2; ++dk) {
+          const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
+          s += (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]) * size_[(ci * n_[1] + cj) * n_[2] + ck];
+        }
+    return s;
+  }
 
  private:
-  long index(const Eigen::Vector3d& x) const {
-    long c[3];
-    for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>((x[d] - lo_[d]) / cell_), 0L, n_[d] - 1);
-    return (c[0] * n_[1] + c[1]) * n_[2] + c[2];
-  }
   double cell_;
   Eigen::Vector3d lo_;
   long n_[3];

@@ -40,48 +40,98 @@ TriKey key_of(int a, int b, int c) {
 
 /// Uniform grid of buckets over ids with a box each; lookups return candidates (the caller
 /// filters stale or far ones). Entries are removed lazily by the caller's alive flags.
+/// Multi-level hashed grid of boxes. An item goes to the level whose cells are at least as
+/// large as its size (level k has cells of base·2^k, so an item sits in at most 8 cells),
+/// which keeps the buckets small where the mesh is graded from tiny to large elements. Every
+/// level also counts its non-empty cells per block of 16³ cells: a query visits, on each
+/// level holding items, either the cells overlapping its box (small boxes) or the occupied
+/// blocks overlapping it (a large box over a fine level costs its blocks, not its cells).
 class Grid {
  public:
-  Grid(const Vec3& origin, double cell) : origin_(origin), inv_(1.0 / cell) {}
-  void insert(int id, const Vec3& lo, const Vec3& hi) {
-    auto a = cell(lo), b = cell(hi);
+  Grid(const Vec3& origin, double base) : origin_(origin), base_(base) {}
+  /// Registers id with box [lo, hi]; `size` (>= the box) chooses the level.
+  void insert(int id, const Vec3& lo, const Vec3& hi, double size = 0) {
+    const double ext = std::max(size, (hi - lo).maxCoeff());
+    int k = 0;
+    while (k < 48 && base_ * std::ldexp(1.0, k) < ext) ++k;
+    while (static_cast<int>(levels_.size()) <= k) levels_.emplace_back(1.0 / (base_ * std::ldexp(1.0, static_cast<int>(levels_.size()))));
+    Level& L = levels_[k];
+    const auto a = L.cell(lo, origin_), b = L.cell(hi, origin_);
     for (long x = a[0]; x <= b[0]; ++x)
       for (long y = a[1]; y <= b[1]; ++y)
-        for (long z = a[2]; z <= b[2]; ++z) buckets_[key(x, y, z)].push_back(id);
+        for (long z = a[2]; z <= b[2]; ++z) {
+          std::vector<int>& ids = L.buckets[key(x, y, z)];
+          if (ids.empty()) ++L.blocks[key(x >> 4, y >> 4, z >> 4)];
+          ids.push_back(id);
+        }
+    ++L.items;
   }
-  /// Appends the live ids (keep(id)) in the cells overlapping [lo, hi] to out, each once
-  /// (`stamp` marks ids already taken in this query: sized to the id range by the caller,
+  /// Appends the live ids (keep(id)) registered in cells overlapping [lo, hi] to out, each
+  /// once (`stamp` marks ids already taken in this query: sized to the id range by the caller,
   /// holding values < `ticket`). Dead ids are dropped from the cells visited on the way.
   template <class Keep>
   void query(const Vec3& lo, const Vec3& hi, std::vector<int>& out, Keep&& keep, std::vector<unsigned>& stamp,
              unsigned ticket) {
-    auto a = cell(lo), b = cell(hi);
-    for (long x = a[0]; x <= b[0]; ++x)
-      for (long y = a[1]; y <= b[1]; ++y)
-        for (long z = a[2]; z <= b[2]; ++z) {
-          auto it = buckets_.find(key(x, y, z));
-          if (it == buckets_.end()) continue;
-          std::vector<int>& ids = it->second;
-          size_t w = 0;
-          for (size_t r = 0; r < ids.size(); ++r) {
-            const int id = ids[r];
-            if (!keep(id)) continue;
-            ids[w++] = id;
-            if (stamp[id] != ticket) stamp[id] = ticket, out.push_back(id);
-          }
-          ids.resize(w);
+    for (Level& L : levels_) {
+      if (L.blocks.empty()) continue;
+      const auto a = L.cell(lo, origin_), b = L.cell(hi, origin_);
+      auto visit = [&](long x, long y, long z) {
+        auto it = L.buckets.find(key(x, y, z));
+        if (it == L.buckets.end()) return;
+        std::vector<int>& ids = it->second;
+        size_t w = 0;
+        for (size_t r = 0; r < ids.size(); ++r) {
+          const int id = ids[r];
+          if (!keep(id)) continue;
+          ids[w++] = id;
+          if (stamp[id] != ticket) stamp[id] = ticket, out.push_back(id);
         }
+        ids.resize(w);
+        if (w == 0) {  // the cell emptied: its block counts one cell less
+          L.buckets.erase(it);
+          auto bl = L.blocks.find(key(x >> 4, y >> 4, z >> 4));
+          if (bl != L.blocks.end() && --bl->second <= 0) L.blocks.erase(bl);
+        }
+      };
+      const long cells = (b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1);
+      if (cells <= 64) {
+        for (long x = a[0]; x <= b[0]; ++x)
+          for (long y = a[1]; y <= b[1]; ++y)
+            for (long z = a[2]; z <= b[2]; ++z) visit(x, y, z);
+        continue;
+      }
+      for (long bx = a[0] >> 4; bx <= b[0] >> 4; ++bx)
+        for (long by = a[1] >> 4; by <= b[1] >> 4; ++by)
+          for (long bz = a[2] >> 4; bz <= b[2] >> 4; ++bz) {
+            if (!L.blocks.count(key(bx, by, bz))) continue;
+            for (long x = std::max(a[0], bx << 4); x <= std::min(b[0], (bx << 4) + 15); ++x)
+              for (long y = std::max(a[1], by << 4); y <= std::min(b[1], (by << 4) + 15); ++y)
+                for (long z = std::max(a[2], bz << 4); z <= std::min(b[2], (bz << 4) + 15); ++z) visit(x, y, z);
+          }
+    }
   }
 
  private:
-  std::array<long, 3> cell(const Vec3& p) const {
-    return {static_cast<long>(std::floor((p[0] - origin_[0]) * inv_)), static_cast<long>(std::floor((p[1] - origin_[1]) * inv_)),
-            static_cast<long>(std::floor((p[2] - origin_[2]) * inv_))};
+  struct Level {
+    explicit Level(double inv_cell) : inv(inv_cell) {}
+    double inv;
+    long items = 0;
+    std::unordered_map<uint64_t, std::vector<int>> buckets;
+    std::unordered_map<uint64_t, int> blocks;  ///< non-empty cells per block of 16³
+    std::array<long, 3> cell(const Vec3& p, const Vec3& o) const {
+      return {static_cast<long>(std::floor((p[0] - o[0]) * inv)), static_cast<long>(std::floor((p[1] - o[1]) * inv)),
+              static_cast<long>(std::floor((p[2] - o[2]) * inv))};
+    }
+  };
+  /// Distinct cells give distinct keys while |coordinates| < 2^20 cells; beyond, two cells
+  /// may share a bucket, which only costs time (callers test the geometry).
+  static uint64_t key(long x, long y, long z) {
+    const uint64_t m = (1ull << 21) - 1;
+    return ((static_cast<uint64_t>(x) & m) << 42) | ((static_cast<uint64_t>(y) & m) << 21) | (static_cast<uint64_t>(z) & m);
   }
-  static long key(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
   Vec3 origin_;
-  double inv_;
-  std::unordered_map<long, std::vector<int>> buckets_;
+  double base_;
+  std::vector<Level> levels_;
 };
 
 using predicates::orient3d;
@@ -157,7 +207,7 @@ class Front {
     faces_grid_.insert(id, lo, hi);
     for (int v : {a, b, c}) {
       if (static_cast<int>(active_.size()) <= v) active_.resize(v + 1, 0), in_grid_.resize(v + 1, 0);
-      if (active_[v]++ == 0 && !in_grid_[v]) nodes_grid_.insert(v, P_[v], P_[v]), in_grid_[v] = 1;
+      if (active_[v]++ == 0 && !in_grid_[v]) nodes_grid_.insert(v, P_[v], P_[v], (hi - lo).maxCoeff()), in_grid_[v] = 1;
     }
     ++count_;
     return id;
@@ -401,6 +451,49 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   return flips;
 }
 
+/// The new nodes (from first_new on) of the tets below `bad`: a compass search for the
+/// position that maximises the worst radius ratio around each (steps of a tenth of the local
+/// edge length, halved when no direction helps); every tet stays positive.
+void compass_search_at_bad_tets(std::vector<Vec3>& P, const std::vector<std::array<int, 4>>& tets,
+                                const NodeStars& stars, int first_new, double bad) {
+  std::vector<char> seen(P.size(), 0);
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]) >= bad) continue;
+    for (int v : tets[t]) {
+      if (v < first_new || seen[v]) continue;
+      seen[v] = 1;
+      const NodeStars::Range ts = stars.of(v);
+      auto worst_around = [&]() {
+        double w = 1;
+        for (int q : ts) {
+          const auto& x = tets[q];
+          if (orient3d(P[x[0]].data(), P[x[1]].data(), P[x[2]].data(), P[x[3]].data()) <= 0) return -1.0;
+          w = std::min(w, tet_rho(P, x[0], x[1], x[2], x[3]));
+        }
+        return w;
+      };
+      double len = 0;
+      int cnt = 0;
+      for (int q : ts)
+        for (int x : tets[q])
+          if (x != v) len += (P[x] - P[v]).norm(), ++cnt;
+      if (!cnt) continue;
+      double step = 0.1 * len / cnt, best = worst_around();
+      for (int it = 0; it < 40 && step > 1e-3 * len / cnt; ++it) {
+        bool moved = false;
+        for (int d = 0; d < 6 && !moved; ++d) {
+          const Vec3 old = P[v];
+          P[v][d / 2] += (d % 2 ? -step : step);
+          const double now = worst_around();
+          if (now > best) best = now, moved = true;
+          else P[v] = old;
+        }
+        if (!moved) step *= 0.5;
+      }
+    }
+  }
+}
+
 /// Sliver removal by point insertion: each new tet below `bad` is taken out with its new
 /// neighbours across its faces (and, when that is not enough, one more layer of them), and
 /// the cavity is filled again as a star from one new point: the point that maximises the
@@ -412,7 +505,7 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
 long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 4>>& tets, double bad) {
   long done = 0;
   auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
-  for (int sweep = 0; sweep < 2; ++sweep) {
+  for (int sweep = 0; sweep < 3; ++sweep) {
     const NodeStars stars(P.size(), tets);
     std::vector<char> locked(P.size(), 0), gone(tets.size(), 0);
     std::vector<std::array<int, 4>> added;
@@ -430,8 +523,16 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 
         }
       }
     };
-    for (size_t t = 0; t < n0; ++t) {
-      if (gone[t] || rho(tets[t]) >= bad) continue;
+    // worst first: a replacement locks its nodes for the rest of the sweep
+    std::vector<std::pair<double, size_t>> order;
+    for (size_t t = 0; t < n0; ++t)
+      if (tets[t][0] >= 0) {
+        const double r = rho(tets[t]);
+        if (r < bad) order.push_back({r, t});
+      }
+    std::sort(order.begin(), order.end());
+    for (const auto& [r0, t] : order) {
+      if (gone[t]) continue;
       bool skip = false;
       for (int x : tets[t]) skip |= locked[x] != 0;
       if (skip) continue;
@@ -563,15 +664,18 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
   if (F.rows() == 0) throw Error(ErrorCode::MeshingFailed, "nothing to fill: the boundary has no triangles");
   // Cell size: the mean boundary edge.
-  double mean_edge = 0;
+  double mean_edge = 0, min_edge = 1e300;
   Vec3 lo = P[F(0, 0)], hi = lo;
   for (long t = 0; t < F.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
-      mean_edge += (P[F(t, k)] - P[F(t, (k + 1) % 3)]).norm();
+      const double l = (P[F(t, k)] - P[F(t, (k + 1) % 3)]).norm();
+      mean_edge += l;
+      if (l > 0) min_edge = std::min(min_edge, l);
       lo = lo.cwiseMin(P[F(t, k)]), hi = hi.cwiseMax(P[F(t, k)]);
     }
   mean_edge /= 3.0 * F.rows();
-  Front front(P, 1.5 * mean_edge, lo);
+  // the finest grid level: the shortest boundary edge (coarser levels double from there)
+  Front front(P, std::max(std::min(min_edge, mean_edge), 1e-9 * (hi - lo).norm()), lo);
   std::vector<std::array<int, 4>> tets;
 
   // ---- the initial front: boundary triangles reversed (normals into the region), then the
@@ -604,6 +708,8 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
   std::vector<int> near_faces, near_nodes;
   std::vector<std::pair<double, int>> candidates;  // (score, node; -1 - k = new_points[k])
+  std::vector<std::pair<double, int>> near_by_distance;
+  // (distance to the ideal point, node)
   std::vector<Vec3> new_points;
   const double sqrt23 = std::sqrt(2.0 / 3.0);
 
@@ -721,11 +827,20 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
         double r = reach[ip] * h;
         front.nodes_near(ideal - Vec3::Constant(r), ideal + Vec3::Constant(r), near_nodes);
         bool crowded = false;
-        std::vector<int> nodes = near_nodes;
-        for (int q : nodes) {
+        // the nearest front nodes only (a large face facing a finely meshed region would
+        // otherwise weigh thousands of them)
+        near_by_distance.clear();
+        for (int q : near_nodes) {
           if (q == a || q == b || q == c) continue;
-          double d = (P[q] - ideal).norm();
-          if (d > r) continue;
+          const double d = (P[q] - ideal).norm();
+          if (d <= r) near_by_distance.push_back({d, q});
+        }
+        constexpr size_t kMaxNodeCandidates = 40;
+        if (near_by_distance.size() > kMaxNodeCandidates) {
+          std::nth_element(near_by_distance.begin(), near_by_distance.begin() + kMaxNodeCandidates, near_by_distance.end());
+          near_by_distance.resize(kMaxNodeCandidates);
+        }
+        for (const auto& [d, q] : near_by_distance) {
           if (d < 0.7 * h) crowded = true;
           if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[q].data()) <= 0) continue;
           double rho = tet_rho(P, a, b, c, q);
@@ -1037,50 +1152,15 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
         }
         if (!ok || now < worst) P[v] = old;
       }
-    // the new nodes of the tets still bad: a compass search for the position that maximises
-    // the worst radius ratio around the node (steps of a tenth of the local edge length,
-    // halved when no direction helps)
-    std::vector<char> seen(P.size(), 0);
-    for (size_t t = 0; t < tets.size(); ++t) {
-      if (tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]) >= params.flip_below) continue;
-      for (int v : tets[t]) {
-        if (v < first_new || seen[v]) continue;
-        seen[v] = 1;
-        const NodeStars::Range ts = stars.of(v);
-        auto worst_around = [&]() {
-          double w = 1;
-          for (int q : ts) {
-            const auto& x = tets[q];
-            if (orient3d(P[x[0]].data(), P[x[1]].data(), P[x[2]].data(), P[x[3]].data()) <= 0) return -1.0;
-            w = std::min(w, tet_rho(P, x[0], x[1], x[2], x[3]));
-          }
-          return w;
-        };
-        double len = 0;
-        int cnt = 0;
-        for (int q : ts)
-          for (int x : tets[q])
-            if (x != v) len += (P[x] - P[v]).norm(), ++cnt;
-        if (!cnt) continue;
-        double step = 0.1 * len / cnt, best = worst_around();
-        for (int it = 0; it < 40 && step > 1e-3 * len / cnt; ++it) {
-          bool moved = false;
-          for (int d = 0; d < 6 && !moved; ++d) {
-            const Vec3 old = P[v];
-            P[v][d / 2] += (d % 2 ? -step : step);
-            const double now = worst_around();
-            if (now > best) best = now, moved = true;
-            else P[v] = old;
-          }
-          if (!moved) step *= 0.5;
-        }
-      }
-    }
+    compass_search_at_bad_tets(P, tets, stars, first_new, params.flip_below);
   }
   }
   // ---- slivers the flips and moves left (e.g. with two faces on the boundary): re-filled
   // from a new point, then one more round of flips
-  if (params.flip_below > 0 && insert_points_at_slivers(P, tets, 0.1) > 0) flip_bad_tets(P, tets, params.flip_below);
+  if (params.sliver_below > 0 && insert_points_at_slivers(P, tets, params.sliver_below) > 0 && params.flip_below > 0) {
+    flip_bad_tets(P, tets, params.flip_below);
+    compass_search_at_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.flip_below);
+  }
   // Output: the input nodes as they were, then only the new nodes some tet uses (tets removed
   // by the re-meshing rounds leave theirs behind, and a later point may land on one)
   std::vector<int> renum(P.size(), -1);

@@ -12,7 +12,9 @@
 // sees them all, and filled in pieces as the last resort), every tet checked against the
 // whole front; then stuck regions are re-meshed with a widening neighbourhood. After
 // filling: edge removal (rings of 3-7 tets), 2-3 flips, smoothing and a compass search on
-// the nodes of bad tets.
+// the nodes of bad tets; last, point insertion at the tets still bad (the cavity around one
+// re-filled as a star from an optimised new point, which also removes slivers with two
+// faces on the boundary).
 #pragma once
 #include <functional>
 
@@ -29,6 +31,7 @@ struct VolumeFillParams {
   long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
   int smoothing_iterations = 5; ///< node smoothing sweeps after filling (quality never drops)
   double flip_below = 0.4;      ///< new tets below this radius ratio get edge removal, 2-3 flips and a compass search on their nodes (0: none)
+  double sliver_below = 0.4;    ///< then new tets still below this get sliver removal by point insertion, worst first (0: none)
 };
 
 struct VolumeFillResult {
