@@ -5,6 +5,10 @@
 #include <BRepClass_FaceClassifier.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <chrono>
 #include <array>
 #include <map>
@@ -15,6 +19,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/parallel.h"
 #include "mesh/gmsh_fragments.h"
 
 namespace topopt::mesh {
@@ -380,11 +385,65 @@ void fill(Steps& s, const std::vector<std::array<int, 3>>& boundary, int dom, co
   }
 }
 
-// Step 12: each non-design solid filled from its closed surface.
+// Step 12: each non-design solid filled from its closed surface. The solids are independent,
+// so they are filled in parallel (largest first) on the same snapshot of the node pool; their
+// new nodes and tets are merged in input order.
 void step12_fill_nondesign(Steps& s) {
-  for (int i = 0; i < s.in.nondesign.num_solids(); ++i) {
-    s.progress.check_cancel("volume meshing");
-    fill(s, s.nd.solid_triangles(i), i + 1, ("non-design solid " + std::to_string(i + 1)).c_str());
+  const int n = s.in.nondesign.num_solids();
+  if (n == 0) return;
+  const MatX3d V = pool_matrix(s.nodes);
+  std::vector<std::vector<std::array<int, 3>>> boundary(n);
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) boundary[i] = s.nd.solid_triangles(i), order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return boundary[a].size() > boundary[b].size(); });
+  std::vector<VolumeFillResult> results(n);
+  std::atomic<int> next{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  Progress quiet;  // worker threads: no caller callbacks (they may not be thread-safe)
+  quiet.cancelled = [&stop] { return stop.load(); };
+  auto worker = [&](bool main_thread) {
+    try {
+      for (int k; !stop.load() && (k = next.fetch_add(1)) < n;) {
+        const int i = order[k];
+        if (main_thread) s.progress.check_cancel("volume meshing");
+        VolumeFillParams vp = s.params.volume;
+        if (!vp.size) {
+          auto bg = s.background;
+          vp.size = [bg](const double* x) { return bg->at(x); };
+        }
+        try {
+          results[i] = fill_volume(V, rows_of(boundary[i]), MatX4i(), vp, main_thread ? s.progress : quiet);
+        } catch (const Error& e) {
+          if (e.code() != ErrorCode::MeshingFailed) throw;
+          throw Error(ErrorCode::MeshingFailed, "non-design solid " + std::to_string(i + 1) + ": " + e.what());
+        }
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      stop = true;
+    }
+  };
+  const int threads = std::min(thread_count(s.params.surface.threads), n);
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, false);
+  worker(true);
+  for (auto& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
+  s.progress.check_cancel("volume meshing");
+  const long n0 = V.rows();
+  for (int i = 0; i < n; ++i) {
+    const VolumeFillResult& r = results[i];
+    const long offset = static_cast<long>(s.nodes.size()) - n0;  // where this solid's new nodes start, minus n0
+    for (long k = n0; k < r.V.rows(); ++k) s.nodes.push_back({r.V(k, 0), r.V(k, 1), r.V(k, 2)});
+    for (long t = 0; t < r.T.rows(); ++t) {
+      std::array<int, 4> tet;
+      for (int c = 0; c < 4; ++c) tet[c] = static_cast<int>(r.T(t, c) < n0 ? r.T(t, c) : r.T(t, c) + offset);
+      s.tets.push_back(tet);
+      s.domain.push_back(i + 1);
+    }
   }
 }
 // Step 13: those tets are Ω's too: the front of step 14 starts from their free faces. (They
