@@ -41,11 +41,18 @@ class StudyPanel:
         self.size.setSuffix(" mm")
         self.size.setSpecialValueText("automatic")
         self.size.setValue(float(study.MeshSize))
+        self.mesher = QtWidgets.QComboBox()
+        self.mesher.addItems(["auto", "native", "gmsh"])
+        self.mesher.setToolTip("auto: the two-B-Rep advancing front, Gmsh where it cannot close a mesh; "
+                               "native: the advancing front only; gmsh: OCC fragments meshed by Gmsh")
+        if hasattr(study, "Mesher"):
+            self.mesher.setCurrentText(str(study.Mesher))
         self.iterations = QtWidgets.QSpinBox()
         self.iterations.setRange(1, 10000)
         self.iterations.setValue(study.MaxIterations)
         grid.addRow("Volume fraction", self.volume)
         grid.addRow("Mesh size", self.size)
+        grid.addRow("Mesher", self.mesher)
         grid.addRow("Iterations (max)", self.iterations)
         layout.addLayout(grid)
         self.summary = QtWidgets.QLabel(self._summary_text())
@@ -93,6 +100,8 @@ class StudyPanel:
     def store_parameters(self):
         self.study.VolumeFraction = self.volume.value()
         self.study.MeshSize = self.size.value()
+        if hasattr(self.study, "Mesher"):
+            self.study.Mesher = self.mesher.currentText()
         self.study.MaxIterations = self.iterations.value()
 
     # --- running ---------------------------------------------------------------------------

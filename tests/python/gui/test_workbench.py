@@ -120,7 +120,10 @@ class Workbench(unittest.TestCase):
         # Run from the panel, on its worker thread, and wait for it
         from topopt.gui.panels import open_study_panel
         panel = open_study_panel(study)
+        self.assertEqual(panel.mesher.currentText(), "auto")
+        panel.mesher.setCurrentText("native")  # the run takes the panel's choice
         panel.start_run()
+        self.assertEqual(study.Mesher, "native")
         self.assertFalse(panel.run_button.isEnabled())
         panel.wait(600)
         self.assertIsNotNone(study.Result, panel.status.text())
