@@ -1,8 +1,13 @@
 // A minimal parallel loop over index ranges on std::threads (no OpenMP, no global pool).
 #pragma once
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
+
+#include "common/progress.h"
 
 namespace topopt {
 
@@ -31,6 +36,40 @@ void parallel_for(long n, int threads, Fn&& fn, long min_chunk = 2048) {
   }
   fn(0L, std::min(n, chunk));
   for (auto& th : pool) th.join();
+}
+
+/// Work queue: calls task(i, progress) for every i of `order` on `threads` threads, each taking
+/// the next item when it is done (uneven tasks, e.g. faces or solids largest first). The calling
+/// thread works too and gets `progress` itself (its cancellation checked before each item,
+/// with `what` in the message); the others get a quiet Progress whose only callback says
+/// whether to stop. The first exception stops the queue and is rethrown here.
+template <class Task>
+void parallel_tasks(const std::vector<int>& order, int threads, const Progress& progress, const char* what, Task&& task) {
+  const int n = static_cast<int>(order.size());
+  std::atomic<int> next{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  Progress quiet;  // worker threads: no caller callbacks (they may not be thread-safe)
+  quiet.cancelled = [&stop] { return stop.load(); };
+  auto worker = [&](bool main_thread) {
+    try {
+      for (int k; !stop.load() && (k = next.fetch_add(1)) < n;) {
+        if (main_thread) progress.check_cancel(what);
+        task(order[k], main_thread ? progress : quiet);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      stop = true;
+    }
+  };
+  const int count = std::max(1, std::min(threads, n));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < count; ++t) pool.emplace_back(worker, false);
+  worker(true);
+  for (auto& th : pool) th.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace topopt

@@ -5,10 +5,6 @@
 #include <BRepClass_FaceClassifier.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
 #include <chrono>
 #include <array>
 #include <map>
@@ -397,41 +393,20 @@ void step12_fill_nondesign(Steps& s) {
   for (int i = 0; i < n; ++i) boundary[i] = s.nd.solid_triangles(i), order[i] = i;
   std::sort(order.begin(), order.end(), [&](int a, int b) { return boundary[a].size() > boundary[b].size(); });
   std::vector<VolumeFillResult> results(n);
-  std::atomic<int> next{0};
-  std::atomic<bool> stop{false};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  Progress quiet;  // worker threads: no caller callbacks (they may not be thread-safe)
-  quiet.cancelled = [&stop] { return stop.load(); };
-  auto worker = [&](bool main_thread) {
-    try {
-      for (int k; !stop.load() && (k = next.fetch_add(1)) < n;) {
-        const int i = order[k];
-        if (main_thread) s.progress.check_cancel("volume meshing");
-        VolumeFillParams vp = s.params.volume;
-        if (!vp.size) {
-          auto bg = s.background;
-          vp.size = [bg](const double* x) { return bg->at(x); };
-        }
-        try {
-          results[i] = fill_volume(V, rows_of(boundary[i]), MatX4i(), vp, main_thread ? s.progress : quiet);
-        } catch (const Error& e) {
-          if (e.code() != ErrorCode::MeshingFailed) throw;
-          throw Error(ErrorCode::MeshingFailed, "non-design solid " + std::to_string(i + 1) + ": " + e.what());
-        }
-      }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      stop = true;
-    }
-  };
-  const int threads = std::min(thread_count(s.params.surface.threads), n);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, false);
-  worker(true);
-  for (auto& th : pool) th.join();
-  if (failure) std::rethrow_exception(failure);
+  parallel_tasks(order, thread_count(s.params.surface.threads), s.progress, "volume meshing",
+                 [&](int i, const Progress& prog) {
+                   VolumeFillParams vp = s.params.volume;
+                   if (!vp.size) {
+                     auto bg = s.background;
+                     vp.size = [bg](const double* x) { return bg->at(x); };
+                   }
+                   try {
+                     results[i] = fill_volume(V, rows_of(boundary[i]), MatX4i(), vp, prog);
+                   } catch (const Error& e) {
+                     if (e.code() != ErrorCode::MeshingFailed) throw;
+                     throw Error(ErrorCode::MeshingFailed, "non-design solid " + std::to_string(i + 1) + ": " + e.what());
+                   }
+                 });
   s.progress.check_cancel("volume meshing");
   const long n0 = V.rows();
   for (int i = 0; i < n; ++i) {

@@ -670,34 +670,8 @@ void ModelSurface::mesh_faces(const Progress& progress) {
     }
   std::sort(order.begin(), order.end(), [&](int x, int y) { return work[x] > work[y]; });
   std::vector<FaceOut> face_out(nf);
-  {
-    const int n = static_cast<int>(order.size());
-    std::atomic<int> next{0};
-    std::atomic<bool> stop{false};
-    std::exception_ptr failure;
-    std::mutex failure_mutex;
-    Progress quiet;  // worker threads: no caller callbacks (they may not be thread-safe)
-    quiet.cancelled = [&stop] { return stop.load(); };
-    auto worker = [&](bool main_thread) {
-      const Progress& prog = main_thread ? progress : quiet;
-      try {
-        for (int i; !stop.load() && (i = next.fetch_add(1)) < n;) {
-          if (main_thread) progress.check_cancel("surface meshing");
-          mesh_face(order[i], prog, face_out[order[i]]);
-        }
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-      }
-    };
-    const int threads = std::min(thread_count(params_.threads), std::max(1, n));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker, false);
-    worker(true);
-    for (auto& th : pool) th.join();
-    if (failure) std::rethrow_exception(failure);
-  }
+  parallel_tasks(order, thread_count(params_.threads), progress, "surface meshing",
+                 [&](int f, const Progress& prog) { mesh_face(f, prog, face_out[f]); });
   for (int f = 0; f < nf; ++f) {
     if (face_given_[f] || face_alias_[f][0] >= 0) continue;
     FaceOut& fo = face_out[f];

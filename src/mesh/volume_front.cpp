@@ -451,6 +451,27 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   return flips;
 }
 
+/// Compass search: moves x along ±x, ±y, ±z by `step` while f (which reads x) rises, halving
+/// the step when no direction helps, for at most `iterations` tries or until the step is a
+/// hundredth of the first. Returns the best f; x ends at its best position.
+template <class F>
+double compass_maximise(Vec3& x, double step, int iterations, F&& f) {
+  double best = f();
+  const double smallest = 1e-2 * step;
+  for (int it = 0; it < iterations && step > smallest; ++it) {
+    bool moved = false;
+    for (int d = 0; d < 6 && !moved; ++d) {
+      const Vec3 old = x;
+      x[d / 2] += (d % 2 ? -step : step);
+      const double now = f();
+      if (now > best) best = now, moved = true;
+      else x = old;
+    }
+    if (!moved) step *= 0.5;
+  }
+  return best;
+}
+
 /// The new nodes (from first_new on) of the tets below `bad`: a compass search for the
 /// position that maximises the worst radius ratio around each (steps of a tenth of the local
 /// edge length, halved when no direction helps); every tet stays positive.
@@ -478,18 +499,7 @@ void compass_search_at_bad_tets(std::vector<Vec3>& P, const std::vector<std::arr
         for (int x : tets[q])
           if (x != v) len += (P[x] - P[v]).norm(), ++cnt;
       if (!cnt) continue;
-      double step = 0.1 * len / cnt, best = worst_around();
-      for (int it = 0; it < 40 && step > 1e-3 * len / cnt; ++it) {
-        bool moved = false;
-        for (int d = 0; d < 6 && !moved; ++d) {
-          const Vec3 old = P[v];
-          P[v][d / 2] += (d % 2 ? -step : step);
-          const double now = worst_around();
-          if (now > best) best = now, moved = true;
-          else P[v] = old;
-        }
-        if (!moved) step *= 0.5;
-      }
+      compass_maximise(P[v], 0.1 * len / cnt, 40, worst_around);
     }
   }
 }
@@ -615,19 +625,7 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 
           }
           return sees ? w : -1 + std::min(hmin, 0.0) / len - 1e-9;
         };
-        double best = star_score();
-        double step = 0.15 * len;
-        for (int it = 0; it < 100 && step > 1e-3 * len; ++it) {
-          bool moved = false;
-          for (int d = 0; d < 6 && !moved; ++d) {
-            const Vec3 old = P[id];
-            P[id][d / 2] += (d % 2 ? -step : step);
-            const double now = star_score();
-            if (now > best) best = now, moved = true;
-            else P[id] = old;
-          }
-          if (!moved) step *= 0.5;
-        }
+        const double best = compass_maximise(P[id], 0.15 * len, 100, star_score);
         if (best > old_worst && best - old_worst > best_gain) {
           best_gain = best - old_worst, best_score = best;
           best_cavity = cavity, best_faces = faces, best_x = P[id];
