@@ -707,6 +707,8 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   std::vector<int> near_faces, near_nodes;
   std::vector<std::pair<double, int>> candidates;  // (score, node; -1 - k = new_points[k])
   std::vector<std::pair<double, int>> near_by_distance;
+  std::vector<unsigned> seen_node;  // stamps for the node test of valid()
+  unsigned seen_ticket = 0;
   // (distance to the ideal point, node)
   std::vector<Vec3> new_points;
   const double sqrt23 = std::sqrt(2.0 / 3.0);
@@ -748,13 +750,23 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
             return false;
       }
     }
-    front.nodes_near(tlo - pad, thi + pad, near_nodes);
-    for (int q : near_nodes) {
-      if (q == a || q == b || q == c || q == p) continue;
-      const double* x = P[q].data();
-      if (orient3d(P[a].data(), P[b].data(), P[c].data(), x) >= 0 && orient3d(P[a].data(), P[b].data(), x, P[p].data()) >= 0 &&
-          orient3d(P[b].data(), P[c].data(), x, P[p].data()) >= 0 && orient3d(P[c].data(), P[a].data(), x, P[p].data()) >= 0)
-        return false;  // a front node inside (or on) the new tet
+    // front nodes inside the new tet: every front node is a corner of a front face, and a
+    // node inside the tet's box has its faces' boxes meeting it, so the faces found above
+    // hold them all
+    if (seen_node.size() < P.size()) seen_node.resize(P.size() + P.size() / 2 + 16, 0);
+    ++seen_ticket;
+    for (int g : near_faces) {
+      for (int q : front.face(g)) {
+        if (seen_node[q] == seen_ticket || q == a || q == b || q == c || q == p) continue;
+        seen_node[q] = seen_ticket;
+        const double* x = P[q].data();
+        if (x[0] < tlo[0] - pad[0] || x[0] > thi[0] + pad[0] || x[1] < tlo[1] - pad[1] || x[1] > thi[1] + pad[1] ||
+            x[2] < tlo[2] - pad[2] || x[2] > thi[2] + pad[2])
+          continue;
+        if (orient3d(P[a].data(), P[b].data(), P[c].data(), x) >= 0 && orient3d(P[a].data(), P[b].data(), x, P[p].data()) >= 0 &&
+            orient3d(P[b].data(), P[c].data(), x, P[p].data()) >= 0 && orient3d(P[c].data(), P[a].data(), x, P[p].data()) >= 0)
+          return false;  // a front node inside (or on) the new tet
+      }
     }
     return true;
   };
