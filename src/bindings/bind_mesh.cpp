@@ -25,11 +25,16 @@ void bind_mesh(pybind11::module_& m) {
         io::Job job = io::parse_job(job_json, "");
         TetMesh mesh;
         mesh::QualityReport q;
+        std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
+        Progress progress;
+        progress.log = [&warnings](LogLevel level, const std::string& message) {
+          if (level == LogLevel::Warning) warnings.push_back(message);
+        };
         {
           pybind11::gil_scoped_release release;
           TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
           TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
-          mesh = pipeline::mesh_job_shapes(job, part, nd);
+          mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
           q = mesh::tet_quality(mesh);
         }
         pybind11::dict out;
@@ -41,6 +46,7 @@ void bind_mesh(pybind11::module_& m) {
         out["boundary_nondesign_faces"] = mesh.nd_face;
         out["min_radius_ratio"] = q.min_radius_ratio;
         out["mean_radius_ratio"] = q.mean_radius_ratio;
+        out["warnings"] = warnings;
         return out;
       },
       pybind11::arg("job_json"), pybind11::arg("part_brep"), pybind11::arg("nondesign_brep") = "",

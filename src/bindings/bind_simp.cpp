@@ -37,6 +37,10 @@ void bind_simp(pyb::module_& m) {
         };
         Progress progress;
         progress.cancelled = [&] { return stop.load(); };
+        std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
+        progress.log = [&warnings](LogLevel level, const std::string& message) {
+          if (level == LogLevel::Warning) warnings.push_back(message);
+        };
         progress.report = [&](const std::string& stage, double fraction, const std::string& message) {
           if (stage == "simp") return;  // iterations come as records below
           pyb::gil_scoped_acquire gil;
@@ -74,6 +78,7 @@ void bind_simp(pyb::module_& m) {
         out["boundary_triangles"] = mesh.F;
         out["boundary_faces"] = mesh.face;
         out["densities"] = r.simp.density;
+        out["warnings"] = warnings;
         pyb::list hist;
         for (const auto& h : r.simp.history) {
           pyb::dict d;

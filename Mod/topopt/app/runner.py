@@ -58,6 +58,7 @@ def mesh_only(study):
     study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
     study.MeshDomains = [int(i) for i in result["domain"]]
     study.Densities = []
+    _report_warnings(result)
     return result
 
 
@@ -68,6 +69,12 @@ def result_mesh(points, triangles):
     vectors = [FreeCAD.Vector(float(p[0]), float(p[1]), float(p[2])) for p in points]
     facets = [[vectors[int(t[0])], vectors[int(t[1])], vectors[int(t[2])]] for t in triangles]
     return Mesh.Mesh(facets)
+
+
+def _report_warnings(result):
+    """The core's warnings (e.g. the native mesher fell back to Gmsh) to FreeCAD's report view."""
+    for w in result.get("warnings", []):
+        FreeCAD.Console.PrintWarning("TopOpt: %s\n" % w)
 
 
 def apply(study, result):
@@ -81,6 +88,7 @@ def apply(study, result):
     study.ComplianceHistory = [float(h["compliance"]) for h in result["history"]]
     study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
     study.Status = result.get("status", "done")
+    _report_warnings(result)
     feature = study.Result
     if feature is None:
         feature = doc.addObject("Mesh::Feature", study.Name + "_Result")

@@ -68,6 +68,7 @@ class StudyFromScript(unittest.TestCase):
         study = self.make()
         study.Mesher = "native"
         result = runner.mesh_only(study)
+        self.assertEqual(list(result["warnings"]), [])  # meshed natively, no fallback to Gmsh
         X, T, dom = result["nodes"], result["tets"], result["domain"]
         a, b, c = (X[T[:, k]] - X[T[:, 0]] for k in (1, 2, 3))
         vol = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
