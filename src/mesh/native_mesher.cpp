@@ -519,14 +519,20 @@ TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, d
     NativeMeshParams np;
     np.surface.size = size;
     np.surface.min_size = min_size;
+    // auto: whatever stops the native mesher (a front that cannot close, or a bug) falls
+    // back to Gmsh with a warning; a cancel or a mesh too large for memory does not
+    std::string reason;
     try {
       return mesh_native(model, np, progress, run);
     } catch (const Error& e) {
-      if (e.code() != ErrorCode::MeshingFailed || mesher == "native") throw;
-      if (run) run->fallback_reason = e.what();
-      progress.warn(std::string("the native mesher could not mesh this part (") + e.what() +
-                    "); meshing with Gmsh's OCC fragments instead");
+      if (mesher == "native" || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::TooLarge) throw;
+      reason = e.what();
+    } catch (const std::exception& e) {
+      if (mesher == "native") throw;
+      reason = e.what();
     }
+    if (run) run->fallback_reason = reason;
+    progress.warn("the native mesher could not mesh this part (" + reason + "); meshing with Gmsh's OCC fragments instead");
   }
   FragmentMeshParams mp;
   mp.size = size;
