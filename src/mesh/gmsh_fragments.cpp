@@ -62,7 +62,7 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
                                          std::to_string(static_cast<long>(estimate)) +
                                          " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
                                          std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
-  progress.say("mesh", 0, "meshing with size " + std::to_string(h) + " mm (Gmsh fragments, interim mesher)");
+  progress.say("mesh", 0, "meshing with size " + std::to_string(h) + " mm (Gmsh fragments)");
   std::lock_guard<std::mutex> lock(gmsh_mutex());
   GmshSession session;
   std::vector<std::pair<int, int>> part, nd, out;

@@ -443,7 +443,18 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
   SurfaceMeshParams sp = params.surface;
   if (sp.size <= 0) sp.size = model.part.diagonal() / 50;
   if (sp.min_size <= 0) sp.min_size = sp.size / 10;
-  Steps s(model, params, sp, progress);
+  {
+    const double h = sp.size, volume = std::abs(model.part.solid_volume.sum());
+    const double estimate = 6.0 * volume / (h * h * h) * 1.2;  // ~6 tets per h³ for a good mesh
+    if (estimate > params.max_tets)
+      throw Error(ErrorCode::TooLarge, "a mesh size of " + std::to_string(h) + " mm would give about " +
+                                           std::to_string(static_cast<long>(estimate)) +
+                                           " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
+                                           std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
+  }
+  NativeMeshParams bounded = params;
+  bounded.volume.max_tets = static_cast<long>(std::min<double>(params.volume.max_tets, 2 * params.max_tets));
+  Steps s(model, bounded, sp, progress);
   progress.say("mesh", 0.02, "edges");
   step1_part_vertex_nodes(s);
   step2_transfer_vertex_nodes(s);

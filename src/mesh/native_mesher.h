@@ -23,6 +23,9 @@ struct NativeMeshParams {
   /// bore, about (2π/N)²/6 of a ring's volume, stays under the 0.5 % the volumes are held to
   SurfaceMeshParams surface;
   VolumeFillParams volume;  ///< its size is set from the surface size and the gradation if empty
+  /// Refuse meshes estimated above this many tets (memory: ~1 kB per tet through SIMP); the
+  /// fills stop at twice this, should the estimate be off.
+  double max_tets = 6e6;
 };
 
 /// What a run did: the mesher that made the mesh and the seconds of each stage.

@@ -126,6 +126,14 @@ TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
   EXPECT_TRUE(run.fallback_reason.empty());
   ASSERT_EQ(run.seconds.size(), 4u);
   EXPECT_TRUE(check_conformity(m, &model).ok());
+  // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
+  try {
+    mesh_two_breps(model, "auto", 0.01, 0);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::TooLarge);
+    EXPECT_NE(std::string(e.what()).find("mesh size of at least"), std::string::npos);
+  }
   try {
     mesh_two_breps(model, "netgen", 0, 0);
     FAIL() << "expected an error";
