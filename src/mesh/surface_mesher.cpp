@@ -138,6 +138,10 @@ std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<doub
   return fine;
 }
 
+/// At most this many pieces on a collapsed edge: the fan around a cone apex or a sphere pole
+/// has about as many triangles, so their angles there stay near 360° / 12 or more.
+constexpr int kMaxApexPieces = 12;
+
 double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
   return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
@@ -392,7 +396,7 @@ ModelSurface::Loops ModelSurface::face_loops(int f) const {
       const int vid = vertex_node_[topo_.vertices.FindIndex(va) - 1];
       const gp_Pnt2d qa = pc->Value(pf), qb = pc->Value(pl);
       const double uvlen = std::hypot((qb.X() - qa.X()) * g.su, (qb.Y() - qa.Y()) * g.sv);
-      const int n = std::max(2, static_cast<int>(std::ceil(uvlen / face_size_[f])));
+      const int n = std::clamp(static_cast<int>(std::ceil(uvlen / face_size_[f])), 2, kMaxApexPieces);
       par.clear();
       ids.assign(n + 1, vid);
       for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
@@ -454,6 +458,24 @@ void ModelSurface::mesh_edges(const Progress& progress) {
         const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
         return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
       };
+      auto len3 = [&](const Loops& LL, int i) {
+        return std::sqrt(sqdist(nodes_[LL.global[LL.segs[i][0]]], nodes_[LL.global[LL.segs[i][1]]]));
+      };
+      auto dist3 = [&](int v, const Loops& LL, int i) {  // from node v to the nearer end of segment i
+        return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]), sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
+      };
+      // segments i and j of two different edges that end at one vertex, both within two of
+      // their lengths of it (3D)
+      auto near_shared_vertex = [&](const Loops& LL, int i, int j) {
+        const int ei = LL.seg_edge[i], ej = LL.seg_edge[j];
+        if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
+        const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()}, vj{edge_node_[ej].front(), edge_node_[ej].back()};
+        const double reach = 4 * std::max(len3(LL, i), len3(LL, j));
+        for (int v : vi)
+          for (int w : vj)
+            if (v == w && dist3(v, LL, i) < reach && dist3(v, LL, j) < reach) return true;
+        return false;
+      };
       auto mark = [&](int s) {
         int e = L.seg_edge[s], piece = L.seg_piece[s];
         if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return;
@@ -494,6 +516,10 @@ void ModelSurface::mesh_edges(const Progress& progress) {
                              predicates::orient2d(C.data(), D.data(), A.data()) *
                                      predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
           const double d = cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
+          // near a cusp (two edges leaving a vertex almost tangentially) the pieces are close
+          // only because the corner is sharp: splitting them makes ever thinner triangles,
+          // while longer chords open the corner up; there only pieces that cross are split
+          if (d < gap && !cross && near_shared_vertex(L, i, j)) continue;
           if (d < gap) {
             // the longer one is what leaves no room; both when they cross
             if (cross || len[i] >= 0.7 * len[j]) mark(i);
