@@ -142,6 +142,41 @@ std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<doub
 /// has about as many triangles, so their angles there stay near 360° / 12 or more.
 constexpr int kMaxApexPieces = 12;
 
+/// The angle (rad) the surface of `face` sweeps around a collapsed edge (cone apex, sphere
+/// pole) whose parameter curve is pc on [t0, t1]: the turning of the surface's derivative
+/// across that curve, summed over samples.
+double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, double t0, double t1) {
+  BRepAdaptor_Surface s(face, Standard_False);
+  const int m = 24;
+  gp_Vec prev;
+  double total = 0;
+  for (int i = 0; i <= m; ++i) {
+    const double t = t0 + (t1 - t0) * i / m;
+    gp_Pnt2d q;
+    gp_Vec2d d;
+    pc->D1(t, q, d);
+    if (d.Magnitude() < 1e-300) continue;
+    // a point just off the collapsed edge, on the face's side, where the derivatives live
+    gp_Vec2d across(-d.Y(), d.X());
+    across.Normalize();
+    double u0, u1, v0, v1;
+    BRepTools::UVBounds(face, u0, u1, v0, v1);
+    const double eps = 1e-4 * std::max(u1 - u0, v1 - v0);
+    gp_Pnt2d inside(q.X() + eps * across.X(), q.Y() + eps * across.Y());
+    if (inside.X() < u0 || inside.X() > u1 || inside.Y() < v0 || inside.Y() > v1)
+      inside.SetCoord(q.X() - eps * across.X(), q.Y() - eps * across.Y()), across.Reverse();
+    gp_Pnt p;
+    gp_Vec xu, xv;
+    s.D1(inside.X(), inside.Y(), p, xu, xv);
+    gp_Vec dir = xu * across.X() + xv * across.Y();
+    if (dir.Magnitude() < 1e-300) continue;
+    dir.Normalize();
+    if (prev.Magnitude() > 0) total += prev.Angle(dir);
+    prev = dir;
+  }
+  return total > 0 ? total : 2 * M_PI;
+}
+
 double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
   return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
@@ -394,9 +429,9 @@ ModelSurface::Loops ModelSurface::face_loops(int f) const {
       TopoDS_Vertex va, vb;
       TopExp::Vertices(E, va, vb);
       const int vid = vertex_node_[topo_.vertices.FindIndex(va) - 1];
-      const gp_Pnt2d qa = pc->Value(pf), qb = pc->Value(pl);
-      const double uvlen = std::hypot((qb.X() - qa.X()) * g.su, (qb.Y() - qa.Y()) * g.sv);
-      const int n = std::clamp(static_cast<int>(std::ceil(uvlen / face_size_[f])), 2, kMaxApexPieces);
+      // as many pieces as the fan needs for angles of about 50° at the apex: the angle the
+      // surface sweeps around it, from the derivative across the collapsed edge
+      const int n = std::clamp(static_cast<int>(std::ceil(apex_angle(fwd, pc, pf, pl) / (50.0 * M_PI / 180))), 2, kMaxApexPieces);
       par.clear();
       ids.assign(n + 1, vid);
       for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
