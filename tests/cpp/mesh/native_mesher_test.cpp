@@ -6,6 +6,9 @@
 // shared face, a load pad's face tagged on the part's boundary.
 #include "mesh/native_mesher.h"
 
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRep_Builder.hxx>
+#include <TopoDS_Compound.hxx>
 #include <gtest/gtest.h>
 
 #include <map>
@@ -141,6 +144,35 @@ TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);
     EXPECT_NE(std::string(e.what()).find("native"), std::string::npos);
   }
+}
+
+TEST(TwoBRepSteps, PartialContactIsNamedAndAutoFallsBackToGmsh) {
+  // two non-design blocks inside a box touch on x = 20, but the first one's face there is
+  // smaller than the second one's: the native mesher meshes only identical touching faces
+  // and says so; "auto" then meshes through Gmsh's fragments, conformally
+  auto box = [](double x, double y, double z, double dx, double dy, double dz) {
+    return BRepPrimAPI_MakeBox(gp_Pnt(x, y, z), dx, dy, dz).Shape();
+  };
+  TopoDS_Compound nd;
+  BRep_Builder builder;
+  builder.MakeCompound(nd);
+  builder.Add(nd, box(10, 5, 2, 10, 10, 6));
+  builder.Add(nd, box(20, 2, 1, 10, 16, 8));
+  const brep::TwoBReps model = brep::load_two_breps(box(0, 0, 0, 40, 20, 10), nd);
+  ASSERT_EQ(model.relations.contacts.size(), 1u);
+  try {
+    mesh_native(model);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::MeshingFailed);
+    EXPECT_NE(std::string(e.what()).find("identical touching faces"), std::string::npos) << e.what();
+  }
+  MeshRun run;
+  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_NE(run.fallback_reason.find("identical touching faces"), std::string::npos);
+  const ConformityReport c = check_conformity(m, &model);
+  EXPECT_TRUE(c.ok()) << c.to_json().dump();
 }
 
 }  // namespace
