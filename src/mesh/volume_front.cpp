@@ -1130,7 +1130,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }), tets.end());
   // ---- quality: flips of the bad tets, then node smoothing, twice
   const int first_new = static_cast<int>(V.rows());
-  for (int round = 0; round < 3; ++round) {
+  for (int round = 0; round < params.quality_rounds; ++round) {
   if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
   // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
   // worst radius ratio around the node and keeps every tet positive
@@ -1167,9 +1167,12 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   }
   // ---- slivers the flips and moves left (e.g. with two faces on the boundary): re-filled
   // from a new point, then one more round of flips
-  if (params.sliver_below > 0 && insert_points_at_slivers(P, tets, params.sliver_below) > 0 && params.flip_below > 0) {
-    flip_bad_tets(P, tets, params.flip_below);
-    compass_search_at_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.flip_below);
+  for (int again = 0; again < 3 && params.sliver_below > 0; ++again) {
+    if (insert_points_at_slivers(P, tets, params.sliver_below) == 0) break;
+    if (params.flip_below > 0) {
+      flip_bad_tets(P, tets, params.sliver_below);
+      compass_search_at_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.sliver_below);
+    }
   }
   // Output: the input nodes as they were, then only the new nodes some tet uses (tets removed
   // by the re-meshing rounds leave theirs behind, and a later point may land on one)

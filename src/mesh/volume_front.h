@@ -30,8 +30,9 @@ struct VolumeFillParams {
   int passes = 4;               ///< widening passes over faces that failed
   long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
   int smoothing_iterations = 5; ///< node smoothing sweeps after filling (quality never drops)
-  double flip_below = 0.4;      ///< new tets below this radius ratio get edge removal, 2-3 flips and a compass search on their nodes (0: none)
-  double sliver_below = 0.4;    ///< then new tets still below this get sliver removal by point insertion, worst first (0: none)
+  double flip_below = 0.55;     ///< new tets below this radius ratio get edge removal, 2-3 flips and a compass search on their nodes (0: none)
+  int quality_rounds = 5;       ///< rounds of flips, smoothing and compass search
+  double sliver_below = 0.4;    ///< then new tets still below this get sliver removal by point insertion, worst first, up to 3 times (0: none)
 };
 
 struct VolumeFillResult {
