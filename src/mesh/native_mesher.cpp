@@ -358,25 +358,32 @@ MatX3i rows_of(const std::vector<std::array<int, 3>>& tris) {
   return F;
 }
 
-/// One fill by the 3D front; the new nodes join the pool, the new tets the mesh.
-void fill(Steps& s, const std::vector<std::array<int, 3>>& boundary, int dom, const char* what) {
-  MatX4i T0(static_cast<long>(s.tets.size()), 4);
-  for (size_t i = 0; i < s.tets.size(); ++i) T0.row(static_cast<long>(i)) << s.tets[i][0], s.tets[i][1], s.tets[i][2], s.tets[i][3];
+/// One fill by the 3D front of the region bounded by `boundary` (around the tets T0) on the
+/// nodes V; a front that cannot close is reported with `what` in front of its message.
+VolumeFillResult fill(const Steps& s, const MatX3d& V, const std::vector<std::array<int, 3>>& boundary, const MatX4i& T0,
+                      const std::string& what, const Progress& progress) {
   VolumeFillParams vp = s.params.volume;
   if (!vp.size) {
     auto bg = s.background;
     vp.size = [bg](const double* x) { return bg->at(x); };
   }
-  VolumeFillResult r;
   try {
-    r = fill_volume(pool_matrix(s.nodes), rows_of(boundary), dom == 0 ? T0 : MatX4i(), vp, s.progress);
+    return fill_volume(V, rows_of(boundary), T0, vp, progress);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::MeshingFailed) throw;
-    throw Error(ErrorCode::MeshingFailed, std::string(what) + ": " + e.what());
+    throw Error(ErrorCode::MeshingFailed, what + ": " + e.what());
   }
-  for (long i = static_cast<long>(s.nodes.size()); i < r.V.rows(); ++i) s.nodes.push_back({r.V(i, 0), r.V(i, 1), r.V(i, 2)});
-  for (long i = 0; i < r.T.rows(); ++i) {
-    s.tets.push_back({r.T(i, 0), r.T(i, 1), r.T(i, 2), r.T(i, 3)});
+}
+
+/// A fill's new nodes join the pool and its tets the mesh, tagged `dom`. The fill ran on the
+/// first n0 nodes of the pool (its rows from n0 on are its own new nodes).
+void merge(Steps& s, const VolumeFillResult& r, long n0, int dom) {
+  const long offset = static_cast<long>(s.nodes.size()) - n0;  // where these new nodes start, minus n0
+  for (long k = n0; k < r.V.rows(); ++k) s.nodes.push_back({r.V(k, 0), r.V(k, 1), r.V(k, 2)});
+  for (long t = 0; t < r.T.rows(); ++t) {
+    std::array<int, 4> tet;
+    for (int c = 0; c < 4; ++c) tet[c] = static_cast<int>(r.T(t, c) < n0 ? r.T(t, c) : r.T(t, c) + offset);
+    s.tets.push_back(tet);
     s.domain.push_back(dom);
   }
 }
@@ -395,37 +402,21 @@ void step12_fill_nondesign(Steps& s) {
   std::vector<VolumeFillResult> results(n);
   parallel_tasks(order, thread_count(s.params.surface.threads), s.progress, "volume meshing",
                  [&](int i, const Progress& prog) {
-                   VolumeFillParams vp = s.params.volume;
-                   if (!vp.size) {
-                     auto bg = s.background;
-                     vp.size = [bg](const double* x) { return bg->at(x); };
-                   }
-                   try {
-                     results[i] = fill_volume(V, rows_of(boundary[i]), MatX4i(), vp, prog);
-                   } catch (const Error& e) {
-                     if (e.code() != ErrorCode::MeshingFailed) throw;
-                     throw Error(ErrorCode::MeshingFailed, "non-design solid " + std::to_string(i + 1) + ": " + e.what());
-                   }
+                   results[i] = fill(s, V, boundary[i], MatX4i(), "non-design solid " + std::to_string(i + 1), prog);
                  });
   s.progress.check_cancel("volume meshing");
-  const long n0 = V.rows();
-  for (int i = 0; i < n; ++i) {
-    const VolumeFillResult& r = results[i];
-    const long offset = static_cast<long>(s.nodes.size()) - n0;  // where this solid's new nodes start, minus n0
-    for (long k = n0; k < r.V.rows(); ++k) s.nodes.push_back({r.V(k, 0), r.V(k, 1), r.V(k, 2)});
-    for (long t = 0; t < r.T.rows(); ++t) {
-      std::array<int, 4> tet;
-      for (int c = 0; c < 4; ++c) tet[c] = static_cast<int>(r.T(t, c) < n0 ? r.T(t, c) : r.T(t, c) + offset);
-      s.tets.push_back(tet);
-      s.domain.push_back(i + 1);
-    }
-  }
+  for (int i = 0; i < n; ++i) merge(s, results[i], V.rows(), i + 1);
 }
 // Step 13: those tets are Ω's too: the front of step 14 starts from their free faces. (They
 // already live in the shared pool and tet list; nothing moves.)
 void step13_transfer_tets(Steps&) {}
 // Step 14: the rest of Ω, from its boundary triangles plus the free faces of Ω̄'s tets.
-void step14_fill_design(Steps& s) { fill(s, s.part.solid_triangles(0), 0, "design domain"); }
+void step14_fill_design(Steps& s) {
+  MatX4i T0(static_cast<long>(s.tets.size()), 4);
+  for (size_t i = 0; i < s.tets.size(); ++i) T0.row(static_cast<long>(i)) << s.tets[i][0], s.tets[i][1], s.tets[i][2], s.tets[i][3];
+  const MatX3d V = pool_matrix(s.nodes);
+  merge(s, fill(s, V, s.part.solid_triangles(0), T0, "design domain", s.progress), V.rows(), 0);
+}
 
 }  // namespace
 
