@@ -16,6 +16,7 @@
 
 #include "common/error.h"
 #include "common/parallel.h"
+#include "mesh/conformity.h"
 #include "mesh/gmsh_fragments.h"
 
 namespace topopt::mesh {
@@ -510,6 +511,17 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
       if (it != s.nd_face_of.end()) m.nd_face[row] = it->second;
       ++row;
     }
+  // the result is checked before anyone uses it: a transfer the classification could not make
+  // (e.g. a non-design face lying across two faces of the part) shows up here, not in SIMP
+  ConformityParams cp;
+  cp.volume_tolerance = 0.05;  // gross errors only: the faceting of curved faces is not one
+  const ConformityReport c = check_conformity(m, &model, cp);
+  lap("conformity check");
+  if (!c.ok()) {
+    std::ostringstream msg;
+    msg << "the mesh is not conformal (" << c.to_json().dump() << ")";
+    throw Error(ErrorCode::MeshingFailed, msg.str());
+  }
   return m;
 }
 
