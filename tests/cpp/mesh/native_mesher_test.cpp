@@ -127,7 +127,8 @@ TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
   const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
   EXPECT_EQ(run.mesher, "native");
   EXPECT_TRUE(run.fallback_reason.empty());
-  ASSERT_EQ(run.seconds.size(), 4u);
+  ASSERT_EQ(run.seconds.size(), 5u);  // steps 1-7, 8-11, 12, 13-14, the conformity check
+  EXPECT_EQ(run.seconds.back().first, "conformity check");
   EXPECT_TRUE(check_conformity(m, &model).ok());
   // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
   try {
