@@ -147,6 +147,9 @@ constexpr int kMaxApexPieces = 12;
 /// across that curve, summed over samples.
 double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, double t0, double t1) {
   BRepAdaptor_Surface s(face, Standard_False);
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(face, u0, u1, v0, v1);
+  const double eps = 1e-4 * std::max(u1 - u0, v1 - v0);
   const int m = 24;
   gp_Vec prev;
   double total = 0;
@@ -159,9 +162,6 @@ double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, doubl
     // a point just off the collapsed edge, on the face's side, where the derivatives live
     gp_Vec2d across(-d.Y(), d.X());
     across.Normalize();
-    double u0, u1, v0, v1;
-    BRepTools::UVBounds(face, u0, u1, v0, v1);
-    const double eps = 1e-4 * std::max(u1 - u0, v1 - v0);
     gp_Pnt2d inside(q.X() + eps * across.X(), q.Y() + eps * across.Y());
     if (inside.X() < u0 || inside.X() > u1 || inside.Y() < v0 || inside.Y() > v1)
       inside.SetCoord(q.X() - eps * across.X(), q.Y() - eps * across.Y()), across.Reverse();
