@@ -27,9 +27,7 @@ void bind_mesh(pybind11::module_& m) {
         mesh::QualityReport q;
         std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
         Progress progress;
-        progress.log = [&warnings](LogLevel level, const std::string& message) {
-          if (level == LogLevel::Warning) warnings.push_back(message);
-        };
+        keep_warnings(progress, warnings);
         {
           pybind11::gil_scoped_release release;
           TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
@@ -38,12 +36,7 @@ void bind_mesh(pybind11::module_& m) {
           q = mesh::tet_quality(mesh);
         }
         pybind11::dict out;
-        out["nodes"] = mesh.V;
-        out["tets"] = mesh.T;
-        out["domain"] = mesh.domain;
-        out["boundary_triangles"] = mesh.F;
-        out["boundary_faces"] = mesh.face;
-        out["boundary_nondesign_faces"] = mesh.nd_face;
+        put_tet_mesh(out, mesh);
         out["min_radius_ratio"] = q.min_radius_ratio;
         out["mean_radius_ratio"] = q.mean_radius_ratio;
         out["warnings"] = warnings;

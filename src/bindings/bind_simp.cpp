@@ -38,9 +38,7 @@ void bind_simp(pyb::module_& m) {
         Progress progress;
         progress.cancelled = [&] { return stop.load(); };
         std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
-        progress.log = [&warnings](LogLevel level, const std::string& message) {
-          if (level == LogLevel::Warning) warnings.push_back(message);
-        };
+        keep_warnings(progress, warnings);
         progress.report = [&](const std::string& stage, double fraction, const std::string& message) {
           if (stage == "simp") return;  // iterations come as records below
           pyb::gil_scoped_acquire gil;
@@ -72,11 +70,7 @@ void bind_simp(pyb::module_& m) {
         }
         if (!callback_error.empty()) throw Error(ErrorCode::Cancelled, "the progress callback raised: " + callback_error);
         pyb::dict out;
-        out["nodes"] = mesh.V;
-        out["tets"] = mesh.T;
-        out["domain"] = mesh.domain;
-        out["boundary_triangles"] = mesh.F;
-        out["boundary_faces"] = mesh.face;
+        put_tet_mesh(out, mesh);
         out["densities"] = r.simp.density;
         out["warnings"] = warnings;
         pyb::list hist;
@@ -104,8 +98,9 @@ BREP strings (Shape.exportBrepToString()), unless the job names a mesh file. cal
 called with {"stage", "fraction", "message"} while meshing and {"iteration", "compliance",
 "volume", "change", "seconds"} after each iteration; returning True cancels (TopOptError with
 .code "Cancelled"). Returns a dict: nodes #V x 3, tets #T x 4, domain #T, boundary_triangles,
-boundary_faces, densities #T, history (list of dicts), threshold, surface_points #P x 3,
-surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp, surface).)doc");
+boundary_faces, boundary_nondesign_faces, densities #T, history (list of dicts), threshold,
+surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp,
+surface), warnings (list of strings).)doc");
 
   m.def(
       "extract_surface",

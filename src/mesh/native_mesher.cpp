@@ -121,6 +121,18 @@ struct Steps {
         tol(1e-6 * model.part.diagonal()) {}
 };
 
+MatX3d pool_matrix(const std::vector<std::array<double, 3>>& nodes) {
+  MatX3d V(static_cast<long>(nodes.size()), 3);
+  for (size_t i = 0; i < nodes.size(); ++i) V.row(static_cast<long>(i)) << nodes[i][0], nodes[i][1], nodes[i][2];
+  return V;
+}
+
+MatX3i rows_of(const std::vector<std::array<int, 3>>& tris) {
+  MatX3i F(static_cast<long>(tris.size()), 3);
+  for (size_t i = 0; i < tris.size(); ++i) F.row(static_cast<long>(i)) << tris[i][0], tris[i][1], tris[i][2];
+  return F;
+}
+
 std::string face_list(const std::vector<int>& faces, const std::vector<std::string>& reasons, const char* model) {
   std::ostringstream m;
   for (size_t k = 0; k < faces.size() && k < 5; ++k) m << (k ? ", " : " ") << "Face" << faces[k];
@@ -162,6 +174,7 @@ void step6_transfer_edge_segments(Steps& s) {
     const int a = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 0));
     const int b = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 1));
     const int ia = static_cast<int>(std::find(ids.begin(), ids.end(), a) - ids.begin());
+    const double t_start = BRepAdaptor_Curve(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD))).FirstParameter();
     std::vector<int> best;
     double best_score = 1e300;
     for (int dir : {1, -1}) {
@@ -180,8 +193,7 @@ void step6_transfer_edge_segments(Steps& s) {
       // the curve's start, on the curve
       double d = 0;
       const double t = s.nd.edge_parameter(e, s.nodes[run[1]].data(), &d);
-      BRepAdaptor_Curve c(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD)));
-      const double score = std::abs(t - c.FirstParameter()) + (d > 1e-3 * s.part.size() + s.tol ? 1e200 : 0.0);
+      const double score = std::abs(t - t_start) + (d > 1e-3 * s.part.size() + s.tol ? 1e200 : 0.0);
       if (score < best_score) best_score = score, best = run;
     }
     if (best.empty() || best_score >= 1e200) {
@@ -329,34 +341,13 @@ void step11_mesh_nondesign_faces(Steps& s) {
   if (!s.nd.failed_faces().empty())
     throw Error(ErrorCode::MeshingFailed, "the surface mesher could not mesh" +
                                               face_list(s.nd.failed_faces(), s.nd.failure_reasons(), "non-design solids"));
-  for (int i = 0; i < s.in.nondesign.num_solids(); ++i) {
-    std::map<std::pair<int, int>, int> directed;
-    for (const auto& t : s.nd.solid_triangles(i))
-      for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
-    long open = 0;
-    for (const auto& [e, n] : directed) {
-      auto rev = directed.find({e.second, e.first});
-      if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
-    }
-    if (open) {
+  for (int i = 0; i < s.in.nondesign.num_solids(); ++i)
+    if (const long open = open_edges(rows_of(s.nd.solid_triangles(i)))) {
       std::ostringstream m;
       m << "the surface mesh of non-design solid " << i + 1 << " is not closed (" << open
         << " edges); a face of it may lie partly on the part's boundary or on another solid";
       throw Error(ErrorCode::MeshingFailed, m.str());
     }
-  }
-}
-
-MatX3d pool_matrix(const std::vector<std::array<double, 3>>& nodes) {
-  MatX3d V(static_cast<long>(nodes.size()), 3);
-  for (size_t i = 0; i < nodes.size(); ++i) V.row(static_cast<long>(i)) << nodes[i][0], nodes[i][1], nodes[i][2];
-  return V;
-}
-
-MatX3i rows_of(const std::vector<std::array<int, 3>>& tris) {
-  MatX3i F(static_cast<long>(tris.size()), 3);
-  for (size_t i = 0; i < tris.size(); ++i) F.row(static_cast<long>(i)) << tris[i][0], tris[i][1], tris[i][2];
-  return F;
 }
 
 /// One fill by the 3D front of the region bounded by `boundary` (around the tets T0) on the

@@ -177,6 +177,17 @@ double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, doubl
   return total > 0 ? total : 2 * M_PI;
 }
 
+/// The faces of solid s (0-based) in the solid's order: (face number, 1-based; whether the
+/// solid uses it reversed with respect to the index's own orientation of that face).
+std::vector<std::pair<int, bool>> solid_faces(const brep::TopologyIndex& topo, int s) {
+  std::vector<std::pair<int, bool>> out;
+  for (TopExp_Explorer ex(topo.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
+    const int f = topo.faces.FindIndex(ex.Current());
+    if (f > 0) out.push_back({f, ex.Current().Orientation() != topo.faces(f).Orientation()});
+  }
+  return out;
+}
+
 double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
   return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
@@ -785,15 +796,11 @@ void ModelSurface::mesh_faces(const Progress& progress) {
 
 std::vector<std::array<int, 3>> ModelSurface::solid_triangles(int s) const {
   std::vector<std::array<int, 3>> rows;
-  for (TopExp_Explorer ex(topo_.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
-    const int f = topo_.faces.FindIndex(ex.Current());
-    if (f <= 0) continue;
-    const bool flip = ex.Current().Orientation() != topo_.faces(f).Orientation();
+  for (const auto& [f, flip] : solid_faces(topo_, s))
     for (auto t : face_tris_[f - 1]) {
       if (flip) std::swap(t[1], t[2]);
       rows.push_back(t);
     }
-  }
   return rows;
 }
 
@@ -836,10 +843,7 @@ SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParam
 
 MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh, int s) {
   std::map<int, bool> flip;
-  for (TopExp_Explorer ex(topo.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
-    const int f = topo.faces.FindIndex(ex.Current());
-    if (f > 0) flip[f] = ex.Current().Orientation() != topo.faces(f).Orientation();
-  }
+  for (const auto& [f, reversed] : solid_faces(topo, s)) flip[f] = reversed;
   std::vector<std::array<int, 3>> rows;
   for (long t = 0; t < mesh.F.rows(); ++t) {
     auto it = flip.find(mesh.face[t]);
@@ -852,32 +856,21 @@ MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh,
   return out;
 }
 
+long open_edges(const MatX3i& T) {
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < T.rows(); ++t)
+    for (int k = 0; k < 3; ++k) ++directed[{T(t, k), T(t, (k + 1) % 3)}];
+  long open = 0;
+  for (const auto& [e, n] : directed) {
+    auto rev = directed.find({e.second, e.first});
+    if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
+  }
+  return open;
+}
+
 std::vector<long> open_edges_per_solid(const brep::TopologyIndex& topo, const SurfaceMesh& mesh) {
   std::vector<long> result;
-  for (int s = 0; s < topo.num_solids(); ++s) {
-    // the solid's faces with their orientation relative to the indexed face
-    std::map<int, bool> flip;
-    for (TopExp_Explorer ex(topo.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
-      const int f = topo.faces.FindIndex(ex.Current());
-      if (f > 0) flip[f] = ex.Current().Orientation() != topo.faces(f).Orientation();
-    }
-    std::map<std::pair<int, int>, int> directed;
-    for (long t = 0; t < mesh.F.rows(); ++t) {
-      auto it = flip.find(mesh.face[t]);
-      if (it == flip.end()) continue;
-      for (int k = 0; k < 3; ++k) {
-        int a = mesh.F(t, k), b = mesh.F(t, (k + 1) % 3);
-        if (it->second) std::swap(a, b);
-        ++directed[{a, b}];
-      }
-    }
-    long open = 0;
-    for (const auto& [e, n] : directed) {
-      auto rev = directed.find({e.second, e.first});
-      if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
-    }
-    result.push_back(open);
-  }
+  for (int s = 0; s < topo.num_solids(); ++s) result.push_back(open_edges(solid_triangles(topo, mesh, s)));
   return result;
 }
 

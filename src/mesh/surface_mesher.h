@@ -160,6 +160,10 @@ class ModelSurface {
   std::vector<std::string> reasons_;
 };
 
+/// The number of edges of the triangles T (#T by 3) not used exactly twice in opposite
+/// directions (0 for a closed, consistently oriented surface).
+long open_edges(const MatX3i& T);
+
 /// Per solid of `topo`: the number of mesh edges not used exactly twice in opposite directions
 /// by the triangles of that solid's faces (0 for a closed, consistently oriented surface).
 std::vector<long> open_edges_per_solid(const brep::TopologyIndex& topo, const SurfaceMesh& mesh);
