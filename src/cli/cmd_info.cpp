@@ -15,10 +15,7 @@ int cmd_info(const Args& args) {
               "  vertex, edge and face lies on the part, and contacts among non-design solids.\n"
               "  --json       print the full report as JSON\n"
               "  --tolerance  coincidence tolerance in mm (default 1e-6 x part size)");
-  if (a.wants_help()) {
-    std::cout << a.usage() << "\n";
-    return 0;
-  }
+  if (a.print_help()) return 0;
   std::string part = a.option("part"), nd = a.option("non-design");
   bool json = a.flag("json");
   brep::ClassifyParams params;

@@ -34,10 +34,7 @@ int cmd_mesh(const Args& args) {
               "           auto (default): native, and gmsh with a warning where native fails\n"
               "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
               "           (a comparison aid)");
-  if (a.wants_help()) {
-    std::cout << a.usage() << "\n";
-    return 0;
-  }
+  if (a.print_help()) return 0;
   std::string part = a.option("part"), nd = a.option("non-design"), out = a.option("out"), stats = a.option("stats");
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);

@@ -23,10 +23,7 @@ int cmd_optimize(const Args& args) {
               "  --out-dir  output folder (default: the job's output.directory, or out/ beside it)\n"
               "  --quiet    no line per iteration\n"
               "  --verbose  also the solver's timings");
-  if (a.wants_help()) {
-    std::cout << a.usage() << "\n";
-    return 0;
-  }
+  if (a.print_help()) return 0;
   std::string out = a.option("out-dir");
   bool quiet = a.flag("quiet"), verbose = a.flag("verbose");
   std::vector<std::string> pos = a.positionals();

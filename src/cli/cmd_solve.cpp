@@ -21,10 +21,7 @@ int cmd_solve(const Args& args) {
               "             (conjugate gradients with smoothed-aggregation multigrid, auto above)\n"
               "  --inp      also write the problem (first load case) as a CalculiX deck, to check\n"
               "             the result with: ccx -i <name without .inp>");
-  if (a.wants_help()) {
-    std::cout << a.usage() << "\n";
-    return 0;
-  }
+  if (a.print_help()) return 0;
   std::string out = a.option("out-dir"), solver = a.option("solver", "auto"), inp = a.option("inp");
   std::vector<std::string> pos = a.positionals();
   if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one job file\n" + a.usage());

@@ -24,10 +24,7 @@ int cmd_surface(const Args& args) {
               "  --size   target edge length in mm (default: part diagonal / 50)\n"
               "  --stats  counts, open edges per solid, self-intersections, angles, time (JSON)\n"
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
-  if (a.wants_help()) {
-    std::cout << a.usage() << "\n";
-    return 0;
-  }
+  if (a.print_help()) return 0;
   const std::string part = a.option("part"), out = a.option("out"), stats = a.option("stats");
   mesh::SurfaceMeshParams p;
   p.size = a.number("size", 0);

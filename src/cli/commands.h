@@ -28,6 +28,8 @@ class ArgReader {
   /// Throws InvalidParameter naming any option that was not consumed.
   std::vector<std::string> positionals();
   bool wants_help() const { return help_; }
+  /// When --help was given: prints the usage to stdout and returns true (the command returns 0).
+  bool print_help() const;
   const std::string& usage() const { return usage_; }
 
  private:

@@ -39,6 +39,11 @@ double ArgReader::number(const std::string& name, double fallback) {
   }
 }
 
+bool ArgReader::print_help() const {
+  if (help_) std::cout << usage_ << "\n";
+  return help_;
+}
+
 bool ArgReader::flag(const std::string& name) {
   for (size_t i = 0; i < args_.size(); ++i)
     if (args_[i] == "--" + name) return used_[i] = true;
