@@ -11,6 +11,7 @@
 #include <TopoDS_Compound.hxx>
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <map>
 
 #include "brep/shape_io.h"
@@ -31,6 +32,17 @@ TetMesh mesh_at(const brep::TwoBReps& model, double factor) {
   NativeMeshParams p;
   p.surface.size = factor * model.part.diagonal() / 50;
   return mesh_native(model, p);
+}
+
+/// f must throw a topopt::Error with `code` whose message contains `fragment`.
+void expect_error(const std::function<void()>& f, ErrorCode code, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
 }
 
 double triangle_area(const TetMesh& m, int a, int b, int c) {
@@ -131,20 +143,8 @@ TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
   EXPECT_EQ(run.seconds.back().first, "conformity check");
   EXPECT_TRUE(check_conformity(m, &model).ok());
   // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
-  try {
-    mesh_two_breps(model, "auto", 0.01, 0);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::TooLarge);
-    EXPECT_NE(std::string(e.what()).find("mesh size of at least"), std::string::npos);
-  }
-  try {
-    mesh_two_breps(model, "netgen", 0, 0);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);
-    EXPECT_NE(std::string(e.what()).find("native"), std::string::npos);
-  }
+  expect_error([&] { mesh_two_breps(model, "auto", 0.01, 0); }, ErrorCode::TooLarge, "mesh size of at least");
+  expect_error([&] { mesh_two_breps(model, "netgen", 0, 0); }, ErrorCode::InvalidParameter, "native");
 }
 
 TEST(TwoBRepSteps, PartialContactIsNamedAndAutoFallsBackToGmsh) {
@@ -161,13 +161,7 @@ TEST(TwoBRepSteps, PartialContactIsNamedAndAutoFallsBackToGmsh) {
   builder.Add(nd, box(20, 2, 1, 10, 16, 8));
   const brep::TwoBReps model = brep::load_two_breps(box(0, 0, 0, 40, 20, 10), nd);
   ASSERT_EQ(model.relations.contacts.size(), 1u);
-  try {
-    mesh_native(model);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::MeshingFailed);
-    EXPECT_NE(std::string(e.what()).find("identical touching faces"), std::string::npos) << e.what();
-  }
+  expect_error([&] { mesh_native(model); }, ErrorCode::MeshingFailed, "identical touching faces");
   MeshRun run;
   const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
   EXPECT_EQ(run.mesher, "gmsh");
