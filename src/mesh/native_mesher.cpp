@@ -112,6 +112,7 @@ struct Steps {
   ModelSurface part, nd;  // Ω and Ω̄
   std::vector<std::array<int, 4>> tets;
   std::vector<int> domain;
+  MatX4i tets_in_part;  // step 13: Ω̄'s tets as tets already present in Ω
   std::map<std::array<int, 3>, int> nd_face_of;  // Ω triangle (sorted nodes) -> Ω̄ face (1-based)
   double tol;
   std::shared_ptr<BackgroundSize> background;
@@ -399,15 +400,17 @@ void step12_fill_nondesign(Steps& s) {
   s.progress.check_cancel("volume meshing");
   for (int i = 0; i < n; ++i) merge(s, results[i], V.rows(), i + 1);
 }
-// Step 13: those tets are Ω's too: the front of step 14 starts from their free faces. (They
-// already live in the shared pool and tet list; nothing moves.)
-void step13_transfer_tets(Steps&) {}
-// Step 14: the rest of Ω, from its boundary triangles plus the free faces of Ω̄'s tets.
+// Step 13: Ω̄'s tets become tets already present in Ω (on the shared node pool): the front of
+// step 14 starts from their free faces.
+void step13_transfer_tets(Steps& s) {
+  s.tets_in_part.resize(static_cast<long>(s.tets.size()), 4);
+  for (size_t i = 0; i < s.tets.size(); ++i)
+    s.tets_in_part.row(static_cast<long>(i)) << s.tets[i][0], s.tets[i][1], s.tets[i][2], s.tets[i][3];
+}
+// Step 14: the rest of Ω, from its boundary triangles plus the free faces of those tets.
 void step14_fill_design(Steps& s) {
-  MatX4i T0(static_cast<long>(s.tets.size()), 4);
-  for (size_t i = 0; i < s.tets.size(); ++i) T0.row(static_cast<long>(i)) << s.tets[i][0], s.tets[i][1], s.tets[i][2], s.tets[i][3];
   const MatX3d V = pool_matrix(s.nodes);
-  merge(s, fill(s, V, s.part.solid_triangles(0), T0, "design domain", s.progress), V.rows(), 0);
+  merge(s, fill(s, V, s.part.solid_triangles(0), s.tets_in_part, "design domain", s.progress), V.rows(), 0);
 }
 
 }  // namespace
