@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "mesh/delaunay_bulk.h"
 #include "mesh/predicates.h"
 #include "mesh/tet_quality.h"
 
@@ -654,10 +655,13 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 
   return done;
 }
 
-}  // namespace
+/// The bulk is dropped when its tetrahedralisation lacks more than this share of the boundary.
+constexpr double kMaxMissingShare = 0.02;
 
-VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
-                             const Progress& progress) {
+/// The fill itself (fill_volume below retries without the bulk when this fails with it).
+VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
+                      const Progress& progress) {
+
   std::vector<Vec3> P(V.rows());
   for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
   if (F.rows() == 0) throw Error(ErrorCode::MeshingFailed, "nothing to fill: the boundary has no triangles");
@@ -676,24 +680,61 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   Front front(P, std::max(std::min(min_edge, mean_edge), 1e-9 * (hi - lo).norm()), lo);
   std::vector<std::array<int, 4>> tets;
 
-  // ---- the initial front: boundary triangles reversed (normals into the region), then the
-  // free faces of the existing tets (outward from them, i.e. into the unfilled region)
-  std::unordered_map<TriKey, int, TriKeyHash> t0_faces;
+  // ---- the bulk by Delaunay refinement, where the tetrahedralisation of the boundary's
+  // nodes holds the boundary; the front fills the rest. The region's boundary: the boundary
+  // triangles no existing tet covers, and the existing tets' free faces turned outwards.
+  std::unordered_map<TriKey, int, TriKeyHash> covered;  // faces of existing and bulk tets
   for (long t = 0; t < T0.rows(); ++t)
-    for (const auto& f : kFace) t0_faces[key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]))]++;
+    for (const auto& f : kFace) covered[key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]))]++;
   std::unordered_map<TriKey, char, TriKeyHash> boundary;
+  for (long t = 0; t < F.rows(); ++t) boundary[key_of(F(t, 0), F(t, 1), F(t, 2))] = 1;
+  if (params.delaunay_bulk) {
+    std::vector<std::array<int, 3>> region;
+    for (long t = 0; t < F.rows(); ++t)
+      if (!covered.count(key_of(F(t, 0), F(t, 1), F(t, 2)))) region.push_back({F(t, 0), F(t, 1), F(t, 2)});
+    for (long t = 0; t < T0.rows(); ++t)
+      for (const auto& f : kFace) {
+        const TriKey k = key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
+        if (covered[k] == 1 && !boundary.count(k)) region.push_back({T0(t, f[0]), T0(t, f[2]), T0(t, f[1])});
+      }
+    DelaunayBulkParams dp;
+    dp.size = params.size;
+    dp.max_tets = params.max_tets;
+    DelaunayBulkResult bulk = delaunay_bulk(P, region, dp, progress);
+    if (static_cast<long>(bulk.tets.size()) >= params.max_tets)
+      throw Error(ErrorCode::TooLarge, "the volume mesh exceeds " + std::to_string(params.max_tets) + " tets");
+    if (bulk.missing_triangles > kMaxMissingShare * static_cast<double>(region.size())) {
+      // a boundary far from Delaunay (e.g. the cocircular squares of a structured face): the
+      // holes would be most of the volume, bounded by long flat tets: the front alone does better
+      progress.info("volume: the Delaunay tetrahedralisation lacks " + std::to_string(bulk.missing_triangles) + " of " +
+                    std::to_string(region.size()) + " boundary triangles; the front fills it alone");
+    } else {
+      tets = std::move(bulk.tets);
+      for (const auto& t : tets)
+        for (const auto& f : kFace) covered[key_of(t[f[0]], t[f[1]], t[f[2]])]++;
+      progress.info("volume: Delaunay bulk of " + std::to_string(tets.size()) + " tets (" + std::to_string(bulk.points) +
+                    " points); the front fills around " + std::to_string(bulk.missing_triangles) +
+                    " boundary triangles it did not hold");
+    }
+  }
+  // ---- the initial front: boundary triangles reversed (normals into the region), then the
+  // free faces of the existing and bulk tets (outward from them, i.e. into the unfilled region)
   for (long t = 0; t < F.rows(); ++t) {
-    TriKey k = key_of(F(t, 0), F(t, 1), F(t, 2));
-    boundary[k] = 1;
-    if (t0_faces.count(k)) continue;  // covered by an existing tet
+    if (covered.count(key_of(F(t, 0), F(t, 1), F(t, 2)))) continue;  // covered by a tet
     front.add_face(F(t, 0), F(t, 2), F(t, 1));
   }
-  for (long t = 0; t < T0.rows(); ++t)
-    for (const auto& f : kFace) {
-      TriKey k = key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
-      if (t0_faces[k] > 1 || boundary.count(k)) continue;
-      front.add_face(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
-    }
+  auto add_free_faces = [&](auto&& tet, long n) {
+    for (long t = 0; t < n; ++t)
+      for (const auto& f : kFace) {
+        const int a = tet(t, f[0]), b = tet(t, f[1]), c = tet(t, f[2]);
+        const TriKey k = key_of(a, b, c);
+        if (covered[k] > 1 || boundary.count(k)) continue;
+        front.add_face(a, b, c);
+      }
+  };
+  add_free_faces([&](long t, int k) { return T0(t, k); }, T0.rows());
+  const long bulk_tets = static_cast<long>(tets.size());
+  add_free_faces([&](long t, int k) { return tets[t][k]; }, bulk_tets);
 
   // ---- the driver loop: smallest face first
   using Item = std::pair<double, int>;
@@ -1162,7 +1203,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
         }
         if (!ok || now < worst) P[v] = old;
       }
-    compass_search_at_bad_tets(P, tets, stars, first_new, params.flip_below);
+    compass_search_at_bad_tets(P, tets, stars, first_new, params.sliver_below);
   }
   }
   // ---- slivers the flips and moves left (e.g. with two faces on the boundary): re-filled
@@ -1190,6 +1231,25 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   for (size_t t = 0; t < tets.size(); ++t)
     out.T.row(t) << renum[tets[t][0]], renum[tets[t][1]], renum[tets[t][2]], renum[tets[t][3]];
   return out;
+}
+
+}  // namespace
+
+VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
+                             const Progress& progress) {
+  if (!params.delaunay_bulk) return fill(V, F, T0, params, progress);
+  try {
+    return fill(V, F, T0, params, progress);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::MeshingFailed) throw;
+    // the bulk's holes left the front a region it could not close: the front alone, from
+    // the boundary, is the method this engine was built on
+    progress.info(std::string("volume: the front could not close the Delaunay bulk's holes (") + e.what() +
+                  "); filling by the front alone");
+    VolumeFillParams alone = params;
+    alone.delaunay_bulk = false;
+    return fill(V, F, T0, alone, progress);
+  }
 }
 
 }  // namespace topopt::mesh

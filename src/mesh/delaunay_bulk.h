@@ -1,0 +1,42 @@
+// The bulk of a volume by Delaunay refinement, for the 3D advancing front to finish (the
+// hybrid that Netgen also uses): the Delaunay tetrahedralisation of the boundary's nodes, the
+// tets inside the boundary kept where it contains the boundary triangles, and refined by
+// inserting circumcentres until the tets meet the size. Where a boundary triangle is missing
+// from the tetrahedralisation, every tet that could meet it is left out: the advancing front
+// (volume_front.h) fills those holes from their faces, so the boundary is never recovered
+// by flips or Steiner points and the hybrid is exactly as reliable as the front alone.
+// Every decision goes through the exact predicates.
+#pragma once
+#include <array>
+#include <functional>
+#include <vector>
+
+#include "common/progress.h"
+#include "common/types.h"
+
+namespace topopt::mesh {
+
+struct DelaunayBulkParams {
+  /// Target edge length at a point, or empty; the size is never above the one interpolated
+  /// from the boundary's edge lengths.
+  std::function<double(const double*)> size;
+  /// A tet is refined while its circumradius exceeds this × the size (the regular tet of edge
+  /// h has 0.61 h; 0.95 gives about as many tets as Gmsh and the front at the same size).
+  double refine_above = 0.95;
+  long max_tets = 20'000'000;   ///< stop refining beyond (the caller checks memory)
+};
+
+struct DelaunayBulkResult {
+  std::vector<std::array<int, 4>> tets;  ///< positively oriented, inside the boundary
+  long missing_triangles = 0;            ///< boundary triangles the tetrahedralisation lacked
+  long points = 0;                       ///< points inserted inside
+};
+
+/// Tets for the region bounded by B (triangles on nodes P, oriented with normals OUT of the
+/// region; closed). New nodes are appended to P (and 4 far nodes that no returned tet uses).
+/// The tets leave holes around boundary triangles the tetrahedralisation lacked: the
+/// region minus the tets is bounded by those triangles and the tets' free faces.
+DelaunayBulkResult delaunay_bulk(std::vector<Eigen::Vector3d>& P, const std::vector<std::array<int, 3>>& B,
+                                 const DelaunayBulkParams& params = {}, const Progress& progress = {});
+
+}  // namespace topopt::mesh
