@@ -89,13 +89,14 @@ share_below_20deg.)doc");
 
   m.def(
       "volume_mesh",
-      [](const MatX3d& nodes, const MatX3i& triangles, double size) {
+      [](const MatX3d& nodes, const MatX3i& triangles, double size, bool delaunay_bulk) {
         mesh::VolumeFillResult r;
         double seconds = 0;
         {
           pybind11::gil_scoped_release release;
           mesh::VolumeFillParams p;
           if (size > 0) p.size = [size](const double*) { return size; };
+          p.delaunay_bulk = delaunay_bulk;
           const auto t0 = std::chrono::steady_clock::now();
           r = mesh::fill_volume(nodes, triangles, MatX4i(), p);
           seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -107,8 +108,10 @@ share_below_20deg.)doc");
         return out;
       },
       pybind11::arg("nodes"), pybind11::arg("triangles"), pybind11::arg("size") = 0.0,
+      pybind11::arg("delaunay_bulk") = true,
       R"doc(Fills the closed surface (nodes #V x 3, triangles #F x 3 oriented outwards) with tets by
-the 3D advancing front, target size `size` inside (0: from the boundary). Returns a dict:
+a Delaunay bulk finished by the 3D advancing front (delaunay_bulk=False: the front alone), target
+size `size` inside (0: from the boundary). Returns a dict:
 nodes (the input nodes first, unchanged), tets #T x 4 (positive), seconds (the fill alone).)doc");
 }
 

@@ -77,7 +77,7 @@ class Tets {
 
   /// The tet holding q (on its closure), walking from t; -1 when the walk meets a wall.
   int locate(int t, const double* q) {
-    for (int steps = 0; steps < 200000; ++steps) {
+    for (int steps = 0; steps < 20000; ++steps) {
       seed_ = seed_ * 1664525u + 1013904223u;
       const unsigned r = seed_ >> 16;
       int next = -2;
@@ -359,7 +359,8 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
       for (int& n : m.nb[t])
         if (n >= 0 && m.dead[n]) n = -1;
   // ---- refinement: circumcentres of the tets too large for the size, largest first
-  auto size_at = [&](int t, const Vec3& c) {  // linear in t from its nodes' sizes
+  auto size_at = [&](int t, const Vec3& c) {  // the size function, else linear in t from its nodes'
+    if (params.size) return params.size(c.data());
     const auto& w = m.v[t];
     const Vec3 &a = P[w[0]], &b = P[w[1]], &cc = P[w[2]], &d = P[w[3]];
     const double vol = (b - a).dot((cc - a).cross(d - a));
@@ -368,7 +369,6 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     double s = 0, h = 0;
     for (int k = 0; k < 4; ++k) l[k] = std::max(0.0, vol > 0 ? l[k] / vol : 0.25), s += l[k];
     for (int k = 0; k < 4; ++k) h += (s > 0 ? l[k] / s : 0.25) * hs[w[k]];
-    if (params.size) h = std::min(h, params.size(c.data()));
     return h;
   };
   struct Item {

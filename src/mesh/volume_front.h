@@ -31,7 +31,7 @@ struct VolumeFillParams {
   long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
   int smoothing_iterations = 1; ///< node smoothing sweeps per round (the worst tet at a node never drops)
   double flip_below = 0.55;     ///< new tets below this radius ratio get edge removal and 2-3 flips (0: none)
-  int quality_rounds = 2;       ///< rounds of flips, smoothing and compass search
+  int quality_rounds = 3;       ///< rounds of flips, smoothing and compass search
   bool delaunay_bulk = true;    ///< fill the bulk by Delaunay refinement first (delaunay_bulk.h), the front the rest
   double sliver_below = 0.4;    ///< new tets below this get a compass search on their nodes each round, then sliver removal by point insertion, worst first, up to 3 times (0: none)
 };
