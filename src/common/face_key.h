@@ -1,11 +1,15 @@
 // An orientation-free key for a triangle (its three node indices sorted) and its hash, for
-// matching faces between tets, boundary lists and files.
+// matching faces between tets, boundary lists and files; and the outward faces of a tet.
 #pragma once
 #include <algorithm>
 #include <array>
 #include <cstddef>
 
 namespace topopt {
+
+/// The faces of a positively oriented tet (v0, v1, v2, v3), opposite vertex 0..3, each turning
+/// so that its normal points out of the tet.
+inline constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
 using FaceKey = std::array<int, 3>;
 

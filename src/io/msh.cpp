@@ -24,7 +24,7 @@ inline FaceKey sorted_key(int a, int b, int c) { return face_key(a, b, c); }
 MatX3i boundary_triangles(const MatX4i& T) {
   // Faces of tet (a,b,c,d) oriented outwards for a positive tet. All 4 #T faces sorted by
   // their key: a face met once is on the boundary (sorting beats hashing here by ~3x).
-  static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  const auto& kFace = kTetFace;
   struct Entry {
     FaceKey key;
     int tet, face;

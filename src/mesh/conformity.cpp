@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "brep/point_locator.h"
+#include "common/face_key.h"
 
 namespace topopt::mesh {
 
@@ -35,18 +36,9 @@ nlohmann::json ConformityReport::to_json() const {
 
 namespace {
 
-using Key3 = std::array<int, 3>;
-struct Key3Hash {
-  size_t operator()(const Key3& k) const {
-    return (static_cast<size_t>(k[0]) * 73856093u) ^ (static_cast<size_t>(k[1]) * 19349663u) ^
-           (static_cast<size_t>(k[2]) * 83492791u);
-  }
-};
-Key3 sorted(int a, int b, int c) {
-  Key3 k{a, b, c};
-  std::sort(k.begin(), k.end());
-  return k;
-}
+using Key3 = FaceKey;
+using Key3Hash = FaceKeyHash;
+Key3 sorted(int a, int b, int c) { return face_key(a, b, c); }
 
 double signed_volume(const TetMesh& m, int t) {
   Eigen::Vector3d a = m.V.row(m.T(t, 1)) - m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 2)) - m.V.row(m.T(t, 0)),
@@ -99,7 +91,7 @@ ConformityReport check_conformity(const TetMesh& m, const brep::TwoBReps* geomet
   // Tet faces: (sorted key) → (count, first tet).
   std::unordered_map<Key3, std::pair<int, int>, Key3Hash> faces;
   faces.reserve(4 * m.T.rows());
-  static const int local[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  const auto& local = kTetFace;
   std::vector<std::pair<Key3, std::pair<int, int>>> interfaces;  // key, (tet a, tet b)
   for (int t = 0; t < m.T.rows(); ++t) {
     double v = signed_volume(m, t);

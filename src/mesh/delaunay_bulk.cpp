@@ -7,6 +7,7 @@
 #include <queue>
 #include <unordered_map>
 
+#include "common/face_key.h"
 #include "mesh/predicates.h"
 
 namespace topopt::mesh {
@@ -16,24 +17,7 @@ using Vec3 = Eigen::Vector3d;
 using predicates::insphere;
 using predicates::orient3d;
 
-/// Outward faces of a positive tet, opposite vertex 0..3 (the convention of volume_front).
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-struct Key3 {
-  int a, b, c;
-  bool operator==(const Key3& o) const { return a == o.a && b == o.b && c == o.c; }
-};
-struct Key3Hash {
-  size_t operator()(const Key3& k) const {
-    return static_cast<size_t>(k.a) * 73856093u ^ static_cast<size_t>(k.b) * 19349663u ^ static_cast<size_t>(k.c) * 83492791u;
-  }
-};
-Key3 sorted(int a, int b, int c) {
-  if (a > b) std::swap(a, b);
-  if (b > c) std::swap(b, c);
-  if (a > b) std::swap(a, b);
-  return {a, b, c};
-}
+constexpr auto& kFace = kTetFace;
 
 /// A tet mesh with face adjacency (nb[t][i]: the tet across face i, -1 for none: a wall) and
 /// Bowyer–Watson insertion. Slots of removed tets are reused; gen[t] counts the reuses so that
@@ -268,9 +252,9 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     }
   }
   // ---- which boundary triangles it holds, and on which side of each its tets lie
-  std::unordered_map<Key3, int, Key3Hash> bindex;
+  std::unordered_map<FaceKey, int, FaceKeyHash> bindex;
   bindex.reserve(B.size() * 2);
-  for (size_t b = 0; b < B.size(); ++b) bindex.emplace(sorted(B[b][0], B[b][1], B[b][2]), static_cast<int>(b));
+  for (size_t b = 0; b < B.size(); ++b) bindex.emplace(face_key(B[b][0], B[b][1], B[b][2]), static_cast<int>(b));
   const size_t nt = m.v.size();
   std::vector<char> found(B.size(), 0), wall(nt, 0), evidence(nt, 0);  // evidence: 1 inside, 2 outside
   for (size_t t = 0; t < nt; ++t) {
@@ -278,7 +262,7 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     for (int i = 0; i < 4; ++i) {
       const int* f = kFace[i];
       const int a = m.v[t][f[0]], b = m.v[t][f[1]], c = m.v[t][f[2]];
-      auto it = bindex.find(sorted(a, b, c));
+      auto it = bindex.find(face_key(a, b, c));
       if (it == bindex.end()) continue;
       found[it->second] = 1;
       wall[t] |= static_cast<char>(1 << i);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/face_key.h"
 #include "mesh/delaunay_bulk.h"
 #include "mesh/predicates.h"
 #include "mesh/tet_quality.h"
@@ -20,24 +21,11 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Tri = std::array<int, 3>;
 
-/// Outward faces of a positive tet, opposite vertex 0..3.
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-struct TriKey {
-  int a, b, c;
-  bool operator==(const TriKey& o) const { return a == o.a && b == o.b && c == o.c; }
-};
-struct TriKeyHash {
-  size_t operator()(const TriKey& k) const {
-    return static_cast<size_t>(k.a) * 73856093u ^ static_cast<size_t>(k.b) * 19349663u ^
-           static_cast<size_t>(k.c) * 83492791u;
-  }
-};
-TriKey key_of(int a, int b, int c) {
-  int v[3] = {a, b, c};
-  std::sort(v, v + 3);
-  return {v[0], v[1], v[2]};
-}
+/// Outward faces of a positive tet, opposite vertex 0..3; triangles matched by their sorted key.
+constexpr auto& kFace = kTetFace;
+using TriKey = FaceKey;
+using TriKeyHash = FaceKeyHash;
+inline TriKey key_of(int a, int b, int c) { return face_key(a, b, c); }
 
 /// Uniform grid of buckets over ids with a box each; lookups return candidates (the caller
 /// filters stale or far ones). Entries are removed lazily by the caller's alive flags.
