@@ -61,7 +61,7 @@ class Tets {
 
   /// The tet holding q (on its closure), walking from t; -1 when the walk meets a wall.
   int locate(int t, const double* q) {
-    for (int steps = 0; steps < 20000; ++steps) {
+    for (int steps = 0; steps < 2000; ++steps) {
       seed_ = seed_ * 1664525u + 1013904223u;
       const unsigned r = seed_ >> 16;
       int next = -2;
@@ -158,6 +158,9 @@ class Tets {
   long alive_ = 0;
   int last_ = -1;
 };
+
+/// How fast the size may grow away from a node (per unit of distance).
+constexpr double kGrading = 0.4;
 
 /// Circumcentre of tet t and its circumradius (infinite for a flat tet).
 double circumcentre(const Tets& m, const std::vector<Vec3>& P, int t, Vec3& c) {
@@ -343,16 +346,12 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
       for (int& n : m.nb[t])
         if (n >= 0 && m.dead[n]) n = -1;
   // ---- refinement: circumcentres of the tets too large for the size, largest first
-  auto size_at = [&](int t, const Vec3& c) {  // the size function, else linear in t from its nodes'
-    if (params.size) return params.size(c.data());
-    const auto& w = m.v[t];
-    const Vec3 &a = P[w[0]], &b = P[w[1]], &cc = P[w[2]], &d = P[w[3]];
-    const double vol = (b - a).dot((cc - a).cross(d - a));
-    double l[4] = {(b - c).dot((cc - c).cross(d - c)), (c - a).dot((cc - a).cross(d - a)),
-                   (b - a).dot((c - a).cross(d - a)), (b - a).dot((cc - a).cross(c - a))};
-    double s = 0, h = 0;
-    for (int k = 0; k < 4; ++k) l[k] = std::max(0.0, vol > 0 ? l[k] / vol : 0.25), s += l[k];
-    for (int k = 0; k < 4; ++k) h += (s > 0 ? l[k] / s : 0.25) * hs[w[k]];
+  // the size at a point: each node of its tet allows its own size plus kGrading × the
+  // distance to it (a small boundary feature sets the size around it, growing away from it);
+  // the size function, where given, caps that
+  auto size_at = [&](int t, const Vec3& c) {
+    double h = params.size ? params.size(c.data()) : INFINITY;
+    for (int x : m.v[t]) h = std::min(h, hs[x] + kGrading * (P[x] - c).norm());
     return h;
   };
   struct Item {
@@ -367,7 +366,7 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     const double R = circumcentre(m, P, t, c);
     if (!std::isfinite(R)) return;
     const auto& w = m.v[t];
-    const double h = (hs[w[0]] + hs[w[1]] + hs[w[2]] + hs[w[3]]) / 4;
+    const double h = size_at(t, (P[w[0]] + P[w[1]] + P[w[2]] + P[w[3]]) / 4);
     if (R > params.refine_above * h) work.push({R / h, t, m.gen[t]});
   };
   for (size_t t = 0; t < m.v.size(); ++t)

@@ -17,7 +17,8 @@
 namespace topopt::mesh {
 
 struct DelaunayBulkParams {
-  /// Target edge length at a point; empty: interpolated from the boundary's edge lengths.
+  /// Target edge length at a point, or empty; either way the size grows from the boundary's
+  /// edge lengths no faster than 0.4 per unit of distance.
   std::function<double(const double*)> size;
   /// A tet is refined while its circumradius exceeds this × the size (the regular tet of edge
   /// h has 0.61 h; 0.95 gives about as many tets as Gmsh and the front at the same size).
