@@ -805,6 +805,9 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
   // Rounds: advance (with widening passes), fill what is left from single points, and if a
   // stuck region remains, remove the new tets around it and advance again.
   for (int round = 0; round < 10 && front.size() > 0; ++round) {
+    if (round > 0 && bulk_tets > 0)  // the bulk's holes did not close: fill_volume goes without it
+      throw Error(ErrorCode::MeshingFailed, "the front could not close the holes of the Delaunay bulk (" +
+                                                std::to_string(front.size()) + " front faces left)");
     if (round > 0) {
       // the new tets around the stuck front's nodes, widened by one ring of nodes every third
       // round, go back to the front
