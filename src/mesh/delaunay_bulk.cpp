@@ -394,8 +394,12 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     ++out.points;
     for (int n : created) consider(n);
   }
-  for (size_t t = 0; t < m.v.size(); ++t)
-    if (!m.dead[t]) out.tets.push_back(m.v[t]);
+  for (size_t t = 0; t < m.v.size(); ++t) {
+    if (m.dead[t]) continue;
+    out.tets.push_back(m.v[t]);
+    for (int i = 0; i < 4; ++i)
+      if (m.nb[t][i] < 0) out.free_faces.push_back({m.v[t][kFace[i][0]], m.v[t][kFace[i][1]], m.v[t][kFace[i][2]]});
+  }
   return out;
 }
 

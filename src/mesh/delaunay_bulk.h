@@ -28,6 +28,7 @@ struct DelaunayBulkParams {
 
 struct DelaunayBulkResult {
   std::vector<std::array<int, 4>> tets;  ///< positively oriented, inside the boundary
+  std::vector<std::array<int, 3>> free_faces;  ///< faces of one tet only, turned out of it: boundary triangles and the holes' faces
   long missing_triangles = 0;            ///< boundary triangles the tetrahedralisation lacked
   long points = 0;                       ///< points inserted inside
 };

@@ -671,7 +671,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
   // ---- the bulk by Delaunay refinement, where the tetrahedralisation of the boundary's
   // nodes holds the boundary; the front fills the rest. The region's boundary: the boundary
   // triangles no existing tet covers, and the existing tets' free faces turned outwards.
-  std::unordered_map<TriKey, int, TriKeyHash> covered;  // faces of existing and bulk tets
+  std::unordered_map<TriKey, int, TriKeyHash> covered;  // faces of existing tets, free faces of bulk tets
+  std::vector<std::array<int, 3>> bulk_free;
   for (long t = 0; t < T0.rows(); ++t)
     for (const auto& f : kFace) covered[key_of(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]))]++;
   std::unordered_map<TriKey, char, TriKeyHash> boundary;
@@ -698,8 +699,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
                     std::to_string(region.size()) + " boundary triangles; the front fills it alone");
     } else {
       tets = std::move(bulk.tets);
-      for (const auto& t : tets)
-        for (const auto& f : kFace) covered[key_of(t[f[0]], t[f[1]], t[f[2]])]++;
+      bulk_free = std::move(bulk.free_faces);  // only these can meet the boundary or T0's faces
+      for (const auto& f : bulk_free) covered[key_of(f[0], f[1], f[2])]++;
       progress.info("volume: Delaunay bulk of " + std::to_string(tets.size()) + " tets (" + std::to_string(bulk.points) +
                     " points); the front fills around " + std::to_string(bulk.missing_triangles) +
                     " boundary triangles it did not hold");
@@ -711,18 +712,14 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     if (covered.count(key_of(F(t, 0), F(t, 1), F(t, 2)))) continue;  // covered by a tet
     front.add_face(F(t, 0), F(t, 2), F(t, 1));
   }
-  auto add_free_faces = [&](auto&& tet, long n) {
-    for (long t = 0; t < n; ++t)
-      for (const auto& f : kFace) {
-        const int a = tet(t, f[0]), b = tet(t, f[1]), c = tet(t, f[2]);
-        const TriKey k = key_of(a, b, c);
-        if (covered[k] > 1 || boundary.count(k)) continue;
-        front.add_face(a, b, c);
-      }
+  auto add_free_face = [&](int a, int b, int c) {
+    const TriKey k = key_of(a, b, c);
+    if (covered[k] == 1 && !boundary.count(k)) front.add_face(a, b, c);
   };
-  add_free_faces([&](long t, int k) { return T0(t, k); }, T0.rows());
+  for (long t = 0; t < T0.rows(); ++t)
+    for (const auto& f : kFace) add_free_face(T0(t, f[0]), T0(t, f[1]), T0(t, f[2]));
+  for (const auto& f : bulk_free) add_free_face(f[0], f[1], f[2]);
   const long bulk_tets = static_cast<long>(tets.size());
-  add_free_faces([&](long t, int k) { return tets[t][k]; }, bulk_tets);
 
   // ---- the driver loop: smallest face first
   using Item = std::pair<double, int>;
