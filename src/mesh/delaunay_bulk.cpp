@@ -82,9 +82,10 @@ class Tets {
 
   /// Inserts node p, lying in tet t: the tets whose circumsphere holds it strictly (connected,
   /// never through a wall) are replaced by the star of p on their boundary. Refused, mesh
-  /// unchanged, when p is an existing node or does not see every boundary face strictly (a
-  /// wall in the way). The new tets go to `created` when given.
-  bool insert(int p, int t, std::vector<int>* created) {
+  /// unchanged, when p is an existing node, does not see every boundary face strictly (a
+  /// wall in the way) or comes nearer than sqrt(min_dist2) to a node of those faces (the
+  /// only nodes it would be joined to). The new tets go to `created` when given.
+  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0) {
     const double* q = x(p);
     auto in_sphere = [&](int s) {
       const auto& w = v[s];
@@ -114,6 +115,9 @@ class Tets {
       const int* f = kFace[i];
       const int a = v[s][f[0]], b = v[s][f[1]], c = v[s][f[2]];
       if (orient3d(x(a), x(b), x(c), q) >= 0) return false;  // p must be strictly inside
+      if (min_dist2 > 0)
+        for (int w : {a, b, c})
+          if ((P_[w] - P_[p]).squaredNorm() < min_dist2) return false;
     }
     edges_.clear();
     if (created) created->clear();
@@ -158,6 +162,11 @@ class Tets {
   long alive_ = 0;
   int last_ = -1;
 };
+
+/// A new point keeps this × the size from every node it is joined to. A Delaunay cavity's
+/// nodes are at least the circumradius (> 0.95 × the size) away; next to walls they need not
+/// be, and without this bound refinement cascades at small angles between boundary faces.
+constexpr double kClearance = 0.5;
 
 /// How fast the size may grow away from a node (per unit of distance).
 constexpr double kGrading = 0.4;
@@ -316,6 +325,10 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
         if (may_meet(m, P, n, B[b])) removed[n] = 1, queue.push_back(n);
       }
   }
+  if (out.missing_triangles > params.max_missing_share * static_cast<double>(B.size())) {
+    P.resize(far0);
+    return out;
+  }
   // ---- components of the rest, not crossing boundary triangles: kept when inside
   std::vector<int> comp(nt, -1);
   std::vector<char> keep_comp;
@@ -387,7 +400,7 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     P.push_back(c);
     hs.push_back(h);
     const int p = static_cast<int>(P.size()) - 1;
-    if (!m.insert(p, t, &created)) {
+    if (!m.insert(p, t, &created, kClearance * kClearance * h * h)) {
       P.pop_back(), hs.pop_back();
       continue;
     }

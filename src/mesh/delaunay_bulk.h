@@ -24,6 +24,9 @@ struct DelaunayBulkParams {
   /// h has 0.61 h; 0.95 gives about as many tets as Gmsh and the front at the same size).
   double refine_above = 0.95;
   long max_tets = 20'000'000;   ///< stop refining beyond (the caller checks memory)
+  /// Give up before refining (no tets, P as it was) when more than this share of the boundary
+  /// triangles is missing from the tetrahedralisation.
+  double max_missing_share = 1.0;
 };
 
 struct DelaunayBulkResult {
