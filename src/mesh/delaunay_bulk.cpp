@@ -284,6 +284,12 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
       evidence[t] |= same ? 1 : 2;
     }
   }
+  out.missing_triangles = std::count(found.begin(), found.end(), 0);
+  if (out.missing_triangles > params.max_missing_share * static_cast<double>(B.size())) {
+    P.resize(far0);
+    out.gave_up = true;
+    return out;
+  }
   // ---- around every missing triangle, every tet that may meet it is left out
   std::vector<int> vtet(P.size(), -1);
   for (size_t t = 0; t < nt; ++t)
@@ -295,7 +301,6 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
   std::vector<int> queue;
   for (size_t b = 0; b < B.size(); ++b) {
     if (found[b]) continue;
-    ++out.missing_triangles;
     // from the stars of its three nodes, every tet that may meet it (other than at a shared
     // node or edge) goes
     queue.clear();
@@ -324,10 +329,6 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
         seen[n] = ticket;
         if (may_meet(m, P, n, B[b])) removed[n] = 1, queue.push_back(n);
       }
-  }
-  if (out.missing_triangles > params.max_missing_share * static_cast<double>(B.size())) {
-    P.resize(far0);
-    return out;
   }
   // ---- components of the rest, not crossing boundary triangles: kept when inside
   std::vector<int> comp(nt, -1);

@@ -34,6 +34,7 @@ struct DelaunayBulkResult {
   std::vector<std::array<int, 3>> free_faces;  ///< faces of one tet only, turned out of it: boundary triangles and the holes' faces
   long missing_triangles = 0;            ///< boundary triangles the tetrahedralisation lacked
   long points = 0;                       ///< points inserted inside
+  bool gave_up = false;                  ///< over max_missing_share missing: no tets, P as it was
 };
 
 /// Tets for the region bounded by B (triangles on nodes P, oriented with normals OUT of the

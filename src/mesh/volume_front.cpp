@@ -693,12 +693,11 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     DelaunayBulkResult bulk = delaunay_bulk(P, region, dp, progress);
     if (static_cast<long>(bulk.tets.size()) >= params.max_tets)
       throw Error(ErrorCode::TooLarge, "the volume mesh exceeds " + std::to_string(params.max_tets) + " tets");
-    if (bulk.missing_triangles > kMaxMissingShare * static_cast<double>(region.size())) {
+    if (bulk.gave_up) {
       // a boundary far from Delaunay (e.g. the cocircular squares of a structured face): the
       // holes would be most of the volume, bounded by long flat tets: the front alone does better
       progress.info("volume: the Delaunay tetrahedralisation lacks " + std::to_string(bulk.missing_triangles) + " of " +
                     std::to_string(region.size()) + " boundary triangles; the front fills it alone");
-      P.resize(V.rows());  // the far nodes (the bulk gave up before refining)
     } else {
       tets = std::move(bulk.tets);
       bulk_free = std::move(bulk.free_faces);  // only these can meet the boundary or T0's faces
