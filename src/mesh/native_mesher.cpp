@@ -16,91 +16,12 @@
 
 #include "common/error.h"
 #include "common/parallel.h"
+#include "mesh/background_size.h"
 #include "mesh/conformity.h"
 #include "mesh/gmsh_fragments.h"
 
 namespace topopt::mesh {
 namespace {
-
-/// Graded size inside a closed surface: a uniform background grid (cells of h/2) holding at
-/// each cell centre min(h, s_i + g·d) for the boundary nodes' spacings s_i, relaxed by a
-/// two-pass chamfer sweep (6-neighbour steps), interpolated trilinearly. Without it the front jumps from
-/// fine boundary parts (bores refined by curvature) to the full size in one layer.
-class BackgroundSize {
- public:
-  BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g) {
-    lo_ = V.colwise().minCoeff().transpose();
-    const Eigen::Vector3d hi = V.colwise().maxCoeff().transpose();
-    cell_ = h / 2;
-    auto dims = [&]() {
-      for (int d = 0; d < 3; ++d) n_[d] = static_cast<long>((hi[d] - lo_[d]) / cell_) + 2;
-      return n_[0] * n_[1] * n_[2];
-    };
-    while (dims() > 20'000'000) cell_ *= 1.25;  // memory: at most 80 MB of floats
-    size_.assign(n_[0] * n_[1] * n_[2], static_cast<float>(h));
-    // boundary nodes: the mean length of their edges
-    std::vector<double> sum(V.rows(), 0.0);
-    std::vector<int> cnt(V.rows(), 0);
-    for (long t = 0; t < F.rows(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int a = F(t, k), b = F(t, (k + 1) % 3);
-        const double l = (V.row(a) - V.row(b)).norm();
-        sum[a] += l, ++cnt[a], sum[b] += l, ++cnt[b];
-      }
-    // a node's spacing seeds the cells around it at their centres (s + g·distance), so a
-    // tiny edge does not impose its size on a whole cell
-    for (long i = 0; i < V.rows(); ++i) {
-      if (!cnt[i]) continue;
-      const Eigen::Vector3d x = V.row(i).transpose();
-      long c[3];
-      for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>(std::floor((x[d] - lo_[d]) / cell_ - 0.5)), 0L, n_[d] - 1);
-      for (long di = 0; di < 2; ++di)
-        for (long dj = 0; dj < 2; ++dj)
-          for (long dk = 0; dk < 2; ++dk) {
-            const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
-            const Eigen::Vector3d centre = lo_ + cell_ * Eigen::Vector3d(ci + 0.5, cj + 0.5, ck + 0.5);
-            float& v = size_[(ci * n_[1] + cj) * n_[2] + ck];
-            v = std::min(v, static_cast<float>(sum[i] / cnt[i] + g * (centre - x).norm()));
-          }
-    }
-    const float step = static_cast<float>(g * cell_);
-    for (int pass = 0; pass < 2; ++pass) {
-      const long dir = pass == 0 ? 1 : -1;
-      for (long i = pass == 0 ? 0 : n_[0] - 1; i >= 0 && i < n_[0]; i += dir)
-        for (long j = pass == 0 ? 0 : n_[1] - 1; j >= 0 && j < n_[1]; j += dir)
-          for (long k = pass == 0 ? 0 : n_[2] - 1; k >= 0 && k < n_[2]; k += dir) {
-            float& c = size_[(i * n_[1] + j) * n_[2] + k];
-            if (i - dir >= 0 && i - dir < n_[0]) c = std::min(c, size_[((i - dir) * n_[1] + j) * n_[2] + k] + step);
-            if (j - dir >= 0 && j - dir < n_[1]) c = std::min(c, size_[(i * n_[1] + j - dir) * n_[2] + k] + step);
-            if (k - dir >= 0 && k - dir < n_[2]) c = std::min(c, size_[(i * n_[1] + j) * n_[2] + k - dir] + step);
-          }
-    }
-  }
-  /// Trilinear between the cell centres.
-  double at(const double* x) const {
-    double w[3];
-    long c[3];
-    for (int d = 0; d < 3; ++d) {
-      const double u = std::clamp((x[d] - lo_[d]) / cell_ - 0.5, 0.0, static_cast<double>(n_[d] - 1));
-      c[d] = std::min(static_cast<long>(u), n_[d] - 2 >= 0 ? n_[d] - 2 : 0);
-      w[d] = std::clamp(u - c[d], 0.0, 1.0);
-    }
-    double s = 0;
-    for (int di = 0; di < 2; ++di)
-      for (int dj = 0; dj < 2; ++dj)
-        for (int dk = 0; dk < 2; ++dk) {
-          const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
-          s += (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]) * size_[(ci * n_[1] + cj) * n_[2] + ck];
-        }
-    return s;
-  }
-
- private:
-  double cell_;
-  Eigen::Vector3d lo_;
-  long n_[3];
-  std::vector<float> size_;
-};
 
 /// What the 14 steps share: one node pool, the surface meshes of the two models on it, and
 /// the tets made so far.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <queue>
 #include <sstream>
 #include <unordered_map>
@@ -11,6 +12,7 @@
 
 #include "common/error.h"
 #include "common/face_key.h"
+#include "mesh/background_size.h"
 #include "mesh/delaunay_bulk.h"
 #include "mesh/predicates.h"
 #include "mesh/tet_quality.h"
@@ -643,12 +645,20 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 
   return done;
 }
 
+/// Without a size, the size grows from the boundary's edge lengths by this per unit distance
+/// (the surface mesher's default gradation, 1.3).
+constexpr double kDefaultGrowth = 0.3;
+/// The front gives up past this many times the tets its size asks for (expected_tets).
+constexpr double kBudgetFactor = 10.0;
+
 /// The bulk is dropped when its tetrahedralisation lacks more than this share of the boundary.
 constexpr double kMaxMissingShare = 0.02;
 
 /// The fill itself (fill_volume below retries without the bulk when this fails with it).
+/// `budget`: the front stops with a named error past this many tets (a front whose faces keep
+/// shrinking instead of closing), 0 for none.
 VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
-                      const Progress& progress) {
+                      long budget, const Progress& progress) {
 
   std::vector<Vec3> P(V.rows());
   for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
@@ -850,8 +860,17 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
         int f = queue.top().second;
         queue.pop();
         if (!front.alive(f)) continue;
-          if (static_cast<long>(tets.size()) > params.max_tets)
+        if (static_cast<long>(tets.size()) > params.max_tets)
           throw Error(ErrorCode::TooLarge, "the volume mesh exceeds " + std::to_string(params.max_tets) + " tets");
+        if (budget > 0 && static_cast<long>(tets.size()) > budget) {
+          const Tri& t = front.face(f);
+          const Vec3 c = (P[t[0]] + P[t[1]] + P[t[2]]) / 3.0;
+          std::ostringstream s;
+          s << "the volume front made " << tets.size() << " tets without closing, far more than the size asks for ("
+            << budget << " at most): its faces keep shrinking, e.g. near (" << c.x() << ", " << c.y() << ", " << c.z()
+            << "); a coarser or smoother surface mesh there may help";
+          throw Error(ErrorCode::MeshingFailed, s.str());
+        }
         if (tets.size() % 20000 == 0) progress.check_cancel("volume meshing");
         const Tri face = front.face(f);
         int a = face[0], b = face[1], c = face[2];
@@ -1224,11 +1243,28 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
 
 }  // namespace
 
-VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
+VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& given,
                              const Progress& progress) {
-  if (!params.delaunay_bulk) return fill(V, F, T0, params, progress);
+  VolumeFillParams params = given;
+  if (!params.size && F.rows() > 0) {
+    // no size given: graded from the boundary's (and the existing tets') edge lengths up to the
+    // longest of them, so that the front does not fill the whole region at its finest edge
+    MatX3i faces(F.rows() + 4 * T0.rows(), 3);
+    faces.topRows(F.rows()) = F;
+    for (long t = 0; t < T0.rows(); ++t)
+      for (int k = 0; k < 4; ++k) faces.row(F.rows() + 4 * t + k) << T0(t, kFace[k][0]), T0(t, kFace[k][1]), T0(t, kFace[k][2]);
+    const std::vector<double> spacing = node_spacing(V, faces);
+    const double h = *std::max_element(spacing.begin(), spacing.end());
+    auto background = std::make_shared<BackgroundSize>(V, faces, h, kDefaultGrowth);
+    params.size = [background](const double* x) { return background->at(x); };
+  }
+  // the front's budget: many times the tets its size asks for, and room for a fine boundary
+  const double expected = params.size ? expected_tets(V, F, params.size) : 0.0;
+  const long budget = expected > 0 ? static_cast<long>(kBudgetFactor * expected) + 30 * F.rows() + 100'000 : 0;
+  progress.info("volume: the size asks for about " + std::to_string(static_cast<long>(expected)) + " tets");
+  if (!params.delaunay_bulk) return fill(V, F, T0, params, budget, progress);
   try {
-    return fill(V, F, T0, params, progress);
+    return fill(V, F, T0, params, budget, progress);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::MeshingFailed) throw;
     // the bulk's holes left the front a region it could not close: the front alone, from
@@ -1237,7 +1273,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
                   "); filling by the front alone");
     VolumeFillParams alone = params;
     alone.delaunay_bulk = false;
-    return fill(V, F, T0, alone, progress);
+    return fill(V, F, T0, alone, budget, progress);
   }
 }
 
