@@ -150,6 +150,19 @@ double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, doubl
   double u0, u1, v0, v1;
   BRepTools::UVBounds(face, u0, u1, v0, v1);
   const double eps = 1e-4 * std::max(u1 - u0, v1 - v0);
+  // the face's side of the collapsed edge, chosen once at its middle (chosen per sample, a
+  // side that flips reverses the direction and adds half-turns to the sum)
+  double side = 1;
+  {
+    gp_Pnt2d q;
+    gp_Vec2d d;
+    pc->D1(0.5 * (t0 + t1), q, d);
+    const double m = d.Magnitude();
+    if (m > 1e-300) {
+      const double x = q.X() - eps * d.Y() / m, y = q.Y() + eps * d.X() / m;
+      if (x < u0 || x > u1 || y < v0 || y > v1) side = -1;
+    }
+  }
   const int m = 24;
   gp_Vec prev;
   double total = 0;
@@ -160,11 +173,9 @@ double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, doubl
     pc->D1(t, q, d);
     if (d.Magnitude() < 1e-300) continue;
     // a point just off the collapsed edge, on the face's side, where the derivatives live
-    gp_Vec2d across(-d.Y(), d.X());
+    gp_Vec2d across(-side * d.Y(), side * d.X());
     across.Normalize();
-    gp_Pnt2d inside(q.X() + eps * across.X(), q.Y() + eps * across.Y());
-    if (inside.X() < u0 || inside.X() > u1 || inside.Y() < v0 || inside.Y() > v1)
-      inside.SetCoord(q.X() - eps * across.X(), q.Y() - eps * across.Y()), across.Reverse();
+    const gp_Pnt2d inside(q.X() + eps * across.X(), q.Y() + eps * across.Y());
     gp_Pnt p;
     gp_Vec xu, xv;
     s.D1(inside.X(), inside.Y(), p, xu, xv);
@@ -753,8 +764,14 @@ void ModelSurface::mesh_faces(const Progress& progress) {
       continue;
     }
     const long nin = static_cast<long>(fo.global.size());
-    std::vector<int> to_global(fo.X.rows());
-    for (long i = 0; i < fo.X.rows(); ++i) to_global[i] = i < nin ? fo.global[i] : new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
+    // the face's own nodes that its triangles use (the optimiser's collapses leave some unused)
+    std::vector<int> to_global(fo.X.rows(), -1);
+    for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];
+    for (long t = 0; t < fo.T.rows(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int i = fo.T(t, k);
+        if (to_global[i] < 0) to_global[i] = new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
+      }
     const bool flip = topo_.faces(f + 1).Orientation() == TopAbs_REVERSED;
     auto& tris = face_tris_[f];
     tris.clear();

@@ -16,13 +16,20 @@ uint64_t ekey(int a, int b) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
 }
 
+/// Two corners at one point (up to rounding): a triangle of a degenerate edge's strip (a cone's
+/// apex, a sphere's pole), whose two apex corners are one node of the surface mesh.
+bool collapsed(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  return std::min({ab, bc, ca}) <= 1e-20 * std::max({ab, bc, ca});
+}
+
 /// Smallest angle (degrees) of the 3D triangle abc.
 double min_angle(const MatX3d& X, int a, int b, int c) {
   const Eigen::Vector3d p[3] = {X.row(a), X.row(b), X.row(c)};
+  if (collapsed(p[0], p[1], p[2])) return 180;  // collapsed onto an apex: not judged
   double m = 180;
   for (int k = 0; k < 3; ++k) {
     const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
-    if (u.squaredNorm() == 0 || v.squaredNorm() == 0) return 180;  // collapsed onto an apex: not judged
     m = std::min(m, std::atan2(u.cross(v).norm(), u.dot(v)));
   }
   return m * 180 / M_PI;
@@ -35,6 +42,7 @@ bool ccw(const MatX2d& P, int a, int b, int c) {
 /// 3D normals of abc and of the surface agree (guards flips and moves against folds on
 /// surfaces that turn a lot within one triangle).
 bool faces_out(const MatX3d& X, const MatX3d& N, int a, int b, int c) {
+  if (collapsed(X.row(a), X.row(b), X.row(c))) return true;  // no normal: judged in the parameters only
   const Eigen::Vector3d n = (Eigen::Vector3d(X.row(b)) - Eigen::Vector3d(X.row(a))).cross(Eigen::Vector3d(X.row(c)) - Eigen::Vector3d(X.row(a)));
   const Eigen::Vector3d s = Eigen::Vector3d(N.row(a)) + Eigen::Vector3d(N.row(b)) + Eigen::Vector3d(N.row(c));
   return n.dot(s) > 0.5 * n.norm() * s.norm();
@@ -82,7 +90,7 @@ void neighbours(const MatX3i& T, const Stars& star, int v, std::vector<int>& out
 SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fixed, const SurfaceEval& eval,
                                          const std::vector<std::array<int, 2>>& constrained, int rounds) {
   SurfaceOptimizeStats st;
-  const long n = P.rows();
+  long n = P.rows();
   long nt = T.rows();
   X.resize(n, 3);
   MatX3d N(n, 3);  // surface normals in the parameters' orientation (Xu × Xv)
@@ -197,37 +205,79 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     return moves;
   };
 
-  // Collapse of short edges that make needles (the front sometimes leaves an edge much
-  // shorter than its neighbours where fronts meet): the edge's movable end goes onto the other
-  // end (or both onto the middle), kept only if every triangle stays valid in the parameters
-  // and the smallest angle of the region rises.
-  std::vector<char> keep_node(n, 0);
+  // Compass search in the parameters for the position of node i that maximises the smallest
+  // angle of its triangles `star` on the surface (every one valid in the parameters and facing
+  // out); returns that angle (-1 if the star is invalid where it starts) and whether i moved.
+  auto compass_node = [&](int i, const int* star_begin, const int* star_end, bool& any) {
+    auto worst = [&]() {
+      double w = 180;
+      for (const int* q = star_begin; q != star_end; ++q) {
+        if (!ccw(P, T(*q, 0), T(*q, 1), T(*q, 2)) || !faces_out(X, N, T(*q, 0), T(*q, 1), T(*q, 2))) return -1.0;
+        w = std::min(w, min_angle(X, T(*q, 0), T(*q, 1), T(*q, 2)));
+      }
+      return w;
+    };
+    any = false;
+    double len = 0;
+    int cnt = 0;
+    for (const int* q = star_begin; q != star_end; ++q)
+      for (int j = 0; j < 3; ++j)
+        if (T(*q, j) != i) len += (P.row(T(*q, j)) - P.row(i)).norm(), ++cnt;
+    double best = worst();
+    if (!cnt || best < 0) return best;
+    double step = 0.1 * len / cnt;
+    for (int it = 0; it < 30 && step > 1e-3 * len / cnt; ++it) {
+      bool moved = false;
+      for (int d = 0; d < 4 && !moved; ++d) {
+        const Eigen::RowVector2d old_p = P.row(i);
+        const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
+        const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
+        P(i, d / 2) += d % 2 ? -step : step;
+        evaluate(i);
+        const double now = worst();
+        if (now > best) {
+          best = now, moved = any = true;
+        } else {
+          P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
+        }
+      }
+      if (!moved) step *= 0.5;
+    }
+    return best;
+  };
+
+  // Collapse of an edge: its movable end b goes onto the other end a (or both onto the
+  // middle when both may move), kept only if every triangle stays valid in the parameters and
+  // the smallest angle of the region rises. Tried on short edges that make needles (the front
+  // sometimes leaves an edge much shorter than its neighbours where fronts meet), and on
+  // triangles below kBadAngle: each edge of theirs, then each movable corner onto each of its
+  // neighbours (a node squeezed against a boundary segment makes a flat cap that no move or
+  // flip can open).
+  constexpr double kBadAngle = 20;
+  // nodes that never move: below `fixed`; the ends of constrained edges may move (the apex's
+  // neighbours on a cone) but are never removed
+  std::vector<char> keep_node(n, 0), pinned(n, 0);
   for (long i = 0; i < fixed; ++i) keep_node[i] = 1;
-  for (const auto& e : constrained) keep_node[e[0]] = keep_node[e[1]] = 1;
+  for (const auto& e : constrained) pinned[e[0]] = pinned[e[1]] = 1;
   std::vector<char> dead(nt, 0);
   auto collapse_sweep = [&]() {
     long done = 0;
     Stars star;
     star.build(T, nt, n, dead);
     std::vector<char> busy(n, 0);
-    std::vector<int> na, nb, region;
-    for (int t0 = 0; t0 < nt; ++t0) {
-      if (dead[t0]) continue;
-      // the triangle's shortest edge, if clearly shorter than the other two
-      double l[3];
-      for (int k = 0; k < 3; ++k) l[k] = (X.row(T(t0, k)) - X.row(T(t0, (k + 1) % 3))).norm();
-      const int k = l[0] <= l[1] && l[0] <= l[2] ? 0 : (l[1] <= l[2] ? 1 : 2);
-      if (l[k] > 0.7 * std::min(l[(k + 1) % 3], l[(k + 2) % 3])) continue;
-      int a = T(t0, k), b = T(t0, (k + 1) % 3);
-      if (keep_node[b]) std::swap(a, b);
-      if (keep_node[b] || busy[a] || busy[b]) continue;
+    std::vector<int> na, nb, region, live;
+    std::vector<Eigen::RowVector3i> saved;
+    auto try_collapse = [&](int a, int b) {
+      if (keep_node[b] || pinned[b]) std::swap(a, b);
+      if (keep_node[b] || pinned[b] || busy[a] || busy[b] || a == b) return false;
       // link condition: a and b share exactly the two apexes of the edge's triangles
       neighbours(T, star, a, na), neighbours(T, star, b, nb);
+      if (!std::binary_search(na.begin(), na.end(), b)) return false;
       int common = 0;
       for (int v : na) common += std::binary_search(nb.begin(), nb.end(), v);
       int shared = 0;
       for (int t : star[b]) shared += (T(t, 0) == a || T(t, 1) == a || T(t, 2) == a);
-      if (common != 2 || shared != 2) continue;
+      if (common != 2 || shared != 2) return false;
       region.assign(star[a].begin(), star[a].end());
       region.insert(region.end(), star[b].begin(), star[b].end());
       std::sort(region.begin(), region.end());
@@ -237,31 +287,10 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       const Eigen::RowVector2d pa = P.row(a), pb = P.row(b);
       const Eigen::RowVector3d xa = X.row(a), na_ = N.row(a);
       const Eigen::Vector3d ua = Xu[a], va = Xv[a];
-      if (!keep_node[a]) {
-        P.row(a) = 0.5 * (pa + pb);
-        evaluate(a);
-      }
-      // b's triangles without a now use a
-      bool ok = true;
-      double after = 180;
+      // apply: the edge's two triangles go, b's others now use a
+      saved.clear(), live.clear();
       for (int t : region) {
-        int v[3] = {T(t, 0), T(t, 1), T(t, 2)};
-        bool has_a = false, has_b = false;
-        for (int& x : v) has_a |= x == a, has_b |= x == b;
-        if (has_a && has_b) continue;  // removed
-        for (int& x : v)
-          if (x == b) x = a;
-        if (!ccw(P, v[0], v[1], v[2]) || !faces_out(X, N, v[0], v[1], v[2])) {
-          ok = false;
-          break;
-        }
-        after = std::min(after, min_angle(X, v[0], v[1], v[2]));
-      }
-      if (!ok || after <= before + 1) {
-        P.row(a) = pa, X.row(a) = xa, N.row(a) = na_, Xu[a] = ua, Xv[a] = va;
-        continue;
-      }
-      for (int t : region) {
+        saved.push_back(T.row(t));
         bool has_a = false, has_b = false;
         for (int j = 0; j < 3; ++j) has_a |= T(t, j) == a, has_b |= T(t, j) == b;
         if (has_a && has_b) {
@@ -270,11 +299,68 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
         }
         for (int j = 0; j < 3; ++j)
           if (T(t, j) == b) T(t, j) = a;
+        live.push_back(t);
+      }
+      auto region_min = [&]() {
+        double w = 180;
+        for (int t : live) {
+          if (!ccw(P, T(t, 0), T(t, 1), T(t, 2)) || !faces_out(X, N, T(t, 0), T(t, 1), T(t, 2))) return -1.0;
+          w = std::min(w, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+        }
+        return w;
+      };
+      // where a stays: in place, or if it may move, the best of the middle and b's place,
+      // then refined by a compass search
+      double after = region_min();
+      if (!keep_node[a]) {
+        Eigen::RowVector2d best_p = pa;
+        for (const Eigen::RowVector2d& q : {Eigen::RowVector2d(0.5 * (pa + pb)), pb}) {
+          P.row(a) = q;
+          evaluate(a);
+          const double w = region_min();
+          if (w > after) after = w, best_p = q;
+        }
+        P.row(a) = best_p;
+        evaluate(a);
+        if (after > 0) {
+          bool moved = false;
+          after = compass_node(a, live.data(), live.data() + live.size(), moved);
+        }
+      }
+      if (after <= before + 1) {
+        for (size_t k = 0; k < region.size(); ++k) T.row(region[k]) = saved[k], dead[region[k]] = 0;
+        P.row(a) = pa, X.row(a) = xa, N.row(a) = na_, Xu[a] = ua, Xv[a] = va;
+        return false;
       }
       busy[a] = busy[b] = 1;
       for (int v : na) busy[v] = 1;
       for (int v : nb) busy[v] = 1;
       ++done;
+      return true;
+    };
+    std::vector<int> around;
+    for (int t0 = 0; t0 < nt; ++t0) {
+      if (dead[t0]) continue;
+      double l[3];
+      for (int k = 0; k < 3; ++k) l[k] = (X.row(T(t0, k)) - X.row(T(t0, (k + 1) % 3))).norm();
+      int order[3] = {0, 1, 2};
+      std::sort(order, order + 3, [&](int p, int q) { return l[p] < l[q]; });
+      const int k = order[0];
+      // the triangle's shortest edge, if clearly shorter than the other two
+      if (l[k] <= 0.7 * std::min(l[(k + 1) % 3], l[(k + 2) % 3]) && try_collapse(T(t0, k), T(t0, (k + 1) % 3))) continue;
+      if (min_angle(X, T(t0, 0), T(t0, 1), T(t0, 2)) >= kBadAngle) continue;
+      bool gone = false;
+      for (int e = 0; e < 3 && !gone; ++e) gone = try_collapse(T(t0, order[e]), T(t0, (order[e] + 1) % 3));
+      for (int c = 0; c < 3 && !gone; ++c) {
+        const int b = T(t0, c);
+        if (keep_node[b] || pinned[b] || busy[b]) continue;
+        neighbours(T, star, b, around);
+        std::sort(around.begin(), around.end(), [&](int p, int q) {
+          return (X.row(p) - X.row(b)).squaredNorm() < (X.row(q) - X.row(b)).squaredNorm();
+        });
+        for (int a : around)
+          if ((gone = try_collapse(a, b))) break;
+      }
     }
     // drop the removed triangles
     if (done) {
@@ -300,39 +386,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       for (int k = 0; k < 3; ++k) {
         const int i = T(t, k);
         if (i < fixed || keep_node[i]) continue;
-        auto worst = [&]() {
-          double w = 180;
-          for (int q : star[i]) {
-            if (!ccw(P, T(q, 0), T(q, 1), T(q, 2)) || !faces_out(X, N, T(q, 0), T(q, 1), T(q, 2))) return -1.0;
-            w = std::min(w, min_angle(X, T(q, 0), T(q, 1), T(q, 2)));
-          }
-          return w;
-        };
-        double len = 0;
-        int cnt = 0;
-        for (int q : star[i])
-          for (int j = 0; j < 3; ++j)
-            if (T(q, j) != i) len += (P.row(T(q, j)) - P.row(i)).norm(), ++cnt;
-        if (!cnt) continue;
-        double step = 0.1 * len / cnt, best = worst();
         bool any = false;
-        for (int it = 0; it < 30 && step > 1e-3 * len / cnt; ++it) {
-          bool moved = false;
-          for (int d = 0; d < 4 && !moved; ++d) {
-            const Eigen::RowVector2d old_p = P.row(i);
-            const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
-            const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
-            P(i, d / 2) += d % 2 ? -step : step;
-            evaluate(i);
-            const double now = worst();
-            if (now > best) {
-              best = now, moved = any = true;
-            } else {
-              P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
-            }
-          }
-          if (!moved) step *= 0.5;
-        }
+        compass_node(i, star[i].begin(), star[i].end(), any);
         moves += any;
       }
     }
@@ -345,8 +400,85 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     st.moves += smooth_sweep();
   }
   st.flips += flip_sweep();
+  // A triangle whose three corners may not move (a corner of the face closed by one triangle
+  // between two boundary segments of unequal length, e.g. 1 and 1.25: 39°) gets its longest
+  // edge split when that edge is inside the face: a new node at its middle, placed by the
+  // compass search, kept when the smallest angle of the four triangles rises.
+  auto split_sweep = [&]() {
+    std::vector<int> cand;
+    for (int t = 0; t < nt; ++t)
+      if (keep_node[T(t, 0)] && keep_node[T(t, 1)] && keep_node[T(t, 2)] && min_angle(X, T(t, 0), T(t, 1), T(t, 2)) < 40)
+        cand.push_back(t);
+    if (cand.empty()) return 0L;
+    std::unordered_map<uint64_t, std::array<int, 2>> edge_tris;
+    edge_tris.reserve(3 * nt);
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) {
+        auto [it, fresh] = edge_tris.try_emplace(ekey(T(t, k), T(t, (k + 1) % 3)), std::array<int, 2>{t, -1});
+        if (!fresh) it->second[1] = t;
+      }
+    // room for every candidate's node and two triangles, trimmed afterwards
+    const long extra = static_cast<long>(cand.size());
+    P.conservativeResize(n + extra, 2), X.conservativeResize(n + extra, 3), N.conservativeResize(n + extra, 3);
+    Xu.resize(n + extra), Xv.resize(n + extra), keep_node.resize(n + extra, 0), pinned.resize(n + extra, 0);
+    T.conservativeResize(nt + 2 * extra, 3);
+    std::vector<char> touched(nt, 0);
+    long done = 0;
+    for (int t0 : cand) {
+      if (touched[t0]) continue;
+      double l[3];
+      for (int k = 0; k < 3; ++k) l[k] = (X.row(T(t0, k)) - X.row(T(t0, (k + 1) % 3))).norm();
+      const int k = l[0] >= l[1] && l[0] >= l[2] ? 0 : (l[1] >= l[2] ? 1 : 2);
+      const int a = T(t0, k), b = T(t0, (k + 1) % 3), c = T(t0, (k + 2) % 3);
+      if (locked.count(ekey(a, b))) continue;
+      const auto it = edge_tris.find(ekey(a, b));
+      if (it == edge_tris.end()) continue;
+      const int t1 = it->second[0] == t0 ? it->second[1] : it->second[0];
+      if (t1 < 0 || touched[t1]) continue;
+      int d = -1, holds = 0;
+      for (int j = 0; j < 3; ++j) {
+        const int v = T(t1, j);
+        if (v == a || v == b) ++holds; else d = v;
+      }
+      if (holds != 2 || d < 0) continue;
+      const double before = std::min(min_angle(X, a, b, c), min_angle(X, b, a, d));
+      const int bad_before = (min_angle(X, a, b, c) < 20) + (min_angle(X, b, a, d) < 20);
+      const int m = static_cast<int>(n);
+      P.row(m) = 0.5 * (P.row(a) + P.row(b));
+      evaluate(m);
+      const Eigen::RowVector3i r0 = T.row(t0), r1 = T.row(t1);
+      const int star[4] = {t0, t1, static_cast<int>(nt), static_cast<int>(nt) + 1};
+      T.row(t0) << a, m, c;
+      T.row(nt) << m, b, c;
+      T.row(t1) << b, m, d;
+      T.row(nt + 1) << m, a, d;
+      bool moved = false;
+      const double after = compass_node(m, star, star + 4, moved);
+      // and no more triangles below 20° than before (two of 19.9° for one of 12° is no gain
+      // for the share of bad triangles)
+      int bad_after = 0;
+      for (int q : star) bad_after += min_angle(X, T(q, 0), T(q, 1), T(q, 2)) < 20;
+      if (after <= before + 0.5 || bad_after > bad_before) {
+        T.row(t0) = r0, T.row(t1) = r1;
+        continue;
+      }
+      touched[t0] = touched[t1] = 1;
+      ++n, nt += 2, ++done;
+    }
+    P.conservativeResize(n, 2), X.conservativeResize(n, 3), N.conservativeResize(n, 3);
+    Xu.resize(n), Xv.resize(n), keep_node.resize(n), pinned.resize(n);
+    T.conservativeResize(nt, 3);
+    dead.assign(nt, 0);
+    return done;
+  };
+
   for (int r = 0; r < std::min(rounds, 2); ++r) {
     st.moves += compass_sweep();
+    st.flips += flip_sweep();
+    st.collapses += collapse_sweep();
+  }
+  if (rounds > 0) {
+    st.splits += split_sweep();
     st.flips += flip_sweep();
   }
   st.min_angle_after = 180;

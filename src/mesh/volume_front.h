@@ -24,7 +24,8 @@
 namespace topopt::mesh {
 
 struct VolumeFillParams {
-  /// Target edge length at a point; empty: interpolated from the boundary's edge lengths.
+  /// Target edge length at a point; empty: graded from the boundary's (and T0's) edge lengths
+  /// by 0.3 per unit distance up to the longest of them (BackgroundSize, background_size.h).
   std::function<double(const double*)> size;
   double min_quality = 0.25;    ///< radius ratio a new tet must reach on the first pass
   int passes = 4;               ///< widening passes over faces that failed
@@ -43,7 +44,8 @@ struct VolumeFillResult {
 
 /// Fills the region bounded by F (#F by 3, oriented with normals pointing OUT of the region)
 /// on nodes V (#V by 3), around the existing tets T0 (#T0 by 4, kept, may be empty).
-/// Throws Error(MeshingFailed) naming where the front could not be closed.
+/// Throws Error(MeshingFailed) naming where the front could not be closed, or where it went
+/// on making tets past ten times what its size asks for (expected_tets) without closing.
 VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params = {},
                              const Progress& progress = {});
 
