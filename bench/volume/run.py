@@ -92,9 +92,17 @@ def run_netgen(P, F, h):
     fd = m.Add(FaceDescriptor(bc=1, domin=1, domout=0, surfnr=1))
     for t in F:
         m.Add(Element2D(fd, [ids[int(i)] for i in t]))
-    t = time.perf_counter()
-    m.GenerateVolumeMesh(MeshingParameters(maxh=h))
-    dt = time.perf_counter() - t
+    # Netgen's C++ still writes "generate vol mesh" to stdout, which would land in the table
+    sys.stdout.flush()
+    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    try:
+        t = time.perf_counter()
+        m.GenerateVolumeMesh(MeshingParameters(maxh=h))
+        dt = time.perf_counter() - t
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved), os.close(devnull)
     Pn = np.array([[p[0], p[1], p[2]] for p in m.Points()])
     T = np.array([[v.nr - 1 for v in e.vertices] for e in m.Elements3D()], dtype=np.int64)
     return dt, Pn, T

@@ -22,6 +22,7 @@ int cmd_surface(const Args& args) {
               "  Meshes every face of PART (STEP or BREP) with the native surface mesher: a closed,\n"
               "  consistently oriented triangulation per solid, each triangle tagged with its face.\n"
               "  --size   target edge length in mm (default: part diagonal / 50)\n"
+              "  --out    binary STL; each triangle's attribute bytes hold its face number (FaceN)\n"
               "  --stats  counts, open edges per solid, self-intersections, angles, time (JSON)\n"
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
   if (a.print_help()) return 0;
@@ -60,7 +61,7 @@ int cmd_surface(const Args& args) {
   for (size_t k = 0; k < m.failed_faces.size(); ++k)
     std::cout << "  Face" << m.failed_faces[k] << ": " << m.reasons[k] << "\n";
   if (!out.empty()) {
-    io::write_stl(out, m.V, m.F, "TopOpt surface mesh");
+    io::write_stl(out, m.V, m.F, "TopOpt surface mesh", &m.face);
     std::cout << "wrote " << out << "\n";
   }
   if (!stats.empty()) {

@@ -1,6 +1,7 @@
 // Binary STL writer (see stl.h).
 #include "io/stl.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -9,7 +10,7 @@
 
 namespace topopt::io {
 
-void write_stl(const std::string& path, const MatX3d& V, const MatX3i& F, const std::string& header) {
+void write_stl(const std::string& path, const MatX3d& V, const MatX3i& F, const std::string& header, const VecXi* tags) {
   FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw Error(ErrorCode::Io, "cannot write " + path);
   char head[80] = {};
@@ -26,7 +27,7 @@ void write_stl(const std::string& path, const MatX3d& V, const MatX3i& F, const 
     for (int v = 0; v < 3; ++v)
       for (int k = 0; k < 3; ++k) rec[3 + 3 * v + k] = static_cast<float>(V(F(t, v), k));
     std::fwrite(rec, 4, 12, f);
-    uint16_t attr = 0;
+    const uint16_t attr = tags ? static_cast<uint16_t>(std::clamp((*tags)[t], 0, 65535)) : 0;
     std::fwrite(&attr, 2, 1, f);
   }
   bool ok = std::ferror(f) == 0;

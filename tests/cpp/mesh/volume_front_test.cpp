@@ -269,17 +269,25 @@ double winding_number(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& x
   return sum / (4 * M_PI);
 }
 
+/// Our surface mesh of a part of ../shared/data at its default size (diagonal / 50, also
+/// returned in `size`).
+SurfaceMesh default_surface(const std::string& file, double* size = nullptr) {
+  const brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/" + file));
+  SurfaceMeshParams sp;
+  sp.size = topo.diagonal() / 50;
+  if (size) *size = sp.size;
+  return mesh_surface(topo, sp);
+}
+
 TEST(DelaunayBulk, HoldsTheRockersSurfaceAndLiesInside) {
   // the rocker's surface from our surface mesher at its default size (a real, non-convex part
   // with holes), refined inside to half that size
-  brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/examples/rocker.step"));
-  SurfaceMeshParams sp;
-  sp.size = topo.diagonal() / 50;
-  const SurfaceMesh s = mesh_surface(topo, sp);
+  double size = 0;
+  const SurfaceMesh s = default_surface("examples/rocker.step", &size);
   ASSERT_TRUE(s.failed_faces.empty());
   std::vector<Eigen::Vector3d> P = points_of(s.V);
   DelaunayBulkParams dp;
-  const double h = sp.size / 2;
+  const double h = size / 2;
   dp.size = [h](const double*) { return h; };
   DelaunayBulkResult r = delaunay_bulk(P, triangles_of(s.F), dp);
   // a surface mesh of well-shaped triangles is (nearly) Delaunay: the tetrahedralisation of
@@ -350,10 +358,7 @@ TEST(DelaunayBulk, FrontClosesTheHolesAroundTrianglesItLacks) {
   // coplanar: the flipped pairs are no longer Delaunay, so the bulk leaves holes there (few
   // enough for the bulk to be used), and the front must close them conformally. (The flipped
   // triangles are poorly shaped, so no quality bound is asserted here.)
-  brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/examples/rocker.step"));
-  SurfaceMeshParams sp;
-  sp.size = topo.diagonal() / 50;
-  SurfaceMesh s = mesh_surface(topo, sp);
+  SurfaceMesh s = default_surface("examples/rocker.step");
   ASSERT_TRUE(s.failed_faces.empty());
   MatX3i& F = s.F;
   std::map<std::pair<int, int>, int> owner;  // directed edge -> triangle
@@ -401,10 +406,7 @@ TEST(VolumeFill, GradesFromAFineBoundaryWithoutASize) {
   // triangles missing, and the front fills alone). Without a size the front used to keep its
   // finest faces' size across the whole volume and ran towards 20 M tets; the size now grows
   // from the boundary's spacing
-  brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/occt/CrankArm.brep"));
-  SurfaceMeshParams sp;
-  sp.size = topo.diagonal() / 50;
-  const SurfaceMesh s = mesh_surface(topo, sp);
+  const SurfaceMesh s = default_surface("occt/CrankArm.brep");
   ASSERT_TRUE(s.failed_faces.empty());
   double volume = 0;
   for (long t = 0; t < s.F.rows(); ++t)
