@@ -1259,7 +1259,10 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     params.size = [background](const double* x) { return background->at(x); };
   }
   // the front's budget: many times the tets its size asks for, and room for a fine boundary
-  const double expected = params.size ? expected_tets(V, F, params.size) : 0.0;
+  // (the grid resolves the region about as finely as its boundary: 8 cells per triangle, at
+  // least 100 k, at most 1 M)
+  const long cells = std::clamp(8 * static_cast<long>(F.rows()), 100'000L, 1'000'000L);
+  const double expected = params.size ? expected_tets(V, F, params.size, cells) : 0.0;
   const long budget = expected > 0 ? static_cast<long>(kBudgetFactor * expected) + 30 * F.rows() + 100'000 : 0;
   progress.info("volume: the size asks for about " + std::to_string(static_cast<long>(expected)) + " tets");
   if (!params.delaunay_bulk) return fill(V, F, T0, params, budget, progress);
