@@ -495,17 +495,18 @@ void compass_search_at_bad_tets(std::vector<Vec3>& P, const std::vector<std::arr
   }
 }
 
+/// A replacement may not leave more tets below this share of the threshold than it removes.
+constexpr double kSliverShare = 0.25;
+
 /// Sliver removal by point insertion: each new tet below `bad` is taken out with its new
 /// neighbours across its faces (and, when that is not enough, one more layer of them), and
 /// the cavity is filled again as a star from one new point: the point that maximises the
 /// worst radius ratio of the star (a compass search from the cavity's centroid), kept only
-/// where it sees every cavity face (so the star tiles the cavity exactly) and the star's worst
-/// tet is better than the cavity's. Removes what flips cannot: a tet with two faces on the
+/// where it sees every cavity face (so the star tiles the cavity exactly), the star's worst
+/// tet is better than the cavity's and it has no more slivers (kSliverShare) than the cavity
+/// had. Removes what flips cannot: a tet with two faces on the
 /// boundary. Input tets and boundary faces stay (they are faces of the star). Returns the
 /// number of cavities re-filled.
-/// A replacement may not leave more tets below this share of the threshold than it removes.
-constexpr double kSliverShare = 0.25;
-
 long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 4>>& tets, double bad) {
   long done = 0;
   auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
