@@ -105,6 +105,14 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     N.row(i) = nn.norm() > 0 ? Eigen::RowVector3d(nn.normalized()) : Eigen::RowVector3d::Zero();
   };
   for (long i = 0; i < n; ++i) evaluate(i);
+  // a node's position with what evaluate() derived from it, to put back a move that failed
+  struct NodeState {
+    Eigen::RowVector2d p;
+    Eigen::RowVector3d x, n;
+    Eigen::Vector3d u, v;
+  };
+  auto save = [&](long i) { return NodeState{P.row(i), X.row(i), N.row(i), Xu[i], Xv[i]}; };
+  auto restore = [&](long i, const NodeState& s) { P.row(i) = s.p, X.row(i) = s.x, N.row(i) = s.n, Xu[i] = s.u, Xv[i] = s.v; };
   st.min_angle_before = 180;
   for (long t = 0; t < nt; ++t) st.min_angle_before = std::min(st.min_angle_before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
   std::unordered_set<uint64_t> locked;
@@ -172,12 +180,10 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
         const double m = min_angle(X, T(t, 0), T(t, 1), T(t, 2));
         old_min = std::min(old_min, m), old_sum += m;
       }
-      const Eigen::RowVector2d old_p = P.row(i);
-      const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
-      const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
+      const NodeState old = save(i);
       bool ok = false;
       for (double step : {1.0, 0.5, 0.25}) {
-        P.row(i) = old_p + step * dlt.transpose();
+        P.row(i) = old.p + step * dlt.transpose();
         bool valid = true;
         for (int t : star[i]) valid &= ccw(P, T(t, 0), T(t, 1), T(t, 2));
         if (!valid) continue;
@@ -199,7 +205,7 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       if (ok) {
         ++moves;
       } else {
-        P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
+        restore(i, old);
       }
     }
     return moves;
@@ -229,16 +235,14 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     for (int it = 0; it < 30 && step > 1e-3 * len / cnt; ++it) {
       bool moved = false;
       for (int d = 0; d < 4 && !moved; ++d) {
-        const Eigen::RowVector2d old_p = P.row(i);
-        const Eigen::RowVector3d old_x = X.row(i), old_n = N.row(i);
-        const Eigen::Vector3d old_u = Xu[i], old_v = Xv[i];
+        const NodeState old = save(i);
         P(i, d / 2) += d % 2 ? -step : step;
         evaluate(i);
         const double now = worst();
         if (now > best) {
           best = now, moved = any = true;
         } else {
-          P.row(i) = old_p, X.row(i) = old_x, N.row(i) = old_n, Xu[i] = old_u, Xv[i] = old_v;
+          restore(i, old);
         }
       }
       if (!moved) step *= 0.5;
@@ -284,9 +288,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       region.erase(std::unique(region.begin(), region.end()), region.end());
       double before = 180;
       for (int t : region) before = std::min(before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
-      const Eigen::RowVector2d pa = P.row(a), pb = P.row(b);
-      const Eigen::RowVector3d xa = X.row(a), na_ = N.row(a);
-      const Eigen::Vector3d ua = Xu[a], va = Xv[a];
+      const NodeState old_a = save(a);
+      const Eigen::RowVector2d pa = old_a.p, pb = P.row(b);
       // apply: the edge's two triangles go, b's others now use a
       saved.clear(), live.clear();
       for (int t : region) {
@@ -329,7 +332,7 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       }
       if (after <= before + 1) {
         for (size_t k = 0; k < region.size(); ++k) T.row(region[k]) = saved[k], dead[region[k]] = 0;
-        P.row(a) = pa, X.row(a) = xa, N.row(a) = na_, Xu[a] = ua, Xv[a] = va;
+        restore(a, old_a);
         return false;
       }
       busy[a] = busy[b] = 1;
