@@ -13,6 +13,7 @@
 #pragma once
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "brep/topology_index.h"
@@ -125,7 +126,10 @@ class ModelSurface {
     std::vector<int> seg_edge;
     std::vector<int> seg_piece;
   };
+  std::vector<std::pair<double, int>> division(int e) const;
   void discretise(int e);
+  void match_vertex_sizes();
+  void grade_vertex_sizes();
   void refresh_alias(int e);
   Loops face_loops(int f) const;
   struct FaceOut {
