@@ -29,6 +29,7 @@
 #include <set>
 #include <sstream>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "common/error.h"
 #include "common/parallel.h"
@@ -141,6 +142,10 @@ std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<doub
 /// At most this many pieces on a collapsed edge: the fan around a cone apex or a sphere pole
 /// has about as many triangles, so their angles there stay near 360° / 12 or more.
 constexpr int kMaxApexPieces = 12;
+/// A face corner sharper than this (radians) is closed by one needle triangle; one sharper
+/// than kCuspAngle is a cusp (see mesh_edges).
+constexpr double kNeedleAngle = 30 * M_PI / 180;
+constexpr double kCuspAngle = 5 * M_PI / 180;
 
 /// The angle (rad) the surface of `face` sweeps around a collapsed edge (cone apex, sphere
 /// pole) whose parameter curve is pc on [t0, t1]: the turning of the surface's derivative
@@ -525,6 +530,59 @@ void ModelSurface::mesh_edges(const Progress& progress) {
   // Given edges are never split; a piece of an aliased edge is split on the edge it copies.
   // Each round looks again only at the faces one of whose edges was split.
   const double floor_len = hmin_ / 8;
+  // (edge, piece) of the edge a piece's splits go to: itself, or the free edge an alias copies
+  auto free_piece = [&](int e, int piece) {
+    if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return std::pair<int, int>{-1, -1};
+    if (edge_kind_[e] == EdgeKind::Alias) {
+      const auto [rep, reversed] = alias_of_[e];
+      if (edge_kind_[rep] != EdgeKind::Free) return std::pair<int, int>{-1, -1};
+      if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
+      e = rep;
+    }
+    return std::pair<int, int>{e, piece};
+  };
+  // The two pieces at a corner of a face sharper than kNeedleAngle (measured on the pieces
+  // themselves, in the face's scaled parameters, where the face lies left of its loops) are
+  // not split, in any face, unless they cross another piece: one needle triangle takes the
+  // corner's angle (NIST 1's 11° slots, arcs tangent to a line). The pieces beyond are split
+  // by the rules below like any others, which grades them away from the corner. At a corner
+  // below kCuspAngle the pieces near it are only split where they cross: that close to a
+  // cusp, splitting makes ever thinner triangles, while longer chords open the corner up.
+  std::vector<std::array<char, 2>> needle_end(ne, {0, 0});  // first / last piece of each edge
+  std::unordered_set<int> cusp;                            // nodes of corners below kCuspAngle
+  for (int f = 0; f < nf; ++f) {
+    if (face_given_[f]) continue;
+    const Loops L = face_loops(f);
+    std::unordered_map<int, int> in, out;  // local node -> the piece ending / starting there
+    std::unordered_set<int> many;
+    for (size_t i = 0; i < L.segs.size(); ++i) {
+      if (!in.emplace(L.segs[i][1], static_cast<int>(i)).second) many.insert(L.segs[i][1]);
+      if (!out.emplace(L.segs[i][0], static_cast<int>(i)).second) many.insert(L.segs[i][0]);
+    }
+    for (const auto& [node, a] : in) {
+      const auto it = out.find(node);
+      if (it == out.end() || many.count(node)) continue;
+      const int b = it->second;
+      const auto &P = L.uv[L.segs[a][0]], &Q = L.uv[node], &R = L.uv[L.segs[b][1]];
+      const double d1[2] = {Q[0] - P[0], Q[1] - P[1]}, d2[2] = {R[0] - Q[0], R[1] - Q[1]};
+      const double turn = std::atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1]);
+      const double corner = M_PI - turn;
+      if (corner >= kNeedleAngle) continue;
+      if (corner < kCuspAngle) {
+        cusp.insert(L.global[node]);
+        continue;
+      }
+      for (int sgm : {a, b}) {
+        const auto [e, piece] = free_piece(L.seg_edge[sgm], L.seg_piece[sgm]);
+        if (e < 0) continue;
+        if (piece == 0) needle_end[e][0] = 1;
+        if (piece + 2 == static_cast<int>(edge_node_[e].size())) needle_end[e][1] = 1;
+      }
+    }
+  }
+  auto is_needle = [&](int e, int piece) {
+    return (piece == 0 && needle_end[e][0]) || (piece + 2 == static_cast<int>(edge_node_[e].size()) && needle_end[e][1]);
+  };
   std::vector<char> stale(nf, 1);
   for (int round = 0; round < 10; ++round) {
     std::vector<std::vector<int>> split(ne);  // pieces of each edge to split
@@ -557,27 +615,21 @@ void ModelSurface::mesh_edges(const Progress& progress) {
       auto dist3 = [&](int v, const Loops& LL, int i) {  // from node v to the nearer end of segment i
         return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]), sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
       };
-      // segments i and j of two different edges that end at one vertex, both within two of
-      // their lengths of it (3D)
-      auto near_shared_vertex = [&](const Loops& LL, int i, int j) {
-        const int ei = LL.seg_edge[i], ej = LL.seg_edge[j];
+      // segments i and j of two different edges that end at one cusp's node, both within four
+      // of their lengths of it (3D)
+      auto near_cusp = [&](int i, int j) {
+        const int ei = L.seg_edge[i], ej = L.seg_edge[j];
         if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
         const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()}, vj{edge_node_[ej].front(), edge_node_[ej].back()};
-        const double reach = 4 * std::max(len3(LL, i), len3(LL, j));
+        const double reach = 4 * std::max(len3(L, i), len3(L, j));
         for (int v : vi)
           for (int w : vj)
-            if (v == w && dist3(v, LL, i) < reach && dist3(v, LL, j) < reach) return true;
+            if (v == w && cusp.count(v) && dist3(v, L, i) < reach && dist3(v, L, j) < reach) return true;
         return false;
       };
-      auto mark = [&](int s) {
-        int e = L.seg_edge[s], piece = L.seg_piece[s];
-        if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return;
-        if (edge_kind_[e] == EdgeKind::Alias) {
-          const auto [rep, reversed] = alias_of_[e];
-          if (edge_kind_[rep] != EdgeKind::Free) return;
-          if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
-          e = rep;
-        }
+      auto mark = [&](int s, bool crossing = false) {
+        auto [e, piece] = free_piece(L.seg_edge[s], L.seg_piece[s]);
+        if (e < 0 || (!crossing && is_needle(e, piece))) return;
         const auto& ids = edge_node_[e];
         const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
         if (l3 > floor_len) split[e].push_back(piece), any = true;
@@ -609,15 +661,10 @@ void ModelSurface::mesh_edges(const Progress& progress) {
                              predicates::orient2d(C.data(), D.data(), A.data()) *
                                      predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
           const double d = cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
-          // near a cusp (two edges leaving a vertex almost tangentially) the pieces are close
-          // only because the corner is sharp: splitting them makes ever thinner triangles,
-          // while longer chords open the corner up; there only pieces that cross are split
-          if (d < gap && !cross && near_shared_vertex(L, i, j)) continue;
-          if (d < gap) {
-            // the longer one is what leaves no room; both when they cross
-            if (cross || len[i] >= 0.7 * len[j]) mark(i);
-            if (cross || len[j] >= 0.7 * len[i]) mark(j);
-          }
+          if (d >= gap || (!cross && near_cusp(i, j))) continue;
+          // the longer one is what leaves no room; both when they cross
+          if (cross || len[i] >= 0.7 * len[j]) mark(i, cross);
+          if (cross || len[j] >= 0.7 * len[i]) mark(j, cross);
         }
       }
     }

@@ -98,17 +98,17 @@ CornerAngles corner_angles(const SurfaceMesh& m) {
 
 TEST(SurfaceMesher, TrianglesBelowTwentyDegreesOnlyWhereTheGeometryForcesThem) {
   // A face corner sharper than 20° gives any mesh a triangle below 20° there; elsewhere the
-  // optimiser (flips, collapses, compass search, splits) should leave none. Counted per
-  // (face, node) from the angles of the face's triangles at the node.
+  // optimiser (flips, collapses, compass search, splits) and the edges' grading away from
+  // sharp corners (NIST 1's 11° slots, arcs running into a line) should leave none. Counted
+  // per (face, node) from the angles of the face's triangles at the node.
   for (double factor : {1.0, 0.5})
-    for (const auto& [name, slack] : std::vector<std::pair<std::string, long>>{
-             {"nist/NIST_MBE_PMI_4.stp", 0}, {"nist/NIST_MBE_PMI_6.stp", 0}, {"nist/NIST_MBE_PMI_1.stp", 8}}) {
+    for (std::string name : {"nist/NIST_MBE_PMI_4.stp", "nist/NIST_MBE_PMI_6.stp", "nist/NIST_MBE_PMI_1.stp"}) {
       SCOPED_TRACE(name + " at " + std::to_string(factor) + " x the default size");
       const CornerAngles a = corner_angles(mesh_at(name, factor));
       long bad = 0, sharp = 0;
       for (double s : a.smallest) bad += s < 20;
       for (const auto& [key, c] : a.corner) sharp += c.first < 20;
-      EXPECT_LE(bad, sharp + slack) << bad << " triangles below 20°, " << sharp << " corners below 20°";
+      EXPECT_LE(bad, sharp) << bad << " triangles below 20°, " << sharp << " corners below 20°";
     }
 }
 
