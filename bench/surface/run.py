@@ -135,7 +135,7 @@ def main():
           "closed, no self-intersection |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for name, h, qo, to, qg, tg, ok, s in rows:
-        print(f"| {name} | {h:.3g} | {qo[3]} / {qg[3]} | {qo[0]:.1f}° / {qg[0]:.1f}° | {qo[1]:.1f}° / {qg[1]:.1f}° | "
+        print(f"| {name} | {h:.3g} | {qo[3]} / {qg[3]} | {qo[0]:.2f}° / {qg[0]:.2f}° | {qo[1]:.1f}° / {qg[1]:.1f}° | "
               f"{100*qo[2]:.3f} % / {100*qg[2]:.3f} % | {qo[4]} / {qg[4]} ({qo[5]} / {qg[5]}) | {to:.3f} / {tg:.3f} | "
               f"{tg/max(to,1e-9):.1f}× | {'yes' if ok else 'NO'} |")
     print(f"\nTotal meshing time: ours {tot_ours:.2f} s, Gmsh {tot_gmsh:.2f} s ({tot_gmsh/max(tot_ours,1e-9):.1f}× ours).")

@@ -257,7 +257,8 @@ FaceFrontResult fill_face(const FaceFrontInput& in, const FaceFrontParams& param
       throw Error(ErrorCode::TooLarge, "face front: more than the allowed number of triangles; raise the mesh size");
     const int a = front.a(e), b = front.b(e);
     const int pass = front.fails(e);
-    const double *A = front.p(a), *B = front.p(b);
+    // copies: a tentative new node below may move the node array
+    const double A[2] = {front.p(a)[0], front.p(a)[1]}, B[2] = {front.p(b)[0], front.p(b)[1]};
     const double L = std::hypot(B[0] - A[0], B[1] - A[1]);
     const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
     const double nrm[2] = {-(B[1] - A[1]) / L, (B[0] - A[0]) / L};  // left normal
