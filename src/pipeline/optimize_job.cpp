@@ -100,12 +100,14 @@ OptimizeResult optimize_job(const io::Job& job, const TetMesh& mesh, const Progr
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
   fem::Supports supports = fem::make_supports(mesh, job.supports);
-  Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases);
+  // gravity apart: the weight of the design tets follows their density
+  Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases, false);
   std::vector<double> weights;
   for (const auto& lc : job.load_cases) weights.push_back(lc.weight);
   OptimizeResult r;
   auto t0 = std::chrono::steady_clock::now();
-  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, set.simp, progress, on_iteration);
+  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, set.simp, progress, on_iteration,
+                          fem::gravity_of(job.load_cases));
   auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
   r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold);

@@ -22,7 +22,7 @@ double mean_edge_length(const TetMesh& mesh) {
 ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& material,
                                      const fem::Supports& supports, const Eigen::MatrixXd& loads,
                                      const std::vector<double>& weights, const SimpParams& params,
-                                     const Progress& progress)
+                                     const Progress& progress, const Eigen::Matrix3Xd& gravity)
     : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
   if (!(params.volume_fraction > 0 && params.volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1 (e.g. 0.3)");
@@ -43,6 +43,20 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
   progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " +
                 std::to_string(filter_->mean_neighbours()) + " neighbours per element");
+  // self-weight: the non-design tets' weight is fixed, each design tet's scales with ρ̄
+  if (gravity.size() && !gravity.isZero()) {
+    if (gravity.cols() != loads.cols())
+      throw Error(ErrorCode::InvalidParameter, "self-weight: one gravity vector per load case is needed");
+    gravity_ = gravity;
+    quarter_mass_ = material.density * vd_ / 4;
+    if (params_.law.linear_below <= 0) params_.law.linear_below = 0.1;
+    for (long t = 0; t < nt; ++t) {
+      if (mesh.domain.size() != nt || mesh.domain[t] == 0) continue;
+      for (long k = 0; k < loads_.cols(); ++k)
+        for (int a = 0; a < 4; ++a)
+          loads_.block<3, 1>(3 * mesh.T(t, a), k) += material.density * volume[t] / 4 * gravity_.col(k);
+    }
+  }
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
   if (!params.heaviside)
@@ -71,15 +85,29 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   // ---- FE analysis
   for (int i = 0; i < nd; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
   fe_->set_scale(scale_);
-  Eigen::MatrixXd U = fe_->solve(loads_, progress_);
-  // ---- objective and sensitivities (w.r.t. ρ̄)
+  // loads: the fixed ones plus the design tets' weight, ρ̄ ρ_material vol g spread to 4 nodes
+  Eigen::MatrixXd F = loads_;
+  if (gravity_.size())
+    for (int i = 0; i < nd; ++i)
+      for (long k = 0; k < F.cols(); ++k)
+        for (int a = 0; a < 4; ++a)
+          F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += rho_bar[i] * quarter_mass_[i] * gravity_.col(k);
+  Eigen::MatrixXd U = fe_->solve(F, progress_);
+  // ---- objective c = Σ w Fᵀ U and its sensitivities (w.r.t. ρ̄):
+  // dc/dρ̄ = Σ w (2 uᵀ dF/dρ̄ − E'(ρ̄) uᵀ K₀ u) for each element
   double c = 0;
   VecXd dc_bar = VecXd::Zero(nd);
-  for (long k = 0; k < loads_.cols(); ++k) {
-    c += weights_[k] * loads_.col(k).dot(U.col(k));
+  for (long k = 0; k < F.cols(); ++k) {
+    c += weights_[k] * F.col(k).dot(U.col(k));
     if (!dc) continue;
     VecXd energy = fe_->element_energy(U.col(k));
     for (int i = 0; i < nd; ++i) dc_bar[i] -= weights_[k] * params_.law.derivative(rho_bar[i]) * energy[design_[i]];
+    if (gravity_.size())
+      for (int i = 0; i < nd; ++i) {
+        Eigen::Vector3d u_sum = Eigen::Vector3d::Zero();
+        for (int a = 0; a < 4; ++a) u_sum += U.block<3, 1>(3 * mesh_.T(design_[i], a), k);
+        dc_bar[i] += weights_[k] * 2 * quarter_mass_[i] * gravity_.col(k).dot(u_sum);
+      }
   }
   if (dc) {
     // ---- chain rule back through projection and filter
@@ -112,9 +140,10 @@ VecXd ComplianceProblem::filter_sensitivity(const VecXd& x, const VecXd& dc) con
 
 SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
-                    const Progress& progress, const std::function<void(const IterationRecord&)>& on_iteration) {
+                    const Progress& progress, const std::function<void(const IterationRecord&)>& on_iteration,
+                    const Eigen::Matrix3Xd& gravity) {
   if (params.max_iterations < 1) throw Error(ErrorCode::InvalidParameter, "the iteration cap must be at least 1");
-  ComplianceProblem problem(mesh, material, supports, loads, weights, params, progress);
+  ComplianceProblem problem(mesh, material, supports, loads, weights, params, progress, gravity);
   SimpResult res;
   res.design = problem.design();
   const int nd = static_cast<int>(res.design.size());

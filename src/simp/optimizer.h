@@ -56,9 +56,13 @@ struct SimpResult {
 /// filter, projection and FE model are built once; evaluate() runs one FE analysis.
 class ComplianceProblem {
  public:
+  /// gravity: 3 by #cases accelerations (mm/s², fem::gravity_of) whose weight is
+  /// design-dependent: each design tet weighs ρ̄ ρ_material vol, each non-design tet its full
+  /// weight; `loads` then holds the other loads only (fem::make_loads(..., false)). With any
+  /// gravity the law turns linear below ρ̄ = 0.1 unless params set linear_below.
   ComplianceProblem(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
-                    const Progress& progress = {});
+                    const Progress& progress = {}, const Eigen::Matrix3Xd& gravity = {});
   ~ComplianceProblem();
   /// Weighted compliance c(x) and, if dc is given, dc/dx (#D) through projection and filter.
   double compliance(const VecXd& x, VecXd* dc = nullptr);
@@ -81,7 +85,9 @@ class ComplianceProblem {
   double design_volume_ = 0;
   std::unique_ptr<DensityFilter> filter_;
   std::unique_ptr<fem::Elasticity> fe_;
-  Eigen::MatrixXd loads_;
+  Eigen::MatrixXd loads_;        // fixed loads, with the non-design tets' weight
+  Eigen::Matrix3Xd gravity_;     // 3 x #cases, empty without self-weight
+  VecXd quarter_mass_;           // #D: ρ_material vol / 4 of each design tet (t)
   std::vector<double> weights_;
   Heaviside proj_;
   Progress progress_;
@@ -89,14 +95,16 @@ class ComplianceProblem {
   void forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const;
 };
 
-/// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1).
+/// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1),
+/// gravity: design-dependent self-weight as for ComplianceProblem (empty: none).
 /// on_iteration is called after every iteration; progress.cancelled stops at the next
 /// iteration with Error(Cancelled). Throws Error(InvalidParameter) for a volume fraction
 /// outside (0, 1) or a mesh without design tets, Error(NoSupport) for a singular system.
 SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
                     const Progress& progress = {},
-                    const std::function<void(const IterationRecord&)>& on_iteration = {});
+                    const std::function<void(const IterationRecord&)>& on_iteration = {},
+                    const Eigen::Matrix3Xd& gravity = {});
 
 /// Mean edge length of the mesh's tets (for default filter radii).
 double mean_edge_length(const TetMesh& mesh);

@@ -4,14 +4,25 @@
 
 namespace topopt::simp {
 
-/// Relative stiffness E(ρ)/E0 = e_min + ρ^p (1 − e_min), ρ in [0, 1].
+/// Relative stiffness E(ρ)/E0 = e_min + ρ^p (1 − e_min), ρ in [0, 1]; below linear_below
+/// (if set) linear in ρ instead, e_min + ρ ρ0^(p−1) (1 − e_min), continuous at ρ0. With
+/// self-weight the load of an element grows like ρ: under ρ^p alone its stiffness would
+/// vanish faster than its weight and near-void elements would carry huge displacements
+/// (Bruyneel & Duysinx 2005).
 struct SimpLaw {
-  double penalty = 3.0;  ///< p
-  double e_min = 1e-9;   ///< stiffness of void relative to solid, keeps K regular
+  double penalty = 3.0;      ///< p
+  double e_min = 1e-9;       ///< stiffness of void relative to solid, keeps K regular
+  double linear_below = 0;   ///< ρ0; 0: the power law everywhere
 
-  double stiffness(double rho) const { return e_min + std::pow(rho, penalty) * (1 - e_min); }
+  double stiffness(double rho) const {
+    if (rho < linear_below) return e_min + rho * std::pow(linear_below, penalty - 1) * (1 - e_min);
+    return e_min + std::pow(rho, penalty) * (1 - e_min);
+  }
   /// dE/dρ (relative)
-  double derivative(double rho) const { return penalty * std::pow(rho, penalty - 1) * (1 - e_min); }
+  double derivative(double rho) const {
+    if (rho < linear_below) return std::pow(linear_below, penalty - 1) * (1 - e_min);
+    return penalty * std::pow(rho, penalty - 1) * (1 - e_min);
+  }
 };
 
 /// Smoothed Heaviside projection ρ̄ = (tanh(βη) + tanh(β(ρ̃−η))) / (tanh(βη) + tanh(β(1−η)))

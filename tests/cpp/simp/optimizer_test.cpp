@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
+#include "fem/elasticity.h"
 #include "mesh/structured_box.h"
 #include "simp/update.h"
 
@@ -35,10 +36,10 @@ Case cantilever(std::array<int, 3> cells = {12, 4, 2}) {
   return c;
 }
 
-void check_gradient(SimpParams params, unsigned seed) {
+void check_gradient(SimpParams params, unsigned seed, const Eigen::Matrix3Xd& gravity = {}) {
   Case c = cantilever({6, 2, 2});
   params.solver.recycle_factor = false;  // every solve to machine precision
-  ComplianceProblem prob(c.mesh, c.mat, c.supports, c.loads, {1.0, 0.5}, params);
+  ComplianceProblem prob(c.mesh, c.mat, c.supports, c.loads, {1.0, 0.5}, params, {}, gravity);
   const int nd = static_cast<int>(prob.design().size());
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.2, 0.8);
@@ -65,6 +66,67 @@ TEST(Simp, ComplianceGradientMatchesFiniteDifferencesThroughTheFilter) {
   check_gradient(p, 1);
   p.filter.kind = FilterKind::Cone;
   check_gradient(p, 2);
+}
+
+TEST(Simp, GradientWithSelfWeight) {
+  // the weight of a design tet follows its density: both load cases get a gravity of 1e9
+  // mm/s² (about 12 N on the whole steel block, against forces of 100 and 60 N), the second
+  // sideways, so the load's derivative counts as much as the stiffness's
+  SimpParams p;
+  p.filter.radius = 6;
+  Eigen::Matrix3Xd g(3, 2);
+  g << 0, 3e8, -1e9, 0, 0, 5e8;
+  check_gradient(p, 4, g);
+  p.heaviside = true;
+  check_gradient(p, 5, g);
+}
+
+TEST(Simp, SelfWeightFollowsTheDensity) {
+  // A block of design tets only, fixed at one end, under its own weight. At a uniform density
+  // ρ the load is ρ F₁ and the stiffness E(ρ) K₁, so c(ρ) = ρ² / E(ρ) c(1): 2 c(1) at ρ = 0.5
+  // (E = 1/8), and 5 c(1) at ρ = 0.05, where the law is linear (E = 0.05 × 0.1²) so that
+  // near-void tets do not sag under a weight their stiffness cannot carry.
+  mesh::StructuredBoxParams bp;
+  bp.size = {30, 10, 5};
+  bp.cells = {6, 2, 2};
+  const TetMesh mesh = mesh::structured_box_mesh(bp);
+  const fem::Material mat;
+  const fem::Supports supports = fem::make_supports(mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {0, 0, -9810}, 0, {}};
+  const std::vector<fem::LoadCase> cases{fem::LoadCase{"g", {weight}, 1}};
+  const Eigen::MatrixXd others = fem::make_loads(mesh, mat, cases, false);
+  EXPECT_EQ(others.norm(), 0.0);
+  SimpParams p;
+  p.solver.recycle_factor = false;
+  p.law.e_min = 0;  // the closed form without the void floor
+  ComplianceProblem prob(mesh, mat, supports, others, {}, p, {}, fem::gravity_of(cases));
+  const int nd = static_cast<int>(prob.design().size());
+  const double c1 = prob.compliance(VecXd::Ones(nd));
+  EXPECT_GT(c1, 0);
+  EXPECT_NEAR(prob.compliance(VecXd::Constant(nd, 0.5)), 2 * c1, 1e-8 * c1);
+  EXPECT_NEAR(prob.compliance(VecXd::Constant(nd, 0.05)), 5 * c1, 1e-8 * c1);
+  // at full density it is the plain analysis with the weight in the loads
+  fem::Elasticity fe(mesh, mat, supports, p.solver);
+  const Eigen::MatrixXd F = fem::make_loads(mesh, mat, cases);
+  EXPECT_NEAR(F.col(0).dot(fe.solve(F).col(0)), c1, 1e-8 * c1);
+}
+
+TEST(Simp, OcUnderSelfWeightAloneMeetsTheVolumeAndLowersTheCompliance) {
+  // a cantilever loaded by nothing but its own weight: removing material also removes load,
+  // so some sensitivities are positive (OC takes those elements to their lower move limit)
+  Case c = cantilever();
+  const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {0, -9810, 0}, 0, {}};
+  const std::vector<fem::LoadCase> cases{fem::LoadCase{"g", {weight}, 1}};
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.max_iterations = 40;
+  const SimpResult r = optimize(c.mesh, c.mat, c.supports, fem::make_loads(c.mesh, c.mat, cases, false), {}, p, {}, {},
+                                fem::gravity_of(cases));
+  ASSERT_GE(r.history.size(), 5u);
+  EXPECT_NEAR(r.history.back().volume_fraction, 0.4, 0.005);
+  EXPECT_LT(r.history.back().compliance, 0.8 * r.history.front().compliance);
+  for (long t = 0; t < c.mesh.T.rows(); ++t)
+    if (c.mesh.domain[t] != 0) EXPECT_EQ(r.density[t], 1.0);
 }
 
 TEST(Simp, GradientThroughHeavisideProjection) {
