@@ -51,8 +51,9 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
 
   m.def(
       "surface_mesh",
-      [](const std::string& brep, double size) {
+      [](const std::string& brep, double size, int wall_layers) {
         if (size < 0) throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
+        wall_layers = mesh::wall_layers_option(wall_layers);
         mesh::SurfaceMesh sm;
         std::vector<long> open;
         long crossings = 0;
@@ -62,6 +63,7 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
           const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep, "shape"));
           mesh::SurfaceMeshParams p;
           p.size = size;
+          p.wall_layers = wall_layers;
           sm = mesh::mesh_surface(topo, p);
           open = mesh::open_edges_per_solid(topo, sm);
           for (int s = 0; s < topo.num_solids(); ++s)
@@ -80,8 +82,9 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
         out["share_below_20deg"] = q.share_below_20;
         return out;
       },
-      pybind11::arg("brep"), pybind11::arg("size") = 0.0,
-      R"doc(The native surface mesh of one model (a BREP string) at `size` mm (0: diagonal / 50).
+      pybind11::arg("brep"), pybind11::arg("size") = 0.0, pybind11::arg("wall_layers") = 0,
+      R"doc(The native surface mesh of one model (a BREP string) at `size` mm (0: diagonal / 50);
+wall_layers > 0 refines walls thinner than two sizes to about that many layers across.
 Returns a dict: nodes #V x 3, triangles #F x 3 (outward), faces #F (FreeCAD face numbers),
 failed_faces with failure_reasons, open_edges_per_solid (0 = closed and oriented),
 self_intersecting_pairs (within each solid, at most 100 counted), min_angle (degrees) and

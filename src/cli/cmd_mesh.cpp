@@ -21,13 +21,14 @@ namespace topopt::cli {
 
 int cmd_mesh(const Args& args) {
   ArgReader a(args,
-              "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] --out FILE\n"
+              "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] [--wall-layers N] --out FILE\n"
               "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
               "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
               "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
               "  part's face numbers (FreeCAD's FaceN).\n"
               "  --out    FILE.msh (Gmsh MSH 4.1), FILE.vtu (ParaView) or FILE.inp (CalculiX mesh)\n"
               "  --size   target element size in mm (default: part diagonal / 50)\n"
+              "  --wall-layers N  (native) walls thinner than two sizes get about N layers across\n"
               "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
               "  --mesher native: the two-B-Rep advancing front (the 14 steps: no boolean of the part\n"
               "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh;\n"
@@ -39,6 +40,7 @@ int cmd_mesh(const Args& args) {
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);
   mp.min_size = a.number("min-size", 0);
+  const int wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
   std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "auto");
   if (mesher != "auto" && mesher != "gmsh" && mesher != "native")
     throw Error(ErrorCode::InvalidParameter, "--mesher takes auto, native or gmsh");
@@ -67,7 +69,7 @@ int cmd_mesh(const Args& args) {
     throw Error(ErrorCode::InvalidParameter, "--volume native goes with --mesher gmsh (the native mesher fills its volumes itself)");
   mesh::MeshRun run;
   if (mp.native_volume) m = mesh::mesh_with_gmsh_fragments(model, mp, progress), run.mesher = "gmsh surfaces + native volumes";
-  else m = mesh::mesh_two_breps(model, mesher, mp.size, mp.min_size, progress, &run);
+  else m = mesh::mesh_two_breps(model, mesher, mp.size, mp.min_size, progress, &run, wall_layers);
   mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
   auto t2 = clock::now();
   if (ext == ".msh") io::write_msh(out, m);

@@ -18,10 +18,13 @@ namespace topopt::cli {
 
 int cmd_surface(const Args& args) {
   ArgReader a(args,
-              "usage: topopt surface --part PART [--size H] [--min-size H0] [--out FILE.stl] [--stats STATS.json]\n"
+              "usage: topopt surface --part PART [--size H] [--min-size H0] [--wall-layers N] [--out FILE.stl]\n"
+              "                      [--stats STATS.json]\n"
               "  Meshes every face of PART (STEP or BREP) with the native surface mesher: a closed,\n"
               "  consistently oriented triangulation per solid, each triangle tagged with its face.\n"
               "  --size   target edge length in mm (default: part diagonal / 50)\n"
+              "  --wall-layers N  walls thinner than two sizes get about N element layers across\n"
+              "           (sizes from the wall thickness, measured by rays; default 0: off)\n"
               "  --out    binary STL; each triangle's attribute bytes hold its face number (FaceN)\n"
               "  --stats  counts, open edges per solid, self-intersections, angles, time (JSON)\n"
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
@@ -30,6 +33,7 @@ int cmd_surface(const Args& args) {
   mesh::SurfaceMeshParams p;
   p.size = a.number("size", 0);
   p.min_size = a.number("min-size", 0);
+  p.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
   if (!a.positionals().empty() || part.empty()) throw Error(ErrorCode::InvalidParameter, "give --part\n" + a.usage());
   if (p.size < 0 || p.min_size < 0) throw Error(ErrorCode::InvalidParameter, "mesh sizes must be positive (mm)");
   if (!out.empty() && std::filesystem::path(out).extension() != ".stl")

@@ -1,6 +1,7 @@
 // Job file parsing and validation (see job.h).
 #include "io/job.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -91,6 +92,10 @@ Job parse_job(const std::string& text, const std::string& base_dir) {
     job.mesh_file = resolve(str(m, "file"), base_dir);
     job.mesh_size = number(m, "size", 0, "mesh.");
     job.mesh_min_size = number(m, "min_size", 0, "mesh.");
+    const double layers = number(m, "wall_layers", 0, "mesh.");
+    if (!(layers >= 0 && layers <= 4 && layers == std::floor(layers)))
+      bad("mesh.wall_layers", "must be a whole number from 0 (off) to 4; 2 gives thin walls two element layers across");
+    job.mesh_wall_layers = static_cast<int>(layers);
     if (m.contains("mesher")) {
       if (!m["mesher"].is_string() || (m["mesher"] != "auto" && m["mesher"] != "native" && m["mesher"] != "gmsh"))
         bad("mesh.mesher", "must be \"auto\", \"native\" (the two-B-Rep advancing front) or \"gmsh\"");

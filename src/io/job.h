@@ -21,6 +21,7 @@ struct Job {
   std::string nondesign;          ///< Ω̄: path, or "" for none
   std::string mesh_file;          ///< a ready MSH 4.1 mesh, or ""
   double mesh_size = 0;           ///< target element size (mm); 0 = automatic
+  int mesh_wall_layers = 0;       ///< layers across thin walls (native mesher; 0 = no refinement)
   double mesh_min_size = 0;       ///< smallest size (mm); 0 = automatic
   /// "native": the two-B-Rep advancing front (14 steps); "gmsh": OCC fragments + Gmsh;
   /// "auto": native, falling back to gmsh with a warning where native cannot close a mesh.

@@ -441,13 +441,14 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
 }
 
 TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, double size, double min_size,
-                       const Progress& progress, MeshRun* run) {
+                       const Progress& progress, MeshRun* run, int wall_layers) {
   if (mesher != "auto" && mesher != "native" && mesher != "gmsh")
     throw Error(ErrorCode::InvalidParameter, "the mesher is \"auto\", \"native\" or \"gmsh\", not \"" + mesher + "\"");
   if (mesher != "gmsh") {
     NativeMeshParams np;
     np.surface.size = size;
     np.surface.min_size = min_size;
+    np.surface.wall_layers = wall_layers;
     // auto: whatever stops the native mesher (a front that cannot close, or a bug) falls
     // back to Gmsh with a warning; a cancel or a mesh too large for memory does not
     std::string reason;

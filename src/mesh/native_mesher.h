@@ -44,8 +44,9 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params 
 
 /// The product's choice of mesher: "native" (mesh_native), "gmsh" (OCC fragments and Gmsh,
 /// gmsh_fragments.h) or "auto" (native; where it cannot close a mesh, a warning through
-/// `progress` and Gmsh). size, min_size in mm, 0 = automatic.
+/// `progress` and Gmsh). size, min_size in mm, 0 = automatic; wall_layers as
+/// SurfaceMeshParams::wall_layers (the native mesher only).
 TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, double size, double min_size,
-                       const Progress& progress = {}, MeshRun* run = nullptr);
+                       const Progress& progress = {}, MeshRun* run = nullptr, int wall_layers = 0);
 
 }  // namespace topopt::mesh

@@ -2,6 +2,9 @@
 #include "mesh/surface_mesher.h"
 
 #include <BRepAdaptor_Curve.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <Poly_Triangulation.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepLProp_CLProps.hxx>
 #include <BRepLProp_SLProps.hxx>
@@ -34,6 +37,7 @@
 #include "common/error.h"
 #include "common/parallel.h"
 #include "mesh/predicates.h"
+#include "mesh/ray_cast.h"
 #include "mesh/surface_optimize.h"
 
 namespace topopt::mesh {
@@ -125,6 +129,65 @@ class PointGrid {
 
 /// Boundary nodes of a face whose spacing (mean length of their segments) is below 0.7 h:
 /// (u, v, spacing), the sources of the face's graded size field.
+/// A size field over a face's scaled parameters on a grid: min(cap, s_i + grade·distance) over
+/// the points (u, v, s_i), by a chamfer transform (two sweeps, 8 neighbours), read
+/// bilinearly. Cells of half the smallest size, at most 512 a side; cap outside the grid.
+class SizeRaster {
+ public:
+  SizeRaster(const std::vector<std::array<double, 3>>& pts, double cap, double grade) : cap_(cap) {
+    if (pts.empty()) return;
+    double smin = cap, lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const auto& p : pts) {
+      smin = std::min(smin, p[2]);
+      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    }
+    const double reach = (cap - smin) / grade;  // beyond it every point's size has grown to cap
+    for (int k = 0; k < 2; ++k) lo_[k] = lo[k] - reach, hi[k] += reach;
+    cell_ = std::max({0.5 * smin, (hi[0] - lo_[0]) / 511, (hi[1] - lo_[1]) / 511, 1e-12});
+    nx_ = static_cast<long>((hi[0] - lo_[0]) / cell_) + 2, ny_ = static_cast<long>((hi[1] - lo_[1]) / cell_) + 2;
+    v_.assign(nx_ * ny_, static_cast<float>(cap));
+    auto at = [&](long i, long j) -> float& { return v_[i * ny_ + j]; };
+    for (const auto& p : pts) {  // the cells around each point, exactly
+      const long ci = static_cast<long>((p[0] - lo_[0]) / cell_), cj = static_cast<long>((p[1] - lo_[1]) / cell_);
+      for (long i = std::max(0L, ci - 1); i <= std::min(nx_ - 1, ci + 2); ++i)
+        for (long j = std::max(0L, cj - 1); j <= std::min(ny_ - 1, cj + 2); ++j) {
+          const double d = std::hypot(lo_[0] + i * cell_ - p[0], lo_[1] + j * cell_ - p[1]);
+          at(i, j) = std::min(at(i, j), static_cast<float>(p[2] + grade * d));
+        }
+    }
+    const float a = static_cast<float>(grade * cell_), b = static_cast<float>(grade * cell_ * std::sqrt(2.0));
+    for (long i = 0; i < nx_; ++i)
+      for (long j = 0; j < ny_; ++j) {
+        float& x = at(i, j);
+        if (i > 0) x = std::min({x, at(i - 1, j) + a, j > 0 ? at(i - 1, j - 1) + b : x, j + 1 < ny_ ? at(i - 1, j + 1) + b : x});
+        if (j > 0) x = std::min(x, at(i, j - 1) + a);
+      }
+    for (long i = nx_ - 1; i >= 0; --i)
+      for (long j = ny_ - 1; j >= 0; --j) {
+        float& x = at(i, j);
+        if (i + 1 < nx_) x = std::min({x, at(i + 1, j) + a, j + 1 < ny_ ? at(i + 1, j + 1) + b : x, j > 0 ? at(i + 1, j - 1) + b : x});
+        if (j + 1 < ny_) x = std::min(x, at(i, j + 1) + a);
+      }
+  }
+  bool empty() const { return v_.empty(); }
+  /// min(h, the field at q)
+  double size_at(const double* q, double h) const {
+    if (v_.empty()) return h;
+    const double x = (q[0] - lo_[0]) / cell_, y = (q[1] - lo_[1]) / cell_;
+    if (!(x >= 0 && y >= 0 && x < nx_ - 1 && y < ny_ - 1)) return std::min(h, cap_);
+    const long i = static_cast<long>(x), j = static_cast<long>(y);
+    const double fx = x - i, fy = y - j;
+    const double s = (1 - fx) * ((1 - fy) * v_[i * ny_ + j] + fy * v_[i * ny_ + j + 1]) +
+                     fx * ((1 - fy) * v_[(i + 1) * ny_ + j] + fy * v_[(i + 1) * ny_ + j + 1]);
+    return std::min(h, s);
+  }
+
+ private:
+  double cap_, cell_ = 1, lo_[2] = {0, 0};
+  long nx_ = 0, ny_ = 0;
+  std::vector<float> v_;
+};
+
 std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<double, 2>>& uv,
                                                const std::vector<std::array<int, 2>>& segs, double h) {
   std::vector<double> spacing(uv.size(), 0.0);
@@ -210,6 +273,13 @@ double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
 
 }  // namespace
 
+int wall_layers_option(double value) {
+  if (!(value >= 0 && value <= 4 && value == std::floor(value)))
+    throw Error(ErrorCode::InvalidParameter,
+                "wall layers must be a whole number from 0 (no refinement by wall thickness) to 4; 2 gives thin walls two element layers across");
+  return static_cast<int>(value);
+}
+
 // ============================================================================ ModelSurface
 
 ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::array<double, 3>>& nodes,
@@ -239,8 +309,9 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
     geo_[f] = {g.su, g.sv, g.kmax};
     if (g.kmax > 0) face_size_[f] = std::clamp(params.max_angle / g.kmax, hmin_, h_);
   }
+  measure_thickness();
   // ---- each edge sampled finely once: parameters, arc length, and the size allowed there
-  // (its faces' sizes and its own local curvature)
+  // (its faces' sizes, its own local curvature, the wall thickness nearby)
   std::vector<double> edge_size(ne, h_);
   for (int f = 0; f < nf; ++f)
     for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e)
@@ -269,6 +340,24 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
       S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin_, params.max_angle / k)) : edge_size[e]);
     }
   }
+  // the wall thickness of the faces along each edge, read through the edge's parameter curves
+  for (int f = 0; f < nf; ++f) {
+    if (thin_uv_[f].empty()) continue;
+    const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
+    const TopoDS_Face F = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
+    for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e) {
+      if (topo.edge_degenerate[*e]) continue;
+      double pf, pl;
+      const Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(TopoDS::Edge(topo.edges(*e + 1)), F, pf, pl);
+      if (pc.IsNull()) continue;
+      EdgeSamples& S = samples_[*e];
+      for (size_t i = 0; i < S.t.size(); ++i) {
+        const gp_Pnt2d w = pc->Value(S.t[i]);
+        const double q[2] = {w.X() * geo_[f].su, w.Y() * geo_[f].sv};
+        S.size[i] = thin.size_at(q, S.size[i]);
+      }
+    }
+  }
   // Vertex sizes: no larger than the sizes along their edges nor their short edges' lengths,
   // then limited by the gradation across edges.
   vsize_.assign(nv, h_);
@@ -280,6 +369,82 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
     vsize_[S.vb] = std::min({vsize_[S.vb], S.size.back(), std::max(len, hmin_ / 8)});
   }
   grade_vertex_sizes();
+}
+
+// Wall thickness (params.wall_layers > 0): walls thinner than two face sizes get about that
+// many element layers across, size = thickness / (layers + 0.5), not below min_size (at
+// thickness / layers exactly, the volume fill's circumradius rule still leaves many tets
+// spanning the wall). Measured on a coarse tessellation of a copy of the model (OCCT's BRepMesh;
+// the model itself keeps no triangulation): points spread over each triangle about a face
+// size apart cast a ray inward, and the nearest triangle it meets gives the thickness there.
+// Each point thinner than two face sizes becomes a fine point in the face's scaled parameters,
+// which a SizeRaster spreads at the gradation rate over the face's fill and its edges.
+void ModelSurface::measure_thickness() {
+  const int nf = topo_.num_faces();
+  thin_uv_.assign(nf, {});
+  if (nf == 0 || params_.wall_layers <= 0) return;
+  BRepBuilderAPI_Copy copier(topo_.shape, Standard_True, Standard_False);
+  const TopoDS_Shape copy = copier.Shape();
+  BRepMesh_IncrementalMesh(copy, 0.2 * h_, Standard_False, 0.5, Standard_True);
+  std::vector<std::array<double, 3>> xyz;
+  std::vector<std::array<double, 2>> uv;
+  std::vector<std::array<int, 3>> tri;
+  std::vector<int> tri_face;
+  for (int f = 0; f < nf; ++f) {
+    const TopoDS_Shape& original = topo_.faces(f + 1);
+    const TopTools_ListOfShape& mod = copier.Modified(original);
+    if (mod.IsEmpty()) continue;
+    const TopoDS_Face face = TopoDS::Face(mod.First());
+    TopLoc_Location loc;
+    const Handle(Poly_Triangulation) pt = BRep_Tool::Triangulation(face, loc);
+    if (pt.IsNull()) continue;
+    const int base = static_cast<int>(xyz.size());
+    for (int i = 1; i <= pt->NbNodes(); ++i) {
+      const gp_Pnt q = pt->Node(i).Transformed(loc.Transformation());
+      xyz.push_back({q.X(), q.Y(), q.Z()});
+      const gp_Pnt2d w = pt->HasUVNodes() ? pt->UVNode(i) : gp_Pnt2d(0, 0);
+      uv.push_back({w.X() * geo_[f].su, w.Y() * geo_[f].sv});
+    }
+    const bool reversed = face.Orientation() == TopAbs_REVERSED;
+    for (int i = 1; i <= pt->NbTriangles(); ++i) {
+      int a, b, c;
+      pt->Triangle(i).Get(a, b, c);
+      if (reversed) std::swap(b, c);
+      tri.push_back({base + a - 1, base + b - 1, base + c - 1});
+      tri_face.push_back(pt->HasUVNodes() ? f : -1);
+    }
+  }
+  if (tri.empty()) return;
+  MatX3d V(static_cast<long>(xyz.size()), 3);
+  for (size_t i = 0; i < xyz.size(); ++i) V.row(static_cast<long>(i)) << xyz[i][0], xyz[i][1], xyz[i][2];
+  MatX3i F(static_cast<long>(tri.size()), 3);
+  for (size_t t = 0; t < tri.size(); ++t) F.row(static_cast<long>(t)) << tri[t][0], tri[t][1], tri[t][2];
+  const TriangleRays rays(V, F);
+  for (long t = 0; t < F.rows(); ++t) {
+    const int f = tri_face[t];
+    if (f < 0) continue;
+    const double hf = face_size_[f];
+    const Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), c = V.row(F(t, 2));
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() <= 0) continue;
+    n.normalize();
+    const Eigen::Vector3d d = -n;  // into the material
+    // samples: a barycentric grid about 0.7 face sizes apart (not below half the model's
+    // size: a fillet's small face size says nothing about how thick the wall behind it is)
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int m = std::clamp(static_cast<int>(std::ceil(longest / (0.7 * std::max(hf, 0.5 * h_)))), 1, 64);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; i + j < m; ++j) {
+        const double wa = (i + 1.0 / 3) / m, wb = (j + 1.0 / 3) / m, wc = 1 - wa - wb;
+        const Eigen::Vector3d x = wa * a + wb * b + wc * c;
+        const double thick = rays.first_hit(x.data(), d.data(), t, 2 * hf);
+        if (thick >= 2 * hf || thick < 1e-9 * h_) continue;
+        const double size = std::max(thick / (params_.wall_layers + 0.5), hmin_);
+        if (size >= hf) continue;
+        const auto &ua = uv[F(t, 0)], &ub = uv[F(t, 1)], &uc = uv[F(t, 2)];
+        thin_uv_[f].push_back({wa * ua[0] + wb * ub[0] + wc * uc[0], wa * ua[1] + wb * ub[1] + wc * uc[1], size});
+      }
+  }
 }
 
 int ModelSurface::new_node(double x, double y, double z) {
@@ -637,13 +802,13 @@ void ModelSurface::mesh_edges(const Progress& progress) {
       // pieces longer than the face's size field there (finer features nearby in the face,
       // e.g. a small hole close to a long straight edge) are split too
       {
-        const std::vector<std::array<double, 3>> fine = fine_points(L.uv, L.segs, face_size_[f]);
-        const PointGrid grid(fine, face_size_[f], grade_);
+        const PointGrid grid(fine_points(L.uv, L.segs, face_size_[f]), face_size_[f], grade_);
+        const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
         for (size_t i = 0; i < ns; ++i) {
           const auto& A = L.uv[L.segs[i][0]];
           const auto& B = L.uv[L.segs[i][1]];
           const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
-          if (len[i] > 1.5 * grid.size_at(mid, face_size_[f])) mark(static_cast<int>(i));
+          if (len[i] > 1.5 * thin.size_at(mid, grid.size_at(mid, face_size_[f]))) mark(static_cast<int>(i));
         }
       }
       for (size_t oi = 0; oi < ns; ++oi) {
@@ -791,7 +956,8 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
   std::vector<std::array<int, 2>> all_segs = loops.segs;
   all_segs.insert(all_segs.end(), csegs.begin(), csegs.end());
   const PointGrid grid(fine_points(uv, all_segs, hf), hf, grade_);
-  fp.size = [hf, &grid](const double* q) { return grid.size_at(q, hf); };
+  const SizeRaster thin(thin_uv_[f], hf, grade_);  // and inside thin walls, half their thickness
+  fp.size = [hf, &grid, &thin](const double* q) { return thin.size_at(q, grid.size_at(q, hf)); };
   FaceFrontResult r;
   try {
     r = fill_face(in, fp, prog);

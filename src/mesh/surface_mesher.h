@@ -7,7 +7,8 @@
 // (max_angle of turning per element, floor min_size), graded along edges from their
 // vertices and inside faces from finer boundary pieces (gradation); boundary pieces are split
 // where a face's loops come close to each other (proximity) or run longer than the face's
-// graded size. The parameter scaling is exact for planes and cylinders and approximate on
+// graded size; on request (wall_layers) walls thinner than two sizes are refined from their
+// thickness, measured by rays across the model. The parameter scaling is exact for planes and cylinders and approximate on
 // other surfaces; the triangles are then improved on the surface itself (surface_optimize.h).
 // A collapsed edge (cone apex, sphere pole) becomes a fan of triangles around its apex.
 #pragma once
@@ -28,6 +29,8 @@ struct SurfaceMeshParams {
   double min_size = 0;               ///< smallest edge length (mm); <= 0: size / 10
   double max_angle = 2 * 3.14159265358979323846 / 16;  ///< turning of the surface or edge per element (rad)
   double gradation = 1.3;            ///< how fast sizes may grow away from finer regions (ratio per element)
+  int wall_layers = 0;               ///< walls thinner than two sizes get about this many element
+                                     ///< layers across (0: no refinement by wall thickness)
   int optimize_rounds = 3;           ///< flip + smoothing rounds judged on the surface (0: none)
   int threads = 0;                   ///< faces meshed in parallel; 0 = all cores
   FaceFrontParams front;             ///< the face engine's settings (its size is set per face)
@@ -40,6 +43,9 @@ struct SurfaceMesh {
   std::vector<int> failed_faces;  ///< faces that could not be meshed (1-based), with reasons below
   std::vector<std::string> reasons;
 };
+
+/// wall_layers from a user (CLI, job): an integer 0..4, else Error(InvalidParameter) saying so.
+int wall_layers_option(double value);
 
 /// Meshes every face of `topo`. A face that cannot be meshed is listed in failed_faces (the
 /// rest of the surface is still returned) so callers can name it.
@@ -130,6 +136,7 @@ class ModelSurface {
   void discretise(int e);
   void match_vertex_sizes();
   void grade_vertex_sizes();
+  void measure_thickness();
   void refresh_alias(int e);
   Loops face_loops(int f) const;
   struct FaceOut {
@@ -149,6 +156,7 @@ class ModelSurface {
   std::vector<double> face_size_;
   std::vector<EdgeSamples> samples_;
   std::vector<double> vsize_;
+  std::vector<std::vector<std::array<double, 3>>> thin_uv_;   ///< per face: (scaled u, v, size)
   std::vector<int> vertex_node_;
   std::vector<EdgeKind> edge_kind_;
   std::vector<std::array<int, 2>> alias_of_;  ///< (rep, reversed) per aliased edge

@@ -53,7 +53,8 @@ TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const Topo
   progress.say("mesh", -1, "checking the part and the non-design solids");
   brep::TwoBReps model = brep::load_two_breps(part, nondesign, {}, progress);
   io::check_faces(job, model.part.num_faces(), model.nondesign.num_faces());
-  TetMesh mesh = mesh::mesh_two_breps(model, job.mesher, job.mesh_size, job.mesh_min_size, progress);
+  TetMesh mesh = mesh::mesh_two_breps(model, job.mesher, job.mesh_size, job.mesh_min_size, progress, nullptr,
+                                         job.mesh_wall_layers);
   // The fronts and Gmsh number nodes in the order they make them; the solver, filter and
   // surface run faster on a numbering that follows space (bench/simp: see BENCHMARKS.md).
   mesh::reorder_for_locality(mesh);

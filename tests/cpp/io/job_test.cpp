@@ -18,7 +18,7 @@ ErrorCode code_of(const std::string& text) {
 }
 
 TEST(Job, ParsesTheDocumentedFormat) {
-  Job j = parse_job(R"({"part": "p.step", "nondesign": "/abs/nd.step", "mesh": {"size": 2.5},
+  Job j = parse_job(R"({"part": "p.step", "nondesign": "/abs/nd.step", "mesh": {"size": 2.5, "wall_layers": 2},
     "material": {"E": 70000, "nu": 0.33},
     "supports": [{"type": "fixed", "faces": ["Face3", "NonDesign:Face2"]},
                  {"type": "components", "faces": ["Face5"], "fix": ["x", "z"]},
@@ -31,6 +31,7 @@ TEST(Job, ParsesTheDocumentedFormat) {
   EXPECT_EQ(j.part, "/data/jobs/p.step");
   EXPECT_EQ(j.nondesign, "/abs/nd.step");
   EXPECT_EQ(j.mesh_size, 2.5);
+  EXPECT_EQ(j.mesh_wall_layers, 2);
   EXPECT_EQ(j.material.young, 70000);
   ASSERT_EQ(j.supports.size(), 3u);
   EXPECT_EQ(j.supports[0].faces, std::vector<int>{3});
@@ -48,6 +49,8 @@ TEST(Job, ParsesTheDocumentedFormat) {
 TEST(Job, BadInputIsNamed) {
   EXPECT_EQ(code_of("{"), ErrorCode::Io);
   EXPECT_EQ(code_of(R"({"mesh": {"size": -1}})"), ErrorCode::InvalidParameter);
+  EXPECT_EQ(code_of(R"({"mesh": {"wall_layers": 1.5}})"), ErrorCode::InvalidParameter);
+  EXPECT_EQ(code_of(R"({"mesh": {"wall_layers": 9}})"), ErrorCode::InvalidParameter);
   EXPECT_EQ(code_of(R"({"part": "p", "supports": [{"faces": ["Fase3"]}]})"), ErrorCode::FaceNotFound);
   EXPECT_EQ(code_of(R"({"part": "p", "supports": [{"type": "glued", "faces": ["Face3"]}]})"),
             ErrorCode::InvalidParameter);

@@ -16,6 +16,8 @@
 
 #include "brep/shape_io.h"
 #include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "fem/elasticity.h"
 #include "mesh/conformity.h"
 #include "mesh/tet_quality.h"
 
@@ -61,6 +63,29 @@ TEST(NativeMesher, PartsAloneAreConformalWithTheBRepVolume) {
     EXPECT_GT(q.min_radius_ratio, 0);  // no flat or inverted tet
     EXPECT_GT(q.mean_radius_ratio, 0.7);
   }
+}
+
+TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
+  // A cantilever plate 40 x 10 x 1 mm, Face1 (x = 0) fixed, 1 N down on Face2 (x = 40), at the
+  // default size (0.83 mm). One layer of linear tets across the thickness locks in bending:
+  // 0.27 of the beam's F L³ / 3 E I; with wall_layers = 2, 0.55 (linear tets stay stiff in
+  // bending until much finer; quadratic elements would be the cure).
+  const brep::TwoBReps model = brep::load_two_breps(BRepPrimAPI_MakeBox(40, 10, 1).Shape(), TopoDS_Shape());
+  const fem::Material mat;
+  const double beam = 1.0 * 40 * 40 * 40 / (3 * mat.young * 10 * 1.0 / 12);
+  double deflection[2];
+  for (int layers : {0, 2}) {
+    const TetMesh m = mesh_two_breps(model, "native", 0, 0, {}, nullptr, layers);
+    const fem::Supports sup = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+    const fem::LoadSpec tip{fem::LoadSpec::Kind::Force, {2}, {0, 0, -1}, 0, {}};
+    const Eigen::MatrixXd F = fem::make_loads(m, mat, {fem::LoadCase{"tip", {tip}, 1}});
+    fem::Elasticity fe(m, mat, sup, {});
+    // F·U over the 1 N: the load-weighted mean deflection of the end face
+    deflection[layers ? 1 : 0] = F.col(0).dot(fe.solve(F).col(0));
+  }
+  EXPECT_LT(deflection[0], 0.35 * beam);
+  EXPECT_GT(deflection[1], 1.8 * deflection[0]);
+  EXPECT_LT(deflection[1], beam);
 }
 
 TEST(TwoBRepSteps, ExamplesMeshIntoOneConformalTaggedMesh) {

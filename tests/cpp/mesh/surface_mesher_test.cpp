@@ -4,6 +4,7 @@
 // face (the tagged areas equal the faces' areas).
 #include "mesh/surface_mesher.h"
 
+#include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 
 #include "brep/shape_io.h"
 #include "mesh/surface_check.h"
+#include "mesh/volume_front.h"
 
 namespace topopt::mesh {
 namespace {
@@ -155,6 +157,44 @@ TEST(SurfaceMesher, CornersOfNarrowFacesGetMatchingSegments) {
   // 38.7°); the vertex takes the shorter piece's length and the long edge grows from it.
   EXPECT_GE(quality_of(mesh_at("examples/cantilever_nondesign.step", 1.0)).min_angle, 40.0);
   EXPECT_GE(quality_of(mesh_at("examples/rocker.step", 0.5)).min_angle, 39.0);
+}
+
+TEST(SurfaceMesher, ThinWallsGetTwoLayersAcross) {
+  // Plates thinner than two sizes: 1 mm at the default size (1.13 mm) and 3 mm at 2.5 mm.
+  // With wall_layers = 2 the surface there is refined from the wall's thickness and the volume
+  // fill puts nodes inside the wall: 37 % and 19 % of the volume left in tets that reach from
+  // one big face to the other; without it over 80 % (one layer across, stiff in bending: see
+  // NativeMesher.WallLayersLetAThinPlateBendLikeABeam).
+  struct Plate {
+    double lx, ly, t, size;
+    int layers;
+    double spanning_min, spanning_max;  // share of the volume in tets touching both big faces
+  };
+  for (const Plate& pl : {Plate{40, 40, 1, 0, 2, 0, 0.45}, Plate{100, 60, 3, 2.5, 2, 0, 0.25}, Plate{40, 40, 1, 0, 0, 0.8, 1}}) {
+    SCOPED_TRACE("plate " + std::to_string(pl.t) + " mm thick, wall_layers " + std::to_string(pl.layers));
+    const brep::TopologyIndex topo = brep::index_topology(BRepPrimAPI_MakeBox(pl.lx, pl.ly, pl.t).Shape());
+    SurfaceMeshParams p;
+    p.size = pl.size;
+    p.wall_layers = pl.layers;
+    const SurfaceMesh m = mesh_surface(topo, p);
+    ASSERT_TRUE(m.failed_faces.empty());
+    const VolumeFillResult r = fill_volume(m.V, m.F, MatX4i());
+    double spanning = 0, total = 0;
+    for (long t = 0; t < r.T.rows(); ++t) {
+      bool bottom = false, top = false;
+      for (int k = 0; k < 4; ++k) {
+        const double z = r.V(r.T(t, k), 2);
+        bottom |= std::abs(z) < 1e-9, top |= std::abs(z - pl.t) < 1e-9;
+      }
+      const Eigen::Vector3d a = r.V.row(r.T(t, 0)), b = r.V.row(r.T(t, 1)), c = r.V.row(r.T(t, 2)), d = r.V.row(r.T(t, 3));
+      const double v = std::abs((b - a).dot((c - a).cross(d - a))) / 6;
+      total += v;
+      if (bottom && top) spanning += v;
+    }
+    EXPECT_NEAR(total, pl.lx * pl.ly * pl.t, 1e-6 * total);
+    EXPECT_GE(spanning / total, pl.spanning_min);
+    EXPECT_LE(spanning / total, pl.spanning_max) << "of the volume in tets from one big face to the other";
+  }
 }
 
 TEST(SurfaceMesher, ExamplesAreClosedOrientedAndTagged) {
