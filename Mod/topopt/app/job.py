@@ -119,9 +119,13 @@ def study_to_job(study):
     if not 0.0 < vf < 1.0:
         raise errors.TopOptError("volume fraction %g is out of range: give a value between 0 and 1" % vf,
                                  "InvalidParameter")
+    layers = int(getattr(study, "WallLayers", 0))
+    if not 0 <= layers <= 4:
+        raise errors.TopOptError("wall layers %d is out of range: give 0 (off) to 4" % layers, "InvalidParameter")
     job = {
         "mesh": dict({"mesher": str(getattr(study, "Mesher", "auto"))},
-                     **({"size": float(study.MeshSize)} if float(study.MeshSize) > 0 else {})),
+                     **({"size": float(study.MeshSize)} if float(study.MeshSize) > 0 else {}),
+                     **({"wall_layers": layers} if layers > 0 else {})),
         "material": {"E": study.YoungsModulus, "nu": study.PoissonRatio, "density": study.Density},
         "supports": supports,
         "load_cases": [{"name": "loads", "weight": 1.0, "loads": loads}],

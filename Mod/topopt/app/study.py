@@ -40,6 +40,9 @@ class Study:
                             "auto: the two-B-Rep advancing front, Gmsh where it fails; native: the "
                             "advancing front only; gmsh: OCC fragments meshed by Gmsh")
             obj.Mesher = ["auto", "native", "gmsh"]
+        _add(obj, "App::PropertyInteger", "WallLayers", "Mesh",
+             "Element layers across walls thinner than two mesh sizes (native mesher; 0 = off, "
+             "2 = two layers, more elements)", 0)
         if "VolumeFraction" not in obj.PropertiesList:
             obj.addProperty("App::PropertyFloatConstraint", "VolumeFraction", "Optimization",
                             "Share of the design domain's volume to keep, in (0, 1)")

@@ -47,12 +47,19 @@ class StudyPanel:
                                "native: the advancing front only; gmsh: OCC fragments meshed by Gmsh")
         if hasattr(study, "Mesher"):
             self.mesher.setCurrentText(str(study.Mesher))
+        self.layers = QtWidgets.QSpinBox()
+        self.layers.setRange(0, 4)
+        self.layers.setSpecialValueText("off")
+        self.layers.setToolTip("Element layers across walls thinner than two mesh sizes (native mesher); "
+                               "one layer of tets is far too stiff in bending, more layers mean more elements")
+        self.layers.setValue(int(getattr(study, "WallLayers", 0)))
         self.iterations = QtWidgets.QSpinBox()
         self.iterations.setRange(1, 10000)
         self.iterations.setValue(study.MaxIterations)
         grid.addRow("Volume fraction", self.volume)
         grid.addRow("Mesh size", self.size)
         grid.addRow("Mesher", self.mesher)
+        grid.addRow("Layers across thin walls", self.layers)
         grid.addRow("Iterations (max)", self.iterations)
         layout.addLayout(grid)
         self.summary = QtWidgets.QLabel(self._summary_text())
@@ -102,6 +109,8 @@ class StudyPanel:
         self.study.MeshSize = self.size.value()
         if hasattr(self.study, "Mesher"):
             self.study.Mesher = self.mesher.currentText()
+        if hasattr(self.study, "WallLayers"):
+            self.study.WallLayers = self.layers.value()
         self.study.MaxIterations = self.iterations.value()
 
     # --- running ---------------------------------------------------------------------------

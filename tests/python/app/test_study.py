@@ -59,6 +59,16 @@ class StudyFromScript(unittest.TestCase):
         self.assertAlmostEqual(job["optimization"]["volume_fraction"], 0.35)
         self.assertEqual(job["mesh"]["size"], 3.0)
         self.assertEqual(job["mesh"]["mesher"], "auto")
+        self.assertNotIn("wall_layers", job["mesh"])  # off unless asked for
+
+    def test_wall_layers_reach_the_job_and_are_checked(self):
+        study = self.make()
+        study.WallLayers = 2
+        self.assertEqual(api.job_of(study)["mesh"]["wall_layers"], 2)
+        study.WallLayers = 7
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.job_of(study)
+        self.assertIn("wall layers", str(ctx.exception))
 
     def test_native_mesh_is_tagged_with_the_brep_volumes(self):
         # the 14-step mesher through the study: every domain's tet volume is its solid's

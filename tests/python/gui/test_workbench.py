@@ -121,6 +121,7 @@ class Workbench(unittest.TestCase):
         from topopt.gui.panels import open_study_panel
         panel = open_study_panel(study)
         self.assertEqual(panel.mesher.currentText(), "auto")
+        self.assertEqual(panel.layers.value(), 0)  # layers across thin walls: off by default
         panel.mesher.setCurrentText("native")  # the run takes the panel's choice
         panel.start_run()
         self.assertEqual(study.Mesher, "native")
