@@ -19,7 +19,8 @@ std::vector<double> node_spacing(const MatX3d& V, const MatX3i& F) {
   return sum;
 }
 
-BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g) {
+BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g,
+                               const std::vector<std::array<double, 4>>& seeds) {
   lo_ = V.colwise().minCoeff().transpose();
   const Eigen::Vector3d hi = V.colwise().maxCoeff().transpose();
   cell_ = h / 2;
@@ -31,10 +32,13 @@ BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, doubl
   size_.assign(n_[0] * n_[1] * n_[2], static_cast<float>(h));
   const std::vector<double> spacing = node_spacing(V, F);
   // a node's spacing seeds the cells around it at their centres (s + g·distance), so a
-  // tiny edge does not impose its size on a whole cell
-  for (long i = 0; i < V.rows(); ++i) {
-    if (spacing[i] <= 0) continue;
-    const Eigen::Vector3d x = V.row(i).transpose();
+  // tiny edge does not impose its size on a whole cell; then the extra seeds the same way
+  for (long i = 0; i < V.rows() + static_cast<long>(seeds.size()); ++i) {
+    const bool node = i < V.rows();
+    const double s = node ? spacing[i] : seeds[i - V.rows()][3];
+    if (s <= 0) continue;
+    const Eigen::Vector3d x = node ? Eigen::Vector3d(V.row(i).transpose())
+                                   : Eigen::Vector3d(seeds[i - V.rows()][0], seeds[i - V.rows()][1], seeds[i - V.rows()][2]);
     long c[3];
     for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>(std::floor((x[d] - lo_[d]) / cell_ - 0.5)), 0L, n_[d] - 1);
     for (long di = 0; di < 2; ++di)
@@ -43,7 +47,7 @@ BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, doubl
           const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
           const Eigen::Vector3d centre = lo_ + cell_ * Eigen::Vector3d(ci + 0.5, cj + 0.5, ck + 0.5);
           float& v = size_[(ci * n_[1] + cj) * n_[2] + ck];
-          v = std::min(v, static_cast<float>(spacing[i] + g * (centre - x).norm()));
+          v = std::min(v, static_cast<float>(s + g * (centre - x).norm()));
         }
   }
   const float step = static_cast<float>(g * cell_);

@@ -11,7 +11,9 @@
 // grid of cell centres classified by the parity of crossings along z; the volume front stops
 // with a named error when it makes many times that (a front that keeps shrinking its faces).
 #pragma once
+#include <array>
 #include <functional>
+#include <vector>
 
 #include "common/types.h"
 
@@ -20,8 +22,10 @@ namespace topopt::mesh {
 class BackgroundSize {
  public:
   /// V, F: the boundary (F's edges give the node spacings); h: the size far from it (also
-  /// the cap); g: growth of the size per unit distance (0.3: 30 % per element length).
-  BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g);
+  /// the cap); g: growth of the size per unit distance (0.3: 30 % per element length);
+  /// seeds: more (x, y, z, size) points, e.g. the middle of thin walls (ModelSurface).
+  BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g,
+                 const std::vector<std::array<double, 4>>& seeds = {});
   double at(const double* x) const;  ///< trilinear between the cell centres
 
  private:

@@ -385,7 +385,10 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
       const auto t = s.nd.solid_triangles(i);
       all.insert(all.end(), t.begin(), t.end());
     }
-    s.background = std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1);
+    // and the middle of thin walls when wall_layers asks for layers across them
+    std::vector<std::array<double, 4>> walls = s.part.wall_points();
+    walls.insert(walls.end(), s.nd.wall_points().begin(), s.nd.wall_points().end());
+    s.background = std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1, walls);
   }
   step12_fill_nondesign(s);
   lap("step 12: non-design volumes");

@@ -382,6 +382,7 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
 void ModelSurface::measure_thickness() {
   const int nf = topo_.num_faces();
   thin_uv_.assign(nf, {});
+  wall_points_.clear();
   if (nf == 0 || params_.wall_layers <= 0) return;
   BRepBuilderAPI_Copy copier(topo_.shape, Standard_True, Standard_False);
   const TopoDS_Shape copy = copier.Shape();
@@ -441,6 +442,8 @@ void ModelSurface::measure_thickness() {
         if (thick >= 2 * hf || thick < 1e-9 * h_) continue;
         const double size = std::max(thick / (params_.wall_layers + 0.5), hmin_);
         if (size >= hf) continue;
+        const Eigen::Vector3d mid = x + 0.5 * thick * d;
+        wall_points_.push_back({mid[0], mid[1], mid[2], size});
         const auto &ua = uv[F(t, 0)], &ub = uv[F(t, 1)], &uc = uv[F(t, 2)];
         thin_uv_[f].push_back({wa * ua[0] + wb * ub[0] + wc * uc[0], wa * ua[1] + wb * ub[1] + wc * uc[1], size});
       }

@@ -108,6 +108,9 @@ class ModelSurface {
   /// Face f's triangles, normals out of the solid that holds the face (the index's first).
   const std::vector<std::array<int, 3>>& face_triangles(int f) const { return face_tris_[f]; }
   const std::vector<int>& failed_faces() const { return failed_; }      ///< 1-based
+  /// With wall_layers: (x, y, z, size) at the middle of each thin wall sample, for the
+  /// volume's size (BackgroundSize seeds), so the fill puts nodes inside the wall.
+  const std::vector<std::array<double, 4>>& wall_points() const { return wall_points_; }
   const std::vector<std::string>& failure_reasons() const { return reasons_; }
 
   /// Triangles of solid s (0-based), oriented out of it.
@@ -157,6 +160,7 @@ class ModelSurface {
   std::vector<EdgeSamples> samples_;
   std::vector<double> vsize_;
   std::vector<std::vector<std::array<double, 3>>> thin_uv_;   ///< per face: (scaled u, v, size)
+  std::vector<std::array<double, 4>> wall_points_;            ///< see wall_points()
   std::vector<int> vertex_node_;
   std::vector<EdgeKind> edge_kind_;
   std::vector<std::array<int, 2>> alias_of_;  ///< (rep, reversed) per aliased edge
