@@ -127,8 +127,6 @@ class PointGrid {
   std::vector<int> items_;
 };
 
-/// Boundary nodes of a face whose spacing (mean length of their segments) is below 0.7 h:
-/// (u, v, spacing), the sources of the face's graded size field.
 /// A size field over a face's scaled parameters on a grid: min(cap, s_i + grade·distance) over
 /// the points (u, v, s_i), by a chamfer transform (two sweeps, 8 neighbours), read
 /// bilinearly. Cells of half the smallest size, at most 512 a side; cap outside the grid.
@@ -169,7 +167,6 @@ class SizeRaster {
         if (j + 1 < ny_) x = std::min(x, at(i, j + 1) + a);
       }
   }
-  bool empty() const { return v_.empty(); }
   /// min(h, the field at q)
   double size_at(const double* q, double h) const {
     if (v_.empty()) return h;
@@ -188,6 +185,8 @@ class SizeRaster {
   std::vector<float> v_;
 };
 
+/// Boundary nodes of a face whose spacing (mean length of their segments) is below 0.7 h:
+/// (u, v, spacing), the sources of the face's graded size field.
 std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<double, 2>>& uv,
                                                const std::vector<std::array<int, 2>>& segs, double h) {
   std::vector<double> spacing(uv.size(), 0.0);
