@@ -116,12 +116,11 @@ Eigen::Matrix3Xd gravity_of(const std::vector<LoadCase>& cases) {
 }
 
 Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
-                           const std::vector<LoadCase>& cases, bool with_gravity) {
+                           const std::vector<LoadCase>& cases) {
   Eigen::MatrixXd F = Eigen::MatrixXd::Zero(3 * mesh.V.rows(), static_cast<long>(cases.size()));
   for (size_t k = 0; k < cases.size(); ++k) {
     for (const LoadSpec& item : cases[k].items) {
       if (item.kind == LoadSpec::Kind::Gravity) {
-        if (!with_gravity) continue;
         Eigen::Vector3d g(item.vector[0], item.vector[1], item.vector[2]);
         for (long t = 0; t < mesh.T.rows(); ++t) {
           Eigen::Vector3d p0 = mesh.V.row(mesh.T(t, 0));

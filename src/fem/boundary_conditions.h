@@ -46,10 +46,10 @@ Supports make_supports(const TetMesh& mesh, const std::vector<SupportSpec>& spec
 /// (3*#V) by #cases consistent nodal loads: a total force is spread over the faces'
 /// triangles by area (a third of each triangle's share to each of its nodes), a pressure
 /// acts along each triangle's inward normal, gravity loads every tet with ρ·vol/4 per node
-/// (left out when with_gravity is false: SIMP scales each design tet's weight by its
-/// density, see gravity_of). Throws Error(FaceNotFound) for a face the mesh lacks.
+/// (SIMP then scales each design tet's share by its density, see gravity_of).
+/// Throws Error(FaceNotFound) for a face the mesh lacks.
 Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
-                           const std::vector<LoadCase>& cases, bool with_gravity = true);
+                           const std::vector<LoadCase>& cases);
 
 /// 3 by #cases: each case's gravity accelerations summed (mm/s²); zero where it has none.
 Eigen::Matrix3Xd gravity_of(const std::vector<LoadCase>& cases);

@@ -100,8 +100,8 @@ OptimizeResult optimize_job(const io::Job& job, const TetMesh& mesh, const Progr
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
   fem::Supports supports = fem::make_supports(mesh, job.supports);
-  // gravity apart: the weight of the design tets follows their density
-  Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases, false);
+  // the weight of the design tets follows their density (gravity_of below)
+  Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases);
   std::vector<double> weights;
   for (const auto& lc : job.load_cases) weights.push_back(lc.weight);
   OptimizeResult r;

@@ -43,19 +43,13 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
   progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " +
                 std::to_string(filter_->mean_neighbours()) + " neighbours per element");
-  // self-weight: the non-design tets' weight is fixed, each design tet's scales with ρ̄
+  // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())
       throw Error(ErrorCode::InvalidParameter, "self-weight: one gravity vector per load case is needed");
     gravity_ = gravity;
     quarter_mass_ = material.density * vd_ / 4;
     if (params_.law.linear_below <= 0) params_.law.linear_below = 0.1;
-    for (long t = 0; t < nt; ++t) {
-      if (mesh.domain.size() != nt || mesh.domain[t] == 0) continue;
-      for (long k = 0; k < loads_.cols(); ++k)
-        for (int a = 0; a < 4; ++a)
-          loads_.block<3, 1>(3 * mesh.T(t, a), k) += material.density * volume[t] / 4 * gravity_.col(k);
-    }
   }
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
@@ -85,13 +79,13 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   // ---- FE analysis
   for (int i = 0; i < nd; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
   fe_->set_scale(scale_);
-  // loads: the fixed ones plus the design tets' weight, ρ̄ ρ_material vol g spread to 4 nodes
+  // loads: the design tets' weight scaled by ρ̄ (loads_ holds it at ρ̄ = 1), spread to 4 nodes
   Eigen::MatrixXd F = loads_;
   if (gravity_.size())
     for (int i = 0; i < nd; ++i)
       for (long k = 0; k < F.cols(); ++k)
         for (int a = 0; a < 4; ++a)
-          F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += rho_bar[i] * quarter_mass_[i] * gravity_.col(k);
+          F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += (rho_bar[i] - 1) * quarter_mass_[i] * gravity_.col(k);
   Eigen::MatrixXd U = fe_->solve(F, progress_);
   // ---- objective c = Σ w Fᵀ U and its sensitivities (w.r.t. ρ̄):
   // dc/dρ̄ = Σ w (2 uᵀ dF/dρ̄ − E'(ρ̄) uᵀ K₀ u) for each element

@@ -56,10 +56,10 @@ struct SimpResult {
 /// filter, projection and FE model are built once; evaluate() runs one FE analysis.
 class ComplianceProblem {
  public:
-  /// gravity: 3 by #cases accelerations (mm/s², fem::gravity_of) whose weight is
-  /// design-dependent: each design tet weighs ρ̄ ρ_material vol, each non-design tet its full
-  /// weight; `loads` then holds the other loads only (fem::make_loads(..., false)). With any
-  /// gravity the law turns linear below ρ̄ = 0.1 unless params set linear_below.
+  /// gravity: 3 by #cases accelerations (mm/s², fem::gravity_of) whose full weight `loads`
+  /// holds (fem::make_loads); each design tet's share is scaled by its density, so it weighs
+  /// ρ̄ ρ_material vol and a non-design tet its full weight. With any gravity the law turns
+  /// linear below ρ̄ = 0.1 unless params set linear_below.
   ComplianceProblem(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
                     const Progress& progress = {}, const Eigen::Matrix3Xd& gravity = {});
@@ -85,7 +85,7 @@ class ComplianceProblem {
   double design_volume_ = 0;
   std::unique_ptr<DensityFilter> filter_;
   std::unique_ptr<fem::Elasticity> fe_;
-  Eigen::MatrixXd loads_;        // fixed loads, with the non-design tets' weight
+  Eigen::MatrixXd loads_;        // as given: with every tet's full weight
   Eigen::Matrix3Xd gravity_;     // 3 x #cases, empty without self-weight
   VecXd quarter_mass_;           // #D: ρ_material vol / 4 of each design tet (t)
   std::vector<double> weights_;
