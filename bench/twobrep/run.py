@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Two-B-Rep meshing benchmark: our 14-step advancing-front mesher against what a Gmsh user
 does today for the same result (OCC fragments of the part with the non-design solids, then
-Gmsh's 2D and 3D meshers, as src/mesh/gmsh_fragments.cpp drives them), one run, same sizes.
+Gmsh's 2D and 3D meshers, as src/mesh/two_brep/gmsh_fragments.cpp drives them), one run, same sizes.
 
 Both go through `build/topopt mesh --mesher native|gmsh --stats`, so the same code checks
 the results: conformity (duplicate nodes, shared faces, boundary, interface on the non-design

@@ -7,13 +7,13 @@
 #include "common/error.h"
 #include "io/job.h"
 #include "brep/topology_index.h"
-#include "mesh/conformity.h"
-#include "mesh/surface_check.h"
-#include "mesh/surface_mesher.h"
-#include "mesh/volume_front.h"
+#include "mesh/core/conformity.h"
+#include "mesh/surface/surface_check.h"
+#include "mesh/surface/surface_mesher.h"
+#include "mesh/volume/volume_front.h"
 
 #include <chrono>
-#include "mesh/tet_quality.h"
+#include "mesh/core/tet_quality.h"
 #include "pipeline/solve_job.h"
 
 namespace topopt::py {

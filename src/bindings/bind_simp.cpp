@@ -114,10 +114,10 @@ surface), warnings (list of strings).)doc");
           throw Error(ErrorCode::InvalidParameter, "one density and one domain tag per tet expected");
         if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
           throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
-        surface::TriSurface s;
+        result::TriSurface s;
         {
           pyb::gil_scoped_release release;
-          surface::SmoothParams sp;
+          result::SmoothParams sp;
           sp.iterations = smoothing_iterations;
           s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
                                        volume_fraction, sp);

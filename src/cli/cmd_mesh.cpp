@@ -11,11 +11,11 @@
 #include "io/inp.h"
 #include "io/msh.h"
 #include "io/vtu.h"
-#include "mesh/conformity.h"
-#include "mesh/gmsh_fragments.h"
-#include "mesh/native_mesher.h"
-#include "mesh/reorder.h"
-#include "mesh/tet_quality.h"
+#include "mesh/core/conformity.h"
+#include "mesh/two_brep/gmsh_fragments.h"
+#include "mesh/two_brep/native_mesher.h"
+#include "mesh/core/reorder.h"
+#include "mesh/core/tet_quality.h"
 
 namespace topopt::cli {
 

@@ -11,8 +11,8 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "io/stl.h"
-#include "mesh/surface_check.h"
-#include "mesh/surface_mesher.h"
+#include "mesh/surface/surface_check.h"
+#include "mesh/surface/surface_mesher.h"
 
 namespace topopt::cli {
 

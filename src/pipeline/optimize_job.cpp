@@ -83,14 +83,14 @@ OptimizeSettings optimize_settings(const io::Job& job) {
   return s;
 }
 
-surface::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
-                                   double volume_fraction, const surface::SmoothParams& smooth,
+result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
+                                   double volume_fraction, const result::SmoothParams& smooth,
                                    double* threshold_used) {
-  VecXd nd = surface::node_densities(mesh, density);
-  double t = threshold > 0 ? threshold : surface::threshold_for_volume(mesh, nd, volume_fraction);
+  VecXd nd = result::node_densities(mesh, density);
+  double t = threshold > 0 ? threshold : result::threshold_for_volume(mesh, nd, volume_fraction);
   if (threshold_used) *threshold_used = t;
-  surface::TriSurface s = surface::extract_iso_surface(mesh, nd, t);
-  if (smooth.iterations > 0) surface::smooth_surface(s, smooth);
+  result::TriSurface s = result::extract_iso_surface(mesh, nd, t);
+  if (smooth.iterations > 0) result::smooth_surface(s, smooth);
   return s;
 }
 

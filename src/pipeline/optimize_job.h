@@ -8,8 +8,8 @@
 #include "common/progress.h"
 #include "io/job.h"
 #include "simp/optimizer.h"
-#include "surface/iso_surface.h"
-#include "surface/smoothing.h"
+#include "result/iso_surface.h"
+#include "result/smoothing.h"
 
 namespace topopt::pipeline {
 
@@ -17,7 +17,7 @@ namespace topopt::pipeline {
 struct OptimizeSettings {
   simp::SimpParams simp;
   double threshold = -1;        ///< < 0: the one that meets the volume fraction
-  surface::SmoothParams smooth;
+  result::SmoothParams smooth;
 };
 
 /// Reads job.raw["optimization"]. Throws Error(InvalidParameter) naming a bad key.
@@ -26,7 +26,7 @@ OptimizeSettings optimize_settings(const io::Job& job);
 struct OptimizeResult {
   simp::SimpResult simp;
   double threshold = 0;
-  surface::TriSurface surface;  ///< smoothed, closed
+  result::TriSurface surface;  ///< smoothed, closed
   double seconds_simp = 0, seconds_surface = 0;
 };
 
@@ -38,8 +38,8 @@ OptimizeResult optimize_job(const io::Job& job, const TetMesh& mesh, const Progr
 
 /// The result shape of given element densities at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain), smoothed.
-surface::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
-                                   double volume_fraction, const surface::SmoothParams& smooth,
+result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
+                                   double volume_fraction, const result::SmoothParams& smooth,
                                    double* threshold_used = nullptr);
 
 /// Writes DIR/density.vtu, DIR/history.csv, DIR/history.json and DIR/result.stl.

@@ -7,13 +7,13 @@
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
 #include "brep/two_breps.h"
-#include "mesh/gmsh_fragments.h"
-#include "mesh/native_mesher.h"
+#include "mesh/two_brep/gmsh_fragments.h"
+#include "mesh/two_brep/native_mesher.h"
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "io/inp.h"
 #include "io/msh.h"
-#include "mesh/reorder.h"
+#include "mesh/core/reorder.h"
 #include "io/vtu.h"
 
 namespace topopt::pipeline {

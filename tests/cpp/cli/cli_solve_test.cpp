@@ -11,7 +11,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "io/msh.h"
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 
 namespace {
 namespace fs = std::filesystem;

@@ -10,7 +10,7 @@
 
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 
 namespace topopt::fem {
 namespace {

@@ -9,7 +9,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "io/inp.h"
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 
 namespace topopt::fem {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "common/error.h"
 #include "io/vtu.h"
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 
 namespace topopt::io {
 namespace {

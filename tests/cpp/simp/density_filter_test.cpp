@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 
 namespace topopt::simp {
 namespace {

@@ -9,7 +9,7 @@
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
-#include "mesh/structured_box.h"
+#include "mesh/core/structured_box.h"
 #include "simp/update.h"
 
 namespace topopt::simp {

@@ -1,0 +1,1145 @@
+// Surface meshing by the B-Rep hierarchy (see surface_mesher.h).
+#include "mesh/surface/surface_mesher.h"
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <Poly_Triangulation.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepLProp_CLProps.hxx>
+#include <BRepLProp_SLProps.hxx>
+#include <BRepTools.hxx>
+#include <BRepClass_FaceClassifier.hxx>
+#include <BRep_Tool.hxx>
+#include <ShapeAnalysis_Curve.hxx>
+#include <ShapeAnalysis_Surface.hxx>
+#include <Geom_Curve.hxx>
+#include <Geom_Surface.hxx>
+#include <Geom2d_Curve.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/error.h"
+#include "common/parallel.h"
+#include "mesh/core/predicates.h"
+#include "mesh/core/ray_cast.h"
+#include "mesh/surface/surface_optimize.h"
+
+namespace topopt::mesh {
+namespace {
+
+/// What the faces need to know about a face's parametrisation: a per-direction scale making
+/// lengths in (su·u, sv·v) approximate lengths on the surface, and the largest curvature.
+struct Scales {
+  double su = 1, sv = 1, kmax = 0;
+};
+
+Scales face_geometry(const TopoDS_Face& f) {
+  Scales g;
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(f, u0, u1, v0, v1);
+  BRepAdaptor_Surface s(f, Standard_True);
+  BRepLProp_SLProps props(s, 2, 1e-9);
+  double su = 0, sv = 0;
+  int n = 0;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      const double u = u0 + (u1 - u0) * (i + 0.5) / 5, v = v0 + (v1 - v0) * (j + 0.5) / 5;
+      gp_Pnt p;
+      gp_Vec du, dv;
+      s.D1(u, v, p, du, dv);
+      su += du.Magnitude();
+      sv += dv.Magnitude();
+      ++n;
+      props.SetParameters(u, v);
+      if (props.IsCurvatureDefined())
+        g.kmax = std::max({g.kmax, std::abs(props.MaxCurvature()), std::abs(props.MinCurvature())});
+    }
+  g.su = su / n > 1e-12 ? su / n : 1;
+  g.sv = sv / n > 1e-12 ? sv / n : 1;
+  return g;
+}
+
+/// Size field near fine boundary pieces of a face: min(h, s_i + grade·|q − p_i|) over the
+/// points (u, v, s_i), looked up in a uniform grid whose cells cover the reach of a point.
+class PointGrid {
+ public:
+  PointGrid(std::vector<std::array<double, 3>> pts, double h, double grade) : pts_(std::move(pts)), grade_(grade) {
+    if (pts_.empty()) return;
+    double smin = h;
+    lo_[0] = hi_[0] = pts_[0][0], lo_[1] = hi_[1] = pts_[0][1];
+    for (const auto& p : pts_) {
+      smin = std::min(smin, p[2]);
+      lo_[0] = std::min(lo_[0], p[0]), hi_[0] = std::max(hi_[0], p[0]);
+      lo_[1] = std::min(lo_[1], p[1]), hi_[1] = std::max(hi_[1], p[1]);
+    }
+    reach_ = (h - smin) / grade_;
+    cell_ = std::max({reach_ / 2, (hi_[0] - lo_[0]) / 512, (hi_[1] - lo_[1]) / 512, 1e-300});
+    nx_ = static_cast<long>((hi_[0] - lo_[0]) / cell_) + 1, ny_ = static_cast<long>((hi_[1] - lo_[1]) / cell_) + 1;
+    start_.assign(nx_ * ny_ + 1, 0);
+    for (const auto& p : pts_) ++start_[cell(p.data()) + 1];
+    for (size_t i = 1; i < start_.size(); ++i) start_[i] += start_[i - 1];
+    items_.resize(pts_.size());
+    std::vector<long> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < pts_.size(); ++i) items_[fill[cell(pts_[i].data())]++] = static_cast<int>(i);
+  }
+  double size_at(const double* q, double h) const {
+    if (pts_.empty()) return h;
+    double s = h;
+    const long i0 = std::max(0L, static_cast<long>(std::floor((q[0] - reach_ - lo_[0]) / cell_)));
+    const long i1 = std::min(nx_ - 1, static_cast<long>(std::floor((q[0] + reach_ - lo_[0]) / cell_)));
+    const long j0 = std::max(0L, static_cast<long>(std::floor((q[1] - reach_ - lo_[1]) / cell_)));
+    const long j1 = std::min(ny_ - 1, static_cast<long>(std::floor((q[1] + reach_ - lo_[1]) / cell_)));
+    for (long i = i0; i <= i1; ++i)
+      for (long j = j0; j <= j1; ++j) {
+        const long c = i * ny_ + j;
+        for (long k = start_[c]; k < start_[c + 1]; ++k) {
+          const auto& p = pts_[items_[k]];
+          s = std::min(s, p[2] + grade_ * std::hypot(q[0] - p[0], q[1] - p[1]));
+        }
+      }
+    return s;
+  }
+
+ private:
+  long cell(const double* p) const {
+    return static_cast<long>((p[0] - lo_[0]) / cell_) * ny_ + static_cast<long>((p[1] - lo_[1]) / cell_);
+  }
+  std::vector<std::array<double, 3>> pts_;
+  double grade_, reach_ = 0, cell_ = 1, lo_[2] = {0, 0}, hi_[2] = {0, 0};
+  long nx_ = 0, ny_ = 0;
+  std::vector<long> start_;
+  std::vector<int> items_;
+};
+
+/// A size field over a face's scaled parameters on a grid: min(cap, s_i + grade·distance) over
+/// the points (u, v, s_i), by a chamfer transform (two sweeps, 8 neighbours), read
+/// bilinearly. Cells of half the smallest size, at most 512 a side; cap outside the grid.
+class SizeRaster {
+ public:
+  SizeRaster(const std::vector<std::array<double, 3>>& pts, double cap, double grade) : cap_(cap) {
+    if (pts.empty()) return;
+    double smin = cap, lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const auto& p : pts) {
+      smin = std::min(smin, p[2]);
+      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    }
+    const double reach = (cap - smin) / grade;  // beyond it every point's size has grown to cap
+    for (int k = 0; k < 2; ++k) lo_[k] = lo[k] - reach, hi[k] += reach;
+    cell_ = std::max({0.5 * smin, (hi[0] - lo_[0]) / 511, (hi[1] - lo_[1]) / 511, 1e-12});
+    nx_ = static_cast<long>((hi[0] - lo_[0]) / cell_) + 2, ny_ = static_cast<long>((hi[1] - lo_[1]) / cell_) + 2;
+    v_.assign(nx_ * ny_, static_cast<float>(cap));
+    auto at = [&](long i, long j) -> float& { return v_[i * ny_ + j]; };
+    for (const auto& p : pts) {  // the cells around each point, exactly
+      const long ci = static_cast<long>((p[0] - lo_[0]) / cell_), cj = static_cast<long>((p[1] - lo_[1]) / cell_);
+      for (long i = std::max(0L, ci - 1); i <= std::min(nx_ - 1, ci + 2); ++i)
+        for (long j = std::max(0L, cj - 1); j <= std::min(ny_ - 1, cj + 2); ++j) {
+          const double d = std::hypot(lo_[0] + i * cell_ - p[0], lo_[1] + j * cell_ - p[1]);
+          at(i, j) = std::min(at(i, j), static_cast<float>(p[2] + grade * d));
+        }
+    }
+    const float a = static_cast<float>(grade * cell_), b = static_cast<float>(grade * cell_ * std::sqrt(2.0));
+    for (long i = 0; i < nx_; ++i)
+      for (long j = 0; j < ny_; ++j) {
+        float& x = at(i, j);
+        if (i > 0) x = std::min({x, at(i - 1, j) + a, j > 0 ? at(i - 1, j - 1) + b : x, j + 1 < ny_ ? at(i - 1, j + 1) + b : x});
+        if (j > 0) x = std::min(x, at(i, j - 1) + a);
+      }
+    for (long i = nx_ - 1; i >= 0; --i)
+      for (long j = ny_ - 1; j >= 0; --j) {
+        float& x = at(i, j);
+        if (i + 1 < nx_) x = std::min({x, at(i + 1, j) + a, j + 1 < ny_ ? at(i + 1, j + 1) + b : x, j > 0 ? at(i + 1, j - 1) + b : x});
+        if (j + 1 < ny_) x = std::min(x, at(i, j + 1) + a);
+      }
+  }
+  /// min(h, the field at q)
+  double size_at(const double* q, double h) const {
+    if (v_.empty()) return h;
+    const double x = (q[0] - lo_[0]) / cell_, y = (q[1] - lo_[1]) / cell_;
+    if (!(x >= 0 && y >= 0 && x < nx_ - 1 && y < ny_ - 1)) return std::min(h, cap_);
+    const long i = static_cast<long>(x), j = static_cast<long>(y);
+    const double fx = x - i, fy = y - j;
+    const double s = (1 - fx) * ((1 - fy) * v_[i * ny_ + j] + fy * v_[i * ny_ + j + 1]) +
+                     fx * ((1 - fy) * v_[(i + 1) * ny_ + j] + fy * v_[(i + 1) * ny_ + j + 1]);
+    return std::min(h, s);
+  }
+
+ private:
+  double cap_, cell_ = 1, lo_[2] = {0, 0};
+  long nx_ = 0, ny_ = 0;
+  std::vector<float> v_;
+};
+
+/// Boundary nodes of a face whose spacing (mean length of their segments) is below 0.7 h:
+/// (u, v, spacing), the sources of the face's graded size field.
+std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<double, 2>>& uv,
+                                               const std::vector<std::array<int, 2>>& segs, double h) {
+  std::vector<double> spacing(uv.size(), 0.0);
+  std::vector<int> count(uv.size(), 0);
+  for (const auto& sg : segs) {
+    const double l = std::hypot(uv[sg[1]][0] - uv[sg[0]][0], uv[sg[1]][1] - uv[sg[0]][1]);
+    for (int k : sg) spacing[k] += l, ++count[k];
+  }
+  std::vector<std::array<double, 3>> fine;
+  for (size_t i = 0; i < uv.size(); ++i)
+    if (count[i] && spacing[i] / count[i] < 0.7 * h) fine.push_back({uv[i][0], uv[i][1], spacing[i] / count[i]});
+  return fine;
+}
+
+/// At most this many pieces on a collapsed edge: the fan around a cone apex or a sphere pole
+/// has about as many triangles, so their angles there stay near 360° / 12 or more.
+constexpr int kMaxApexPieces = 12;
+/// A face corner sharper than this (radians) is closed by one needle triangle; one sharper
+/// than kCuspAngle is a cusp (see mesh_edges).
+constexpr double kNeedleAngle = 30 * M_PI / 180;
+constexpr double kCuspAngle = 5 * M_PI / 180;
+
+/// The angle (rad) the surface of `face` sweeps around a collapsed edge (cone apex, sphere
+/// pole) whose parameter curve is pc on [t0, t1]: the turning of the surface's derivative
+/// across that curve, summed over samples.
+double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, double t0, double t1) {
+  BRepAdaptor_Surface s(face, Standard_False);
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(face, u0, u1, v0, v1);
+  const double eps = 1e-4 * std::max(u1 - u0, v1 - v0);
+  // the face's side of the collapsed edge, chosen once at its middle (chosen per sample, a
+  // side that flips reverses the direction and adds half-turns to the sum)
+  double side = 1;
+  {
+    gp_Pnt2d q;
+    gp_Vec2d d;
+    pc->D1(0.5 * (t0 + t1), q, d);
+    const double m = d.Magnitude();
+    if (m > 1e-300) {
+      const double x = q.X() - eps * d.Y() / m, y = q.Y() + eps * d.X() / m;
+      if (x < u0 || x > u1 || y < v0 || y > v1) side = -1;
+    }
+  }
+  const int m = 24;
+  gp_Vec prev;
+  double total = 0;
+  for (int i = 0; i <= m; ++i) {
+    const double t = t0 + (t1 - t0) * i / m;
+    gp_Pnt2d q;
+    gp_Vec2d d;
+    pc->D1(t, q, d);
+    if (d.Magnitude() < 1e-300) continue;
+    // a point just off the collapsed edge, on the face's side, where the derivatives live
+    gp_Vec2d across(-side * d.Y(), side * d.X());
+    across.Normalize();
+    const gp_Pnt2d inside(q.X() + eps * across.X(), q.Y() + eps * across.Y());
+    gp_Pnt p;
+    gp_Vec xu, xv;
+    s.D1(inside.X(), inside.Y(), p, xu, xv);
+    gp_Vec dir = xu * across.X() + xv * across.Y();
+    if (dir.Magnitude() < 1e-300) continue;
+    dir.Normalize();
+    if (prev.Magnitude() > 0) total += prev.Angle(dir);
+    prev = dir;
+  }
+  return total > 0 ? total : 2 * M_PI;
+}
+
+/// The faces of solid s (0-based) in the solid's order: (face number, 1-based; whether the
+/// solid uses it reversed with respect to the index's own orientation of that face).
+std::vector<std::pair<int, bool>> solid_faces(const brep::TopologyIndex& topo, int s) {
+  std::vector<std::pair<int, bool>> out;
+  for (TopExp_Explorer ex(topo.solids(s + 1), TopAbs_FACE); ex.More(); ex.Next()) {
+    const int f = topo.faces.FindIndex(ex.Current());
+    if (f > 0) out.push_back({f, ex.Current().Orientation() != topo.faces(f).Orientation()});
+  }
+  return out;
+}
+
+double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+}  // namespace
+
+int wall_layers_option(double value) {
+  if (!(value >= 0 && value <= 4 && value == std::floor(value)))
+    throw Error(ErrorCode::InvalidParameter,
+                "wall layers must be a whole number from 0 (no refinement by wall thickness) to 4; 2 gives thin walls two element layers across");
+  return static_cast<int>(value);
+}
+
+// ============================================================================ ModelSurface
+
+ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::array<double, 3>>& nodes,
+                           const SurfaceMeshParams& params)
+    : topo_(topo), nodes_(nodes), params_(params) {
+  h_ = params.size > 0 ? params.size : topo.diagonal() / 50;
+  hmin_ = params.min_size > 0 ? params.min_size : h_ / 10;
+  grade_ = params.gradation - 1;
+  const int nv = topo.num_vertices(), ne = topo.num_edges(), nf = topo.num_faces();
+  vertex_node_.assign(nv, -1);
+  edge_kind_.assign(ne, EdgeKind::Free);
+  alias_of_.assign(ne, {-1, 0});
+  fixed_.resize(ne);
+  edge_param_.resize(ne);
+  edge_node_.resize(ne);
+  constraint_.resize(nf);
+  face_extra_nodes_.resize(nf);
+  face_given_.assign(nf, 0);
+  face_alias_.assign(nf, {-1, 0});
+  face_tris_.resize(nf);
+
+  // ---- per face: parameter scaling and the size its curvature allows
+  geo_.resize(nf);
+  face_size_.assign(nf, h_);
+  for (int f = 0; f < nf; ++f) {
+    const Scales g = face_geometry(TopoDS::Face(topo.faces(f + 1)));
+    geo_[f] = {g.su, g.sv, g.kmax};
+    if (g.kmax > 0) face_size_[f] = std::clamp(params.max_angle / g.kmax, hmin_, h_);
+  }
+  measure_thickness();
+  // ---- each edge sampled finely once: parameters, arc length, and the size allowed there
+  // (its faces' sizes, its own local curvature, the wall thickness nearby)
+  std::vector<double> edge_size(ne, h_);
+  for (int f = 0; f < nf; ++f)
+    for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e)
+      edge_size[*e] = std::min(edge_size[*e], face_size_[f]);
+  samples_.resize(ne);
+  for (int e = 0; e < ne; ++e) {
+    if (topo.edge_degenerate[e]) continue;
+    const TopoDS_Edge E = TopoDS::Edge(topo.edges(e + 1).Oriented(TopAbs_FORWARD));
+    TopoDS_Vertex va, vb;
+    TopExp::Vertices(E, va, vb);
+    EdgeSamples& S = samples_[e];
+    S.va = topo.vertices.FindIndex(va) - 1, S.vb = topo.vertices.FindIndex(vb) - 1;
+    BRepAdaptor_Curve c(E);
+    BRepLProp_CLProps props(c, 2, 1e-9);
+    const double t0 = c.FirstParameter(), t1 = c.LastParameter();
+    const int m = 128;
+    gp_Pnt prev;
+    for (int i = 0; i <= m; ++i) {
+      const double t = t0 + (t1 - t0) * i / m;
+      const gp_Pnt p = c.Value(t);
+      S.t.push_back(t);
+      S.s.push_back(i ? S.s.back() + p.Distance(prev) : 0.0);
+      prev = p;
+      props.SetParameter(t);
+      double k = props.IsTangentDefined() ? std::abs(props.Curvature()) : 0.0;
+      S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin_, params.max_angle / k)) : edge_size[e]);
+    }
+  }
+  // the wall thickness of the faces along each edge, read through the edge's parameter curves
+  for (int f = 0; f < nf; ++f) {
+    if (thin_uv_[f].empty()) continue;
+    const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
+    const TopoDS_Face F = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
+    for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e) {
+      if (topo.edge_degenerate[*e]) continue;
+      double pf, pl;
+      const Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(TopoDS::Edge(topo.edges(*e + 1)), F, pf, pl);
+      if (pc.IsNull()) continue;
+      EdgeSamples& S = samples_[*e];
+      for (size_t i = 0; i < S.t.size(); ++i) {
+        const gp_Pnt2d w = pc->Value(S.t[i]);
+        const double q[2] = {w.X() * geo_[f].su, w.Y() * geo_[f].sv};
+        S.size[i] = thin.size_at(q, S.size[i]);
+      }
+    }
+  }
+  // Vertex sizes: no larger than the sizes along their edges nor their short edges' lengths,
+  // then limited by the gradation across edges.
+  vsize_.assign(nv, h_);
+  for (int e = 0; e < ne; ++e) {
+    const EdgeSamples& S = samples_[e];
+    if (S.va < 0) continue;
+    const double len = S.s.back();
+    vsize_[S.va] = std::min({vsize_[S.va], S.size.front(), std::max(len, hmin_ / 8)});
+    vsize_[S.vb] = std::min({vsize_[S.vb], S.size.back(), std::max(len, hmin_ / 8)});
+  }
+  grade_vertex_sizes();
+}
+
+// Wall thickness (params.wall_layers > 0): walls thinner than two face sizes get about that
+// many element layers across, size = thickness / (layers + 0.5), not below min_size (at
+// thickness / layers exactly, the volume fill's circumradius rule still leaves many tets
+// spanning the wall). Measured on a coarse tessellation of a copy of the model (OCCT's BRepMesh;
+// the model itself keeps no triangulation): points spread over each triangle about a face
+// size apart cast a ray inward, and the nearest triangle it meets gives the thickness there.
+// Each point thinner than two face sizes becomes a fine point in the face's scaled parameters,
+// which a SizeRaster spreads at the gradation rate over the face's fill and its edges.
+void ModelSurface::measure_thickness() {
+  const int nf = topo_.num_faces();
+  thin_uv_.assign(nf, {});
+  wall_points_.clear();
+  if (nf == 0 || params_.wall_layers <= 0) return;
+  BRepBuilderAPI_Copy copier(topo_.shape, Standard_True, Standard_False);
+  const TopoDS_Shape copy = copier.Shape();
+  BRepMesh_IncrementalMesh(copy, 0.2 * h_, Standard_False, 0.5, Standard_True);
+  std::vector<std::array<double, 3>> xyz;
+  std::vector<std::array<double, 2>> uv;
+  std::vector<std::array<int, 3>> tri;
+  std::vector<int> tri_face;
+  for (int f = 0; f < nf; ++f) {
+    const TopoDS_Shape& original = topo_.faces(f + 1);
+    const TopTools_ListOfShape& mod = copier.Modified(original);
+    if (mod.IsEmpty()) continue;
+    const TopoDS_Face face = TopoDS::Face(mod.First());
+    TopLoc_Location loc;
+    const Handle(Poly_Triangulation) pt = BRep_Tool::Triangulation(face, loc);
+    if (pt.IsNull()) continue;
+    const int base = static_cast<int>(xyz.size());
+    for (int i = 1; i <= pt->NbNodes(); ++i) {
+      const gp_Pnt q = pt->Node(i).Transformed(loc.Transformation());
+      xyz.push_back({q.X(), q.Y(), q.Z()});
+      const gp_Pnt2d w = pt->HasUVNodes() ? pt->UVNode(i) : gp_Pnt2d(0, 0);
+      uv.push_back({w.X() * geo_[f].su, w.Y() * geo_[f].sv});
+    }
+    const bool reversed = face.Orientation() == TopAbs_REVERSED;
+    for (int i = 1; i <= pt->NbTriangles(); ++i) {
+      int a, b, c;
+      pt->Triangle(i).Get(a, b, c);
+      if (reversed) std::swap(b, c);
+      tri.push_back({base + a - 1, base + b - 1, base + c - 1});
+      tri_face.push_back(pt->HasUVNodes() ? f : -1);
+    }
+  }
+  if (tri.empty()) return;
+  MatX3d V(static_cast<long>(xyz.size()), 3);
+  for (size_t i = 0; i < xyz.size(); ++i) V.row(static_cast<long>(i)) << xyz[i][0], xyz[i][1], xyz[i][2];
+  MatX3i F(static_cast<long>(tri.size()), 3);
+  for (size_t t = 0; t < tri.size(); ++t) F.row(static_cast<long>(t)) << tri[t][0], tri[t][1], tri[t][2];
+  const TriangleRays rays(V, F);
+  for (long t = 0; t < F.rows(); ++t) {
+    const int f = tri_face[t];
+    if (f < 0) continue;
+    const double hf = face_size_[f];
+    const Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), c = V.row(F(t, 2));
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() <= 0) continue;
+    n.normalize();
+    const Eigen::Vector3d d = -n;  // into the material
+    // samples: a barycentric grid about 0.7 face sizes apart (not below half the model's
+    // size: a fillet's small face size says nothing about how thick the wall behind it is)
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int m = std::clamp(static_cast<int>(std::ceil(longest / (0.7 * std::max(hf, 0.5 * h_)))), 1, 64);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; i + j < m; ++j) {
+        const double wa = (i + 1.0 / 3) / m, wb = (j + 1.0 / 3) / m, wc = 1 - wa - wb;
+        const Eigen::Vector3d x = wa * a + wb * b + wc * c;
+        const double thick = rays.first_hit(x.data(), d.data(), t, 2 * hf);
+        if (thick >= 2 * hf || thick < 1e-9 * h_) continue;
+        const double size = std::max(thick / (params_.wall_layers + 0.5), hmin_);
+        if (size >= hf) continue;
+        const Eigen::Vector3d mid = x + 0.5 * thick * d;
+        wall_points_.push_back({mid[0], mid[1], mid[2], size});
+        const auto &ua = uv[F(t, 0)], &ub = uv[F(t, 1)], &uc = uv[F(t, 2)];
+        thin_uv_[f].push_back({wa * ua[0] + wb * ub[0] + wc * uc[0], wa * ua[1] + wb * ub[1] + wc * uc[1], size});
+      }
+  }
+}
+
+int ModelSurface::new_node(double x, double y, double z) {
+  nodes_.push_back({x, y, z});
+  return static_cast<int>(nodes_.size()) - 1;
+}
+
+void ModelSurface::set_vertex_node(int v, int node) { vertex_node_[v] = node; }
+
+void ModelSurface::create_vertex_nodes(double merge_tolerance) {
+  for (int v = 0; v < topo_.num_vertices(); ++v) {
+    if (vertex_node_[v] >= 0) continue;
+    const std::array<double, 3> p{topo_.vertex_point(v, 0), topo_.vertex_point(v, 1), topo_.vertex_point(v, 2)};
+    if (merge_tolerance > 0)
+      for (int u = 0; u < v && vertex_node_[v] < 0; ++u)
+        if (vertex_node_[u] >= 0 && sqdist(nodes_[vertex_node_[u]], p) <= merge_tolerance * merge_tolerance)
+          vertex_node_[v] = vertex_node_[u];
+    if (vertex_node_[v] < 0) vertex_node_[v] = new_node(p[0], p[1], p[2]);
+  }
+}
+
+double ModelSurface::edge_parameter(int e, const double* x, double* distance) const {
+  const TopoDS_Edge E = TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD));
+  double first, last;
+  Handle(Geom_Curve) curve = BRep_Tool::Curve(E, first, last);
+  if (curve.IsNull()) {
+    if (distance) *distance = 1e300;
+    return first;
+  }
+  gp_Pnt proj;
+  double t = first;
+  const double d = ShapeAnalysis_Curve().Project(curve, gp_Pnt(x[0], x[1], x[2]), 1e-9, proj, t, first, last, Standard_False);
+  if (distance) *distance = d;
+  return std::clamp(t, std::min(first, last), std::max(first, last));
+}
+
+void ModelSurface::fix_edge_node(int e, int node) {
+  const double t = edge_parameter(e, nodes_[node].data());
+  for (const auto& [s, n] : fixed_[e])
+    if (n == node) return;
+  fixed_[e].push_back({t, node});
+}
+
+void ModelSurface::set_edge_mesh(int e, const std::vector<int>& ids) {
+  const TopoDS_Edge E = TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD));
+  BRepAdaptor_Curve c(E);
+  std::vector<double> par(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i)
+    par[i] = i == 0 ? c.FirstParameter() : i + 1 == ids.size() ? c.LastParameter() : edge_parameter(e, nodes_[ids[i]].data());
+  edge_param_[e] = std::move(par);
+  edge_node_[e] = ids;
+  edge_kind_[e] = EdgeKind::Given;
+}
+
+void ModelSurface::alias_edge(int e, int rep, bool reversed) {
+  edge_kind_[e] = EdgeKind::Alias;
+  alias_of_[e] = {rep, reversed ? 1 : 0};
+}
+
+void ModelSurface::refresh_alias(int e) {
+  const auto [rep, reversed] = alias_of_[e];
+  std::vector<int> ids = edge_node_[rep];
+  if (reversed) std::reverse(ids.begin(), ids.end());
+  const EdgeKind keep = edge_kind_[e];
+  set_edge_mesh(e, ids);
+  edge_kind_[e] = keep;
+}
+
+// Where the nodes of edge e go: spacing = the smallest of the local size and the sizes
+// growing from both vertices at the gradation rate, at equal steps of ∫ ds / size between the
+// vertices and the fixed nodes (step 5: nodes transferred from the other model are kept).
+// Returns (parameter, node) from the first vertex to the last; node -1 where one is to be made.
+std::vector<std::pair<double, int>> ModelSurface::division(int e) const {
+  const EdgeSamples& S = samples_[e];
+  const int m = static_cast<int>(S.t.size()) - 1;
+  const double len = S.s.back();
+  std::vector<double> size(m + 1), phi(m + 1, 0.0);
+  for (int i = 0; i <= m; ++i) {
+    size[i] = std::min({S.size[i], vsize_[S.va] + grade_ * S.s[i], vsize_[S.vb] + grade_ * (len - S.s[i])});
+    size[i] = std::max(size[i], 1e-12);
+  }
+  // size also graded along the edge (a local curvature peak spreads out)
+  for (int i = 1; i <= m; ++i) size[i] = std::min(size[i], size[i - 1] + grade_ * (S.s[i] - S.s[i - 1]));
+  for (int i = m - 1; i >= 0; --i) size[i] = std::min(size[i], size[i + 1] + grade_ * (S.s[i + 1] - S.s[i]));
+  for (int i = 1; i <= m; ++i) phi[i] = phi[i - 1] + (S.s[i] - S.s[i - 1]) * 0.5 * (1 / size[i] + 1 / size[i - 1]);
+  const bool increasing = S.t.back() >= S.t.front();
+  auto phi_at = [&](double t) {  // phi at parameter t, linear between samples
+    double x = (t - S.t.front()) / (S.t.back() - S.t.front()) * m;
+    if (!increasing) x = (S.t.front() - t) / (S.t.front() - S.t.back()) * m;
+    x = std::clamp(x, 0.0, static_cast<double>(m));
+    const int i = std::min(m - 1, static_cast<int>(x));
+    return phi[i] + (x - i) * (phi[i + 1] - phi[i]);
+  };
+  auto t_at = [&](double target) {  // inverse of phi
+    int j = static_cast<int>(std::upper_bound(phi.begin(), phi.end(), target) - phi.begin()) - 1;
+    j = std::clamp(j, 0, m - 1);
+    const double w = phi[j + 1] > phi[j] ? (target - phi[j]) / (phi[j + 1] - phi[j]) : 0.5;
+    return S.t[j] + std::clamp(w, 0.0, 1.0) * (S.t[j + 1] - S.t[j]);
+  };
+  // break points: the ends and the fixed nodes, in order along the edge
+  std::vector<std::pair<double, int>> breaks{{S.t.front(), vertex_node_[S.va]}};
+  std::vector<std::pair<double, int>> fixed = fixed_[e];
+  std::sort(fixed.begin(), fixed.end(), [&](const auto& a, const auto& b) { return increasing ? a.first < b.first : a.first > b.first; });
+  for (const auto& fx : fixed)
+    if (fx.second != vertex_node_[S.va] && fx.second != vertex_node_[S.vb]) breaks.push_back(fx);
+  breaks.push_back({S.t.back(), vertex_node_[S.vb]});
+  const int pieces = static_cast<int>(breaks.size()) - 1;
+  std::vector<int> count(pieces);
+  int total = 0;
+  for (int k = 0; k < pieces; ++k) {
+    const double dphi = phi_at(breaks[k + 1].first) - phi_at(breaks[k].first);
+    count[k] = std::max(1, static_cast<int>(std::ceil(dphi - 0.3)));
+    total += count[k];
+  }
+  if (S.va == S.vb)  // a closed edge needs at least three segments
+    for (; total < 3; ++total) ++*std::max_element(count.begin(), count.end());
+  std::vector<std::pair<double, int>> out{breaks[0]};
+  for (int k = 0; k < pieces; ++k) {
+    const double p0 = phi_at(breaks[k].first), p1 = phi_at(breaks[k + 1].first);
+    for (int i = 1; i < count[k]; ++i) out.push_back({t_at(p0 + (p1 - p0) * i / count[k]), -1});
+    out.push_back(breaks[k + 1]);
+  }
+  return out;
+}
+
+void ModelSurface::discretise(int e) {
+  BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
+  std::vector<double>& par = edge_param_[e];
+  std::vector<int>& ids = edge_node_[e];
+  par.clear(), ids.clear();
+  for (const auto& [t, node] : division(e)) {
+    par.push_back(t);
+    if (node >= 0) {
+      ids.push_back(node);
+    } else {
+      const gp_Pnt p = c.Value(t);
+      ids.push_back(new_node(p.X(), p.Y(), p.Z()));
+    }
+  }
+}
+
+// A vertex's size becomes the length of the shortest segment next to it when that is clearly
+// shorter: an edge a little longer than the size is cut into pieces shorter than the size, and
+// the edges meeting it at a vertex then start from that length instead of the full size (a
+// 2 mm side at size 1.28 gets two pieces of 1 mm; the side meeting it at a right angle
+// started at 1.25 mm, a corner triangle of 39°; now ~1 mm, 45°). One pass, then graded again.
+void ModelSurface::match_vertex_sizes() {
+  bool changed = false;
+  for (int e = 0; e < topo_.num_edges(); ++e) {
+    if (topo_.edge_degenerate[e] || edge_kind_[e] != EdgeKind::Free) continue;
+    const EdgeSamples& S = samples_[e];
+    const std::vector<std::pair<double, int>> d = division(e);
+    // one segment: its length is already below the vertex sizes; many: the rounding is spread
+    if (d.size() < 3 || d.size() > 4) continue;
+    BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
+    const double first = c.Value(d[0].first).Distance(c.Value(d[1].first));
+    const double last = c.Value(d[d.size() - 2].first).Distance(c.Value(d.back().first));
+    for (auto [v, l] : {std::pair<int, double>{S.va, first}, std::pair<int, double>{S.vb, last}})
+      if (l < 0.85 * vsize_[v]) vsize_[v] = std::max(l, hmin_), changed = true;
+  }
+  if (changed) grade_vertex_sizes();
+}
+
+// Vertex sizes limited by the gradation across edges (relaxed to a fixed point).
+void ModelSurface::grade_vertex_sizes() {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int e = 0; e < topo_.num_edges(); ++e) {
+      const EdgeSamples& S = samples_[e];
+      if (S.va < 0) continue;
+      const double len = S.s.back();
+      for (auto [x, y] : {std::pair<int, int>{S.va, S.vb}, std::pair<int, int>{S.vb, S.va}})
+        if (vsize_[x] > vsize_[y] + grade_ * len * 1.0000001) vsize_[x] = vsize_[y] + grade_ * len, changed = true;
+    }
+  }
+}
+
+// The boundary of face f in its scaled parameters: local nodes (a seam's nodes appear twice,
+// at both ends of the period), their global numbers, directed segments with the face on
+// their left, and the B-Rep edge of each segment.
+ModelSurface::Loops ModelSurface::face_loops(int f) const {
+  Loops L;
+  const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
+  const FaceGeometry& g = geo_[f];
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(fwd, u0, u1, v0, v1);
+  const double tol = 1e-6 * std::hypot((u1 - u0) * g.su, (v1 - v0) * g.sv);
+  std::unordered_map<int, std::vector<int>> locals;  // global node -> its local copies (seams)
+  auto local_node = [&](int gid, double u, double v) {
+    for (int l : locals[gid])
+      if (std::hypot(L.uv[l][0] - u, L.uv[l][1] - v) <= std::max(tol, 1e-3 * face_size_[f])) return l;
+    L.uv.push_back({u, v});
+    L.global.push_back(gid);
+    locals[gid].push_back(static_cast<int>(L.uv.size()) - 1);
+    return static_cast<int>(L.uv.size()) - 1;
+  };
+  for (TopExp_Explorer ex(fwd, TopAbs_EDGE); ex.More(); ex.Next()) {
+    const TopoDS_Edge E = TopoDS::Edge(ex.Current());
+    const int e = topo_.edges.FindIndex(E) - 1;
+    double pf, pl;
+    Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(E, fwd, pf, pl);
+    if (pc.IsNull() || e < 0) continue;
+    std::vector<double> par = edge_param_[e];
+    std::vector<int> ids = edge_node_[e];
+    if (topo_.edge_degenerate[e]) {
+      // A collapsed edge (cone apex, sphere pole): a segment in the parameters, one node
+      // in space. Its pieces all carry the vertex's node; the triangles that collapse onto
+      // it are dropped, which leaves a fan around the apex.
+      TopoDS_Vertex va, vb;
+      TopExp::Vertices(E, va, vb);
+      const int vid = vertex_node_[topo_.vertices.FindIndex(va) - 1];
+      // as many pieces as the fan needs for angles of about 50° at the apex: the angle the
+      // surface sweeps around it, from the derivative across the collapsed edge
+      const int n = std::clamp(static_cast<int>(std::ceil(apex_angle(fwd, pc, pf, pl) / (50.0 * M_PI / 180))), 2, kMaxApexPieces);
+      par.clear();
+      ids.assign(n + 1, vid);
+      for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
+    }
+    std::vector<int> loc(par.size());
+    for (size_t i = 0; i < par.size(); ++i) {
+      gp_Pnt2d q = pc->Value(par[i]);
+      loc[i] = local_node(ids[i], q.X() * g.su, q.Y() * g.sv);
+    }
+    const bool forward = E.Orientation() == TopAbs_FORWARD;
+    for (size_t i = 0; i + 1 < loc.size(); ++i) {
+      L.segs.push_back(forward ? std::array<int, 2>{loc[i], loc[i + 1]} : std::array<int, 2>{loc[i + 1], loc[i]});
+      L.seg_edge.push_back(e);
+      L.seg_piece.push_back(topo_.edge_degenerate[e] ? -1 : static_cast<int>(i));
+    }
+  }
+  return L;
+}
+
+void ModelSurface::mesh_edges(const Progress& progress) {
+  const int ne = topo_.num_edges(), nf = topo_.num_faces();
+  for (int v = 0; v < topo_.num_vertices(); ++v)
+    if (vertex_node_[v] < 0) throw Error(ErrorCode::Internal, "mesh_edges: a vertex has no node yet");
+  match_vertex_sizes();
+  for (int e = 0; e < ne; ++e)
+    if (!topo_.edge_degenerate[e] && edge_kind_[e] == EdgeKind::Free) discretise(e);
+  for (int e = 0; e < ne; ++e)
+    if (edge_kind_[e] == EdgeKind::Alias) refresh_alias(e);
+
+  // ---- proximity: where two boundary segments of a face cross in its parameters or come
+  // closer than a third of their length (thin strips, nearly tangent edges), the polygon the
+  // front starts from would cross itself or leave no room; those pieces of their edges are
+  // split at their middle, locally, until no face has such a pair (or the floor is reached).
+  // Given edges are never split; a piece of an aliased edge is split on the edge it copies.
+  // Each round looks again only at the faces one of whose edges was split.
+  const double floor_len = hmin_ / 8;
+  // (edge, piece) of the edge a piece's splits go to: itself, or the free edge an alias copies
+  auto free_piece = [&](int e, int piece) {
+    if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return std::pair<int, int>{-1, -1};
+    if (edge_kind_[e] == EdgeKind::Alias) {
+      const auto [rep, reversed] = alias_of_[e];
+      if (edge_kind_[rep] != EdgeKind::Free) return std::pair<int, int>{-1, -1};
+      if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
+      e = rep;
+    }
+    return std::pair<int, int>{e, piece};
+  };
+  // The two pieces at a corner of a face sharper than kNeedleAngle (measured on the pieces
+  // themselves, in the face's scaled parameters, where the face lies left of its loops) are
+  // not split, in any face, unless they cross another piece: one needle triangle takes the
+  // corner's angle (NIST 1's 11° slots, arcs tangent to a line). The pieces beyond are split
+  // by the rules below like any others, which grades them away from the corner. At a corner
+  // below kCuspAngle the pieces near it are only split where they cross: that close to a
+  // cusp, splitting makes ever thinner triangles, while longer chords open the corner up.
+  std::vector<std::array<char, 2>> needle_end(ne, {0, 0});  // first / last piece of each edge
+  std::unordered_set<int> cusp;                            // nodes of corners below kCuspAngle
+  for (int f = 0; f < nf; ++f) {
+    if (face_given_[f]) continue;
+    const Loops L = face_loops(f);
+    std::unordered_map<int, int> in, out;  // local node -> the piece ending / starting there
+    std::unordered_set<int> many;
+    for (size_t i = 0; i < L.segs.size(); ++i) {
+      if (!in.emplace(L.segs[i][1], static_cast<int>(i)).second) many.insert(L.segs[i][1]);
+      if (!out.emplace(L.segs[i][0], static_cast<int>(i)).second) many.insert(L.segs[i][0]);
+    }
+    for (const auto& [node, a] : in) {
+      const auto it = out.find(node);
+      if (it == out.end() || many.count(node)) continue;
+      const int b = it->second;
+      const auto &P = L.uv[L.segs[a][0]], &Q = L.uv[node], &R = L.uv[L.segs[b][1]];
+      const double d1[2] = {Q[0] - P[0], Q[1] - P[1]}, d2[2] = {R[0] - Q[0], R[1] - Q[1]};
+      const double turn = std::atan2(d1[0] * d2[1] - d1[1] * d2[0], d1[0] * d2[0] + d1[1] * d2[1]);
+      const double corner = M_PI - turn;
+      if (corner >= kNeedleAngle) continue;
+      if (corner < kCuspAngle) {
+        cusp.insert(L.global[node]);
+        continue;
+      }
+      for (int sgm : {a, b}) {
+        const auto [e, piece] = free_piece(L.seg_edge[sgm], L.seg_piece[sgm]);
+        if (e < 0) continue;
+        if (piece == 0) needle_end[e][0] = 1;
+        if (piece + 2 == static_cast<int>(edge_node_[e].size())) needle_end[e][1] = 1;
+      }
+    }
+  }
+  auto is_needle = [&](int e, int piece) {
+    return (piece == 0 && needle_end[e][0]) || (piece + 2 == static_cast<int>(edge_node_[e].size()) && needle_end[e][1]);
+  };
+  std::vector<char> stale(nf, 1);
+  for (int round = 0; round < 10; ++round) {
+    std::vector<std::vector<int>> split(ne);  // pieces of each edge to split
+    bool any = false;
+    for (int f = 0; f < nf; ++f) {
+      if (!stale[f] || face_given_[f]) continue;
+      progress.check_cancel("surface meshing");
+      stale[f] = 0;
+      const Loops L = face_loops(f);
+      const size_t ns = L.segs.size();
+      std::vector<int> order(ns);
+      std::vector<double> xlo(ns), xhi(ns), ylo(ns), yhi(ns), len(ns);
+      for (size_t i = 0; i < ns; ++i) {
+        const auto& A = L.uv[L.segs[i][0]];
+        const auto& B = L.uv[L.segs[i][1]];
+        len[i] = std::hypot(B[0] - A[0], B[1] - A[1]);
+        xlo[i] = std::min(A[0], B[0]), xhi[i] = std::max(A[0], B[0]);
+        ylo[i] = std::min(A[1], B[1]), yhi[i] = std::max(A[1], B[1]);
+        order[i] = static_cast<int>(i);
+      }
+      std::sort(order.begin(), order.end(), [&](int p, int q) { return xlo[p] < xlo[q]; });
+      auto point_seg = [&](const std::array<double, 2>& P, const std::array<double, 2>& A, const std::array<double, 2>& B) {
+        const double dx = B[0] - A[0], dy = B[1] - A[1], l2 = dx * dx + dy * dy;
+        const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
+        return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
+      };
+      auto len3 = [&](const Loops& LL, int i) {
+        return std::sqrt(sqdist(nodes_[LL.global[LL.segs[i][0]]], nodes_[LL.global[LL.segs[i][1]]]));
+      };
+      auto dist3 = [&](int v, const Loops& LL, int i) {  // from node v to the nearer end of segment i
+        return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]), sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
+      };
+      // segments i and j of two different edges that end at one cusp's node, both within four
+      // of their lengths of it (3D)
+      auto near_cusp = [&](int i, int j) {
+        const int ei = L.seg_edge[i], ej = L.seg_edge[j];
+        if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
+        const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()}, vj{edge_node_[ej].front(), edge_node_[ej].back()};
+        const double reach = 4 * std::max(len3(L, i), len3(L, j));
+        for (int v : vi)
+          for (int w : vj)
+            if (v == w && cusp.count(v) && dist3(v, L, i) < reach && dist3(v, L, j) < reach) return true;
+        return false;
+      };
+      auto mark = [&](int s, bool crossing = false) {
+        auto [e, piece] = free_piece(L.seg_edge[s], L.seg_piece[s]);
+        if (e < 0 || (!crossing && is_needle(e, piece))) return;
+        const auto& ids = edge_node_[e];
+        const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
+        if (l3 > floor_len) split[e].push_back(piece), any = true;
+      };
+      // pieces longer than the face's size field there (finer features nearby in the face,
+      // e.g. a small hole close to a long straight edge) are split too
+      {
+        const PointGrid grid(fine_points(L.uv, L.segs, face_size_[f]), face_size_[f], grade_);
+        const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
+        for (size_t i = 0; i < ns; ++i) {
+          const auto& A = L.uv[L.segs[i][0]];
+          const auto& B = L.uv[L.segs[i][1]];
+          const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
+          if (len[i] > 1.5 * thin.size_at(mid, grid.size_at(mid, face_size_[f]))) mark(static_cast<int>(i));
+        }
+      }
+      for (size_t oi = 0; oi < ns; ++oi) {
+        const int i = order[oi];
+        for (size_t oj = oi + 1; oj < ns; ++oj) {
+          const int j = order[oj];
+          const double gap = std::max(len[i], len[j]) / 3;
+          if (xlo[j] > xhi[i] + gap) break;
+          if (ylo[j] > yhi[i] + gap || ylo[i] > yhi[j] + gap) continue;
+          const auto &si = L.segs[i], &sj = L.segs[j];
+          if (si[0] == sj[0] || si[0] == sj[1] || si[1] == sj[0] || si[1] == sj[1]) continue;
+          const auto &A = L.uv[si[0]], &B = L.uv[si[1]], &C = L.uv[sj[0]], &D = L.uv[sj[1]];
+          const bool cross = predicates::orient2d(A.data(), B.data(), C.data()) *
+                                     predicates::orient2d(A.data(), B.data(), D.data()) <= 0 &&
+                             predicates::orient2d(C.data(), D.data(), A.data()) *
+                                     predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
+          const double d = cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
+          if (d >= gap || (!cross && near_cusp(i, j))) continue;
+          // the longer one is what leaves no room; both when they cross
+          if (cross || len[i] >= 0.7 * len[j]) mark(i, cross);
+          if (cross || len[j] >= 0.7 * len[i]) mark(j, cross);
+        }
+      }
+    }
+    if (!any) break;
+    std::vector<char> changed(ne, 0);
+    for (int e = 0; e < ne; ++e) {
+      if (split[e].empty()) continue;
+      changed[e] = 1;
+      std::sort(split[e].begin(), split[e].end());
+      split[e].erase(std::unique(split[e].begin(), split[e].end()), split[e].end());
+      BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
+      for (auto it = split[e].rbegin(); it != split[e].rend(); ++it) {
+        const int k = *it;
+        const double t = 0.5 * (edge_param_[e][k] + edge_param_[e][k + 1]);
+        const gp_Pnt p = c.Value(t);
+        edge_param_[e].insert(edge_param_[e].begin() + k + 1, t);
+        edge_node_[e].insert(edge_node_[e].begin() + k + 1, new_node(p.X(), p.Y(), p.Z()));
+      }
+    }
+    for (int e = 0; e < ne; ++e)
+      if (edge_kind_[e] == EdgeKind::Alias && changed[alias_of_[e][0]]) refresh_alias(e), changed[e] = 1;
+    for (int f = 0; f < nf; ++f)
+      for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f) && !stale[f]; ++e)
+        stale[f] = changed[*e];
+  }
+}
+
+void ModelSurface::constrain_face(int f, int a, int b) {
+  if (a == b) return;
+  for (const auto& s : constraint_[f])
+    if ((s[0] == a && s[1] == b) || (s[0] == b && s[1] == a)) return;
+  constraint_[f].push_back({a, b});
+}
+
+void ModelSurface::add_face_node(int f, int n) {
+  if (std::find(face_extra_nodes_[f].begin(), face_extra_nodes_[f].end(), n) == face_extra_nodes_[f].end())
+    face_extra_nodes_[f].push_back(n);
+}
+
+void ModelSurface::set_face_mesh(int f, std::vector<std::array<int, 3>> tris) {
+  face_tris_[f] = std::move(tris);
+  face_given_[f] = 1;
+}
+
+void ModelSurface::alias_face(int f, int src, bool reversed) { face_alias_[f] = {src, reversed ? 1 : 0}; }
+
+// Step 9 / 11 for one face: the front fills the face's loops in its scaled parameters,
+// honouring the constraint segments and nodes, then the triangles are improved on the
+// surface (constraint nodes and segments fixed).
+void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
+  const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
+  const FaceGeometry& g = geo_[f];
+  Loops loops = face_loops(f);
+  std::vector<std::array<double, 2>>& uv = loops.uv;
+  std::vector<int> global = std::move(loops.global);
+  // constraint nodes: a boundary node takes its local copy (the one nearest the segment's
+  // other end on a seam), any other node its parameters by projection onto the surface
+  std::unordered_map<int, std::vector<int>> locals;
+  for (size_t l = 0; l < global.size(); ++l) locals[global[l]].push_back(static_cast<int>(l));
+  ShapeAnalysis_Surface sas(BRep_Tool::Surface(fwd));
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(fwd, u0, u1, v0, v1);
+  auto project = [&](int n) {
+    const auto& x = nodes_[n];
+    gp_Pnt2d q = sas.ValueOfUV(gp_Pnt(x[0], x[1], x[2]), 1e-9);
+    double u = q.X(), v = q.Y();
+    const Handle(Geom_Surface)& s = sas.Surface();
+    if (s->IsUPeriodic()) {
+      const double T = s->UPeriod();
+      while (u < u0 - 1e-9 * T) u += T;
+      while (u > u1 + 1e-9 * T) u -= T;
+    }
+    if (s->IsVPeriodic()) {
+      const double T = s->VPeriod();
+      while (v < v0 - 1e-9 * T) v += T;
+      while (v > v1 + 1e-9 * T) v -= T;
+    }
+    uv.push_back({u * g.su, v * g.sv});
+    global.push_back(n);
+    locals[n].push_back(static_cast<int>(uv.size()) - 1);
+    return static_cast<int>(uv.size()) - 1;
+  };
+  auto local_of = [&](int n, int near) {
+    auto it = locals.find(n);
+    if (it == locals.end() || it->second.empty()) return project(n);
+    int best = it->second[0];
+    if (near >= 0)
+      for (int l : it->second)
+        if (std::hypot(uv[l][0] - uv[near][0], uv[l][1] - uv[near][1]) <
+            std::hypot(uv[best][0] - uv[near][0], uv[best][1] - uv[near][1]))
+          best = l;
+    return best;
+  };
+  std::vector<std::array<int, 2>> csegs;
+  for (const auto& s : constraint_[f]) {
+    const bool a_unique = locals.count(s[0]) && locals[s[0]].size() == 1;
+    int a, b;
+    if (a_unique || !locals.count(s[1])) {
+      a = local_of(s[0], -1);
+      b = local_of(s[1], a);
+    } else {
+      b = local_of(s[1], -1);
+      a = local_of(s[0], b);
+    }
+    csegs.push_back({a, b});
+  }
+  std::vector<int> isolated;
+  for (int n : face_extra_nodes_[f])
+    if (!locals.count(n)) isolated.push_back(local_of(n, -1));
+
+  FaceFrontInput in;
+  in.P.resize(static_cast<long>(uv.size()), 2);
+  for (size_t i = 0; i < uv.size(); ++i) in.P.row(static_cast<long>(i)) << uv[i][0], uv[i][1];
+  in.boundary.resize(static_cast<long>(loops.segs.size()), 2);
+  for (size_t i = 0; i < loops.segs.size(); ++i) in.boundary.row(static_cast<long>(i)) << loops.segs[i][0], loops.segs[i][1];
+  in.segments.resize(static_cast<long>(csegs.size()), 2);
+  for (size_t i = 0; i < csegs.size(); ++i) in.segments.row(static_cast<long>(i)) << csegs[i][0], csegs[i][1];
+  in.isolated = isolated;
+  FaceFrontParams fp = params_.front;
+  // size: the face's, but near boundary and constraint pieces finer than that (split by
+  // proximity, from a finer neighbour, or from the other model) it grows from their length
+  // at the gradation rate
+  const double hf = face_size_[f];
+  std::vector<std::array<int, 2>> all_segs = loops.segs;
+  all_segs.insert(all_segs.end(), csegs.begin(), csegs.end());
+  const PointGrid grid(fine_points(uv, all_segs, hf), hf, grade_);
+  const SizeRaster thin(thin_uv_[f], hf, grade_);  // and inside thin walls, half their thickness
+  fp.size = [hf, &grid, &thin](const double* q) { return thin.size_at(q, grid.size_at(q, hf)); };
+  FaceFrontResult r;
+  try {
+    r = fill_face(in, fp, prog);
+  } catch (const Error& err) {
+    if (err.code() == ErrorCode::Cancelled) throw;
+    out.error = err.what();
+    return;
+  }
+  // local optimisation judged on the surface; triangles collapsed on an apex keep their edges
+  BRepAdaptor_Surface s(fwd, Standard_False);
+  const double su = g.su, sv = g.sv;
+  SurfaceEval eval = [&s, su, sv](const double* q, double* x, double* du, double* dv) {
+    gp_Pnt p;
+    gp_Vec a, b;
+    s.D1(q[0] / su, q[1] / sv, p, a, b);
+    x[0] = p.X(), x[1] = p.Y(), x[2] = p.Z();
+    du[0] = a.X() / su, du[1] = a.Y() / su, du[2] = a.Z() / su;
+    dv[0] = b.X() / sv, dv[1] = b.Y() / sv, dv[2] = b.Z() / sv;
+  };
+  std::vector<std::array<int, 2>> locked = csegs;
+  const long nin = static_cast<long>(global.size());
+  for (long t = 0; t < r.T.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = r.T(t, k), b = r.T(t, (k + 1) % 3), c = r.T(t, (k + 2) % 3);
+      if (a < nin && b < nin && global[a] == global[b]) locked.push_back({a, c}), locked.push_back({b, c});
+    }
+  optimize_on_surface(r.P, r.T, out.X, static_cast<int>(nin), eval, locked, params_.optimize_rounds);
+  out.global = std::move(global);
+  out.T = std::move(r.T);
+}
+
+void ModelSurface::mesh_faces(const Progress& progress) {
+  const int nf = topo_.num_faces();
+  // faces in parallel (largest first), merged in face order so the result does not depend
+  // on the threads
+  std::vector<int> order;
+  std::vector<double> work(nf, 0.0);
+  for (int f = 0; f < nf; ++f)
+    if (!face_given_[f] && face_alias_[f][0] < 0) {
+      order.push_back(f);
+      work[f] = topo_.face_area[f] / (face_size_[f] * face_size_[f]);
+    }
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return work[x] > work[y]; });
+  std::vector<FaceOut> face_out(nf);
+  parallel_tasks(order, thread_count(params_.threads), progress, "surface meshing",
+                 [&](int f, const Progress& prog) { mesh_face(f, prog, face_out[f]); });
+  for (int f = 0; f < nf; ++f) {
+    if (face_given_[f] || face_alias_[f][0] >= 0) continue;
+    FaceOut& fo = face_out[f];
+    if (!fo.error.empty()) {
+      failed_.push_back(f + 1);
+      reasons_.push_back(fo.error);
+      continue;
+    }
+    const long nin = static_cast<long>(fo.global.size());
+    // the face's own nodes that its triangles use (the optimiser's collapses leave some unused)
+    std::vector<int> to_global(fo.X.rows(), -1);
+    for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];
+    for (long t = 0; t < fo.T.rows(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int i = fo.T(t, k);
+        if (to_global[i] < 0) to_global[i] = new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
+      }
+    const bool flip = topo_.faces(f + 1).Orientation() == TopAbs_REVERSED;
+    auto& tris = face_tris_[f];
+    tris.clear();
+    for (long t = 0; t < fo.T.rows(); ++t) {
+      std::array<int, 3> tri{to_global[fo.T(t, 0)], to_global[fo.T(t, 1)], to_global[fo.T(t, 2)]};
+      if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;  // collapsed on an apex
+      if (flip) std::swap(tri[1], tri[2]);
+      tris.push_back(tri);
+    }
+    fo = FaceOut();
+  }
+  // aliased faces (solids that touch): the source's triangles, after checking that their
+  // boundary is this face's boundary
+  for (int f = 0; f < nf; ++f) {
+    const auto [src, reversed] = face_alias_[f];
+    if (src < 0) continue;
+    std::vector<std::array<int, 3>> tris = face_tris_[src];
+    if (reversed)
+      for (auto& t : tris) std::swap(t[1], t[2]);
+    std::set<std::pair<int, int>> mine, theirs;
+    const Loops L = face_loops(f);
+    for (const auto& s : L.segs) mine.insert(std::minmax(L.global[s[0]], L.global[s[1]]));
+    std::map<std::pair<int, int>, int> uses;
+    for (const auto& t : tris)
+      for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+    for (const auto& [e, n] : uses)
+      if (n == 1) theirs.insert(e);
+    if (tris.empty() || mine != theirs) {
+      failed_.push_back(f + 1);
+      std::ostringstream m;
+      m << "Face" << f + 1 << " lies on Face" << src + 1
+        << " but their boundaries differ (only identical touching faces are supported)";
+      reasons_.push_back(m.str());
+      continue;
+    }
+    face_tris_[f] = std::move(tris);
+  }
+}
+
+std::vector<std::array<int, 3>> ModelSurface::solid_triangles(int s) const {
+  std::vector<std::array<int, 3>> rows;
+  for (const auto& [f, flip] : solid_faces(topo_, s))
+    for (auto t : face_tris_[f - 1]) {
+      if (flip) std::swap(t[1], t[2]);
+      rows.push_back(t);
+    }
+  return rows;
+}
+
+SurfaceMesh ModelSurface::result() const {
+  SurfaceMesh out;
+  out.failed_faces = failed_;
+  out.reasons = reasons_;
+  const int nv = topo_.num_vertices();
+  std::unordered_map<int, int> renum;
+  std::vector<int> used;
+  auto take = [&](int n) {
+    auto [it, inserted] = renum.emplace(n, static_cast<int>(used.size()));
+    if (inserted) used.push_back(n);
+    return it->second;
+  };
+  for (int v = 0; v < nv; ++v) take(vertex_node_[v]);
+  long nt = 0;
+  for (const auto& tris : face_tris_) nt += static_cast<long>(tris.size());
+  out.F.resize(nt, 3);
+  out.face.resize(nt);
+  long row = 0;
+  for (int f = 0; f < topo_.num_faces(); ++f)
+    for (const auto& t : face_tris_[f]) {
+      out.F.row(row) << take(t[0]), take(t[1]), take(t[2]);
+      out.face[row++] = f + 1;
+    }
+  out.V.resize(static_cast<long>(used.size()), 3);
+  for (size_t i = 0; i < used.size(); ++i) out.V.row(static_cast<long>(i)) << nodes_[used[i]][0], nodes_[used[i]][1], nodes_[used[i]][2];
+  return out;
+}
+
+SurfaceMesh mesh_surface(const brep::TopologyIndex& topo, const SurfaceMeshParams& params, const Progress& progress) {
+  std::vector<std::array<double, 3>> nodes;
+  ModelSurface model(topo, nodes, params);
+  model.create_vertex_nodes();
+  model.mesh_edges(progress);
+  model.mesh_faces(progress);
+  return model.result();
+}
+
+MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh, int s) {
+  std::map<int, bool> flip;
+  for (const auto& [f, reversed] : solid_faces(topo, s)) flip[f] = reversed;
+  std::vector<std::array<int, 3>> rows;
+  for (long t = 0; t < mesh.F.rows(); ++t) {
+    auto it = flip.find(mesh.face[t]);
+    if (it == flip.end()) continue;
+    if (it->second) rows.push_back({mesh.F(t, 0), mesh.F(t, 2), mesh.F(t, 1)});
+    else rows.push_back({mesh.F(t, 0), mesh.F(t, 1), mesh.F(t, 2)});
+  }
+  MatX3i out(static_cast<long>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) out.row(i) << rows[i][0], rows[i][1], rows[i][2];
+  return out;
+}
+
+long open_edges(const MatX3i& T) {
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < T.rows(); ++t)
+    for (int k = 0; k < 3; ++k) ++directed[{T(t, k), T(t, (k + 1) % 3)}];
+  long open = 0;
+  for (const auto& [e, n] : directed) {
+    auto rev = directed.find({e.second, e.first});
+    if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
+  }
+  return open;
+}
+
+std::vector<long> open_edges_per_solid(const brep::TopologyIndex& topo, const SurfaceMesh& mesh) {
+  std::vector<long> result;
+  for (int s = 0; s < topo.num_solids(); ++s) result.push_back(open_edges(solid_triangles(topo, mesh, s)));
+  return result;
+}
+
+}  // namespace topopt::mesh

@@ -1,0 +1,50 @@
+// The result shape: the region where the node densities reach a threshold, cut out of the
+// tagged tet mesh by marching tetrahedra, plus the non-design solids whole. Its boundary is
+// a closed, manifold, outward-oriented triangle mesh made of iso-triangles inside design
+// tets and the kept parts of Ω's boundary faces.
+#pragma once
+#include "common/types.h"
+
+namespace topopt::result {
+
+/// #V node densities: the volume-weighted mean of the densities of the tets around a node;
+/// nodes of non-design tets get 1 so the non-design solids are kept whole. density: #T.
+VecXd node_densities(const TetMesh& mesh, const VecXd& density);
+
+/// Volume of {x in design tets : interpolated node density >= threshold} (mm³), exact for
+/// the piecewise-linear field.
+double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold);
+
+/// The threshold in (0, 1) at which the kept design volume equals `volume_fraction` of the
+/// design domain's volume, by bisection.
+double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, double volume_fraction);
+
+/// A triangle surface with a tag per triangle and what may move when smoothing.
+struct TriSurface {
+  MatX3d V;         ///< #P by 3 points
+  MatX3i F;         ///< #Q by 3 triangles, oriented outwards
+  VecXi tag;        ///< #Q: 0 iso-surface, f > 0 Ω's face f, -k face of non-design solid k
+  /// #P: 0 free (iso-surface inside Ω), 1 on Ω's boundary, 2 on a non-design solid (fixed).
+  VecXi lock;
+  /// #P: for the points where the iso-surface meets Ω's face f (the cut line), f; else 0.
+  VecXi point_face;
+  /// Indexed by Ω face number: (n, d) of the face's plane n·x = d when the face is planar,
+  /// (0, 0, 0, 0) otherwise.
+  std::vector<Eigen::Vector4d> face_plane;
+};
+
+/// Marching tetrahedra at `threshold` on the node densities (#V). Returns the closed
+/// boundary of the kept region: iso-triangles in design tets, Ω's boundary triangles (or
+/// their kept parts) with their face tags, non-design tets' boundary triangles on Ω.
+TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold);
+
+/// Checks of a triangle surface: every edge used by exactly two triangles in opposite
+/// directions (closed, manifold, consistently oriented).
+struct SurfaceCheck {
+  long open_edges = 0, overshared_edges = 0, misoriented_edges = 0;
+  double volume = 0;  ///< enclosed volume (divergence theorem), > 0 when oriented outwards
+  bool closed_manifold() const { return open_edges == 0 && overshared_edges == 0 && misoriented_edges == 0; }
+};
+SurfaceCheck check_surface(const MatX3d& V, const MatX3i& F);
+
+}  // namespace topopt::result

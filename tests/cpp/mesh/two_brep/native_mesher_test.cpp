@@ -1,0 +1,217 @@
+// The native mesher end to end on the shared examples: a part alone (our surface mesh filled
+// by our advancing front), and the part with its non-design solids through the 14 steps —
+// one conformal tagged mesh (no duplicate nodes, interior faces shared by two tets, boundary
+// equal to the surface mesh, interface between domains on Ω̄'s faces, every domain's volume
+// within 0.5 % of the B-Rep's), the bracket's touching clamp pads conformal across their
+// shared face, a load pad's face tagged on the part's boundary.
+#include "mesh/two_brep/native_mesher.h"
+
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRep_Builder.hxx>
+#include <TopoDS_Compound.hxx>
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <map>
+
+#include "brep/shape_io.h"
+#include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "fem/elasticity.h"
+#include "mesh/core/conformity.h"
+#include "mesh/core/tet_quality.h"
+
+namespace topopt::mesh {
+namespace {
+
+brep::TwoBReps load(const std::string& name, bool with_nd = false) {
+  const std::string dir = std::string(TOPOPT_SHARED_DATA) + "/examples/";
+  return brep::load_two_breps(brep::read_shape_file(dir + name + ".step"),
+                              with_nd ? brep::read_shape_file(dir + name + "_nondesign.step") : TopoDS_Shape());
+}
+
+TetMesh mesh_at(const brep::TwoBReps& model, double factor) {
+  NativeMeshParams p;
+  p.surface.size = factor * model.part.diagonal() / 50;
+  return mesh_native(model, p);
+}
+
+/// f must throw a topopt::Error with `code` whose message contains `fragment`.
+void expect_error(const std::function<void()>& f, ErrorCode code, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+double triangle_area(const TetMesh& m, int a, int b, int c) {
+  return 0.5 * (m.V.row(b) - m.V.row(a)).cross(m.V.row(c) - m.V.row(a)).norm();
+}
+
+TEST(NativeMesher, PartsAloneAreConformalWithTheBRepVolume) {
+  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0}, {"bracket", 1.0}}) {
+    SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
+    const brep::TwoBReps model = load(name);
+    const TetMesh m = mesh_at(model, factor);
+    const ConformityReport c = check_conformity(m, &model);
+    EXPECT_TRUE(c.ok()) << c.to_json().dump();
+    EXPECT_LT(c.max_volume_error, 0.005);
+    const QualityReport q = tet_quality(m);
+    EXPECT_GT(q.min_radius_ratio, 0);  // no flat or inverted tet
+    EXPECT_GT(q.mean_radius_ratio, 0.7);
+  }
+}
+
+TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
+  // A cantilever plate 40 x 10 x 1 mm, Face1 (x = 0) fixed, 1 N down on Face2 (x = 40), at the
+  // default size (0.83 mm). One layer of linear tets across the thickness (91 % of the volume
+  // in tets touching both big faces) locks in bending: 0.27 of the beam's F L³ / 3 E I. With
+  // wall_layers = 2 the surface is refined from the thickness and the volume's size is seeded
+  // at mid-wall: 0.1 % of the volume left in such tets, 0.63 of the beam (linear tets stay
+  // stiff in bending until much finer: 0.77 with 4 layers; quadratic elements would be the cure).
+  const brep::TwoBReps model = brep::load_two_breps(BRepPrimAPI_MakeBox(40, 10, 1).Shape(), TopoDS_Shape());
+  const fem::Material mat;
+  const double beam = 1.0 * 40 * 40 * 40 / (3 * mat.young * 10 * 1.0 / 12);
+  double deflection[2], spanning[2];
+  for (int layers : {0, 2}) {
+    const int k = layers ? 1 : 0;
+    const TetMesh m = mesh_two_breps(model, "native", 0, 0, {}, nullptr, layers);
+    const fem::Supports sup = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+    const fem::LoadSpec tip{fem::LoadSpec::Kind::Force, {2}, {0, 0, -1}, 0, {}};
+    const Eigen::MatrixXd F = fem::make_loads(m, mat, {fem::LoadCase{"tip", {tip}, 1}});
+    fem::Elasticity fe(m, mat, sup, {});
+    // F·U over the 1 N: the load-weighted mean deflection of the end face
+    deflection[k] = F.col(0).dot(fe.solve(F).col(0));
+    double span = 0, total = 0;
+    for (long t = 0; t < m.T.rows(); ++t) {
+      bool bottom = false, top = false;
+      for (int c = 0; c < 4; ++c) {
+        const double z = m.V(m.T(t, c), 2);
+        bottom |= std::abs(z) < 1e-9, top |= std::abs(z - 1) < 1e-9;
+      }
+      const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)), d = m.V.row(m.T(t, 3));
+      const double v = std::abs((b - a).dot((c - a).cross(d - a))) / 6;
+      total += v, span += bottom && top ? v : 0;
+    }
+    EXPECT_NEAR(total, 400, 1e-6 * 400);
+    spanning[k] = span / total;
+  }
+  EXPECT_GT(spanning[0], 0.8);
+  EXPECT_LT(spanning[1], 0.02);
+  EXPECT_LT(deflection[0], 0.35 * beam);
+  EXPECT_GT(deflection[1], 2 * deflection[0]);
+  EXPECT_LT(deflection[1], beam);
+}
+
+TEST(TwoBRepSteps, ExamplesMeshIntoOneConformalTaggedMesh) {
+  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0},
+                              {"cantilever", 0.6}, {"bracket", 1.0}, {"bracket", 0.75}}) {
+    SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
+    const brep::TwoBReps model = load(name, true);
+    const TetMesh m = mesh_at(model, factor);
+    const ConformityReport c = check_conformity(m, &model);
+    // duplicates, over-shared faces, boundary = surface mesh, interface on Ω̄, volumes
+    EXPECT_TRUE(c.ok()) << c.to_json().dump();
+    EXPECT_EQ(c.duplicate_nodes, 0);
+    EXPECT_EQ(c.interface_off_nondesign, 0);
+    EXPECT_GT(c.interface_sampled, 0);
+    ASSERT_EQ(c.domain_volume.size(), static_cast<size_t>(model.nondesign.num_solids() + 1));
+    for (size_t d = 0; d < c.domain_volume.size(); ++d) {
+      ASSERT_LT(d, c.expected_volume.size());
+      EXPECT_NEAR(c.domain_volume[d], c.expected_volume[d], 0.005 * c.expected_volume[d]) << "domain " << d;
+    }
+    const QualityReport q = tet_quality(m);
+    EXPECT_GT(q.min_radius_ratio, 0.02);
+    EXPECT_GT(q.mean_radius_ratio, 0.7);
+    // every boundary triangle carries one of Ω's faces
+    EXPECT_GE(m.face.minCoeff(), 1);
+    EXPECT_LE(m.face.maxCoeff(), model.part.num_faces());
+  }
+}
+
+TEST(TwoBRepSteps, TouchingClampPadsAreConformalAcrossTheirSharedFace) {
+  // bracket: pads 6 and 7 (domains 6, 7) share the square x = 52, 0 <= y, z <= 10
+  const brep::TwoBReps model = load("bracket", true);
+  ASSERT_EQ(model.relations.contacts.size(), 1u);
+  const TetMesh m = mesh_at(model, 1.0);
+  std::map<std::array<int, 3>, std::vector<int>> owners;  // face on the plane -> domains of its tets
+  static const int kF[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (const auto& f : kF) {
+      std::array<int, 3> k{m.T(t, f[0]), m.T(t, f[1]), m.T(t, f[2])};
+      bool on = true;
+      for (int v : k) on &= std::abs(m.V(v, 0) - 52) < 1e-9;
+      if (!on) continue;
+      std::sort(k.begin(), k.end());
+      owners[k].push_back(m.domain[t]);
+    }
+  double shared_area = 0;
+  for (const auto& [k, doms] : owners) {
+    double ymax = 0, zmax = 0;
+    for (int v : k) ymax = std::max(ymax, m.V(v, 1)), zmax = std::max(zmax, m.V(v, 2));
+    if (ymax > 10 + 1e-9 || zmax > 10 + 1e-9) continue;  // the plane x = 52 elsewhere
+    // inside the square: one tet of each pad, nothing else
+    ASSERT_EQ(doms.size(), 2u);
+    EXPECT_EQ(std::min(doms[0], doms[1]), 6);
+    EXPECT_EQ(std::max(doms[0], doms[1]), 7);
+    shared_area += triangle_area(m, k[0], k[1], k[2]);
+  }
+  EXPECT_NEAR(shared_area, 100.0, 1e-9);
+}
+
+TEST(TwoBRepSteps, LoadPadFaceIsTaggedOnThePartBoundary) {
+  // cantilever: the pad's top face (Face12 of Ω̄, 4 x 6 mm) lies on Ω's top face (Face6)
+  const brep::TwoBReps model = load("cantilever", true);
+  const TetMesh m = mesh_at(model, 1.0);
+  ASSERT_EQ(m.nd_face.size(), m.F.rows());
+  double area = 0;
+  for (long t = 0; t < m.F.rows(); ++t)
+    if (m.nd_face[t] == 12) {
+      EXPECT_EQ(m.face[t], 6);
+      area += triangle_area(m, m.F(t, 0), m.F(t, 1), m.F(t, 2));
+    }
+  EXPECT_NEAR(area, 24.0, 1e-9);
+}
+
+TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
+  const brep::TwoBReps model = load("cantilever", true);
+  MeshRun run;
+  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
+  EXPECT_EQ(run.mesher, "native");
+  EXPECT_TRUE(run.fallback_reason.empty());
+  ASSERT_EQ(run.seconds.size(), 5u);  // steps 1-7, 8-11, 12, 13-14, the conformity check
+  EXPECT_EQ(run.seconds.back().first, "conformity check");
+  EXPECT_TRUE(check_conformity(m, &model).ok());
+  // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
+  expect_error([&] { mesh_two_breps(model, "auto", 0.01, 0); }, ErrorCode::TooLarge, "mesh size of at least");
+  expect_error([&] { mesh_two_breps(model, "netgen", 0, 0); }, ErrorCode::InvalidParameter, "native");
+}
+
+TEST(TwoBRepSteps, PartialContactIsNamedAndAutoFallsBackToGmsh) {
+  // two non-design blocks inside a box touch on x = 20, but the first one's face there is
+  // smaller than the second one's: the native mesher meshes only identical touching faces
+  // and says so; "auto" then meshes through Gmsh's fragments, conformally
+  auto box = [](double x, double y, double z, double dx, double dy, double dz) {
+    return BRepPrimAPI_MakeBox(gp_Pnt(x, y, z), dx, dy, dz).Shape();
+  };
+  TopoDS_Compound nd;
+  BRep_Builder builder;
+  builder.MakeCompound(nd);
+  builder.Add(nd, box(10, 5, 2, 10, 10, 6));
+  builder.Add(nd, box(20, 2, 1, 10, 16, 8));
+  const brep::TwoBReps model = brep::load_two_breps(box(0, 0, 0, 40, 20, 10), nd);
+  ASSERT_EQ(model.relations.contacts.size(), 1u);
+  expect_error([&] { mesh_native(model); }, ErrorCode::MeshingFailed, "identical touching faces");
+  MeshRun run;
+  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_NE(run.fallback_reason.find("identical touching faces"), std::string::npos);
+  const ConformityReport c = check_conformity(m, &model);
+  EXPECT_TRUE(c.ok()) << c.to_json().dump();
+}
+
+}  // namespace
+}  // namespace topopt::mesh
