@@ -14,6 +14,8 @@ const char* error_code_name(ErrorCode code) {
     case ErrorCode::MeshingFailed: return "MeshingFailed";
     case ErrorCode::TooLarge: return "TooLarge";
     case ErrorCode::Cancelled: return "Cancelled";
+    case ErrorCode::Timeout: return "Timeout";
+    case ErrorCode::Crashed: return "Crashed";
     case ErrorCode::Internal: return "Internal";
   }
   return "Internal";

@@ -20,6 +20,8 @@ enum class ErrorCode {
   MeshingFailed,       ///< a front could not be closed; the message says where
   TooLarge,            ///< the requested mesh or system does not fit in memory
   Cancelled,           ///< the user cancelled through the Progress callback
+  Timeout,             ///< a stage ran past its time budget and was stopped
+  Crashed,             ///< isolated work (a child process) crashed; the caller is unharmed
   Internal             ///< a bug; please report
 };
 
