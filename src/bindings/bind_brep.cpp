@@ -43,8 +43,7 @@ is a solid or a compound of solids in input order. Returns the report as a dict 
 "NonDesignOverlap", "Io") with a message that says what to fix.)doc");
 
   m.def(
-      "read_shape_file",
-      [](const std::string& path) { return brep::write_brep_string(brep::read_shape_file(path)); },
+      "read_shape_file", [](const std::string& path) { return brep::write_brep_string(brep::read_shape_file(path)); },
       pybind11::arg("path"), "Read a STEP/IGES/BREP file; returns its BREP string.");
 }
 

@@ -4,9 +4,9 @@
 
 #include "bindings/bindings.h"
 #include "brep/shape_io.h"
+#include "brep/topology_index.h"
 #include "common/error.h"
 #include "io/job.h"
-#include "brep/topology_index.h"
 #include "mesh/core/conformity.h"
 #include "mesh/surface/surface_check.h"
 #include "mesh/surface/surface_mesher.h"
@@ -52,7 +52,8 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
   m.def(
       "surface_mesh",
       [](const std::string& brep, double size, int wall_layers) {
-        if (size < 0) throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
+        if (size < 0)
+          throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
         wall_layers = mesh::wall_layers_option(wall_layers);
         mesh::SurfaceMesh sm;
         std::vector<long> open;

@@ -18,8 +18,7 @@ namespace pyb = pybind11;
 void bind_simp(pyb::module_& m) {
   m.def(
       "run_job",
-      [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep,
-         pyb::object callback) {
+      [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep, pyb::object callback) {
         io::Job job = io::parse_job(job_json, "");
         // The callback runs with the GIL held; returning True (or raising) cancels.
         std::atomic<bool> stop{false};
@@ -68,7 +67,8 @@ void bind_simp(pyb::module_& m) {
             call(d);
           });
         }
-        if (!callback_error.empty()) throw Error(ErrorCode::Cancelled, "the progress callback raised: " + callback_error);
+        if (!callback_error.empty())
+          throw Error(ErrorCode::Cancelled, "the progress callback raised: " + callback_error);
         pyb::dict out;
         put_tet_mesh(out, mesh);
         out["densities"] = r.simp.density;
@@ -119,8 +119,8 @@ surface), warnings (list of strings).)doc");
           pyb::gil_scoped_release release;
           result::SmoothParams sp;
           sp.iterations = smoothing_iterations;
-          s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
-                                       volume_fraction, sp);
+          s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
+                                       sp);
         }
         return pyb::make_tuple(s.V, s.F);
       },

@@ -29,10 +29,14 @@ namespace topopt::brep {
 
 const char* on_name(On on) {
   switch (on) {
-    case On::Interior: return "interior";
-    case On::Vertex: return "vertex";
-    case On::Edge: return "edge";
-    case On::Face: return "face";
+    case On::Interior:
+      return "interior";
+    case On::Vertex:
+      return "vertex";
+    case On::Edge:
+      return "edge";
+    case On::Face:
+      return "face";
   }
   return "interior";
 }
@@ -135,8 +139,7 @@ std::string fmt(double x) {
 
 }  // namespace
 
-Classification classify(const TopologyIndex& base, const TopologyIndex& other,
-                        const ClassifyParams& params) {
+Classification classify(const TopologyIndex& base, const TopologyIndex& other, const ClassifyParams& params) {
   const double tol = default_tolerance(base, params);
   PointLocator probe(base, tol);
   ensure_triangulated(other.shape);
@@ -211,9 +214,8 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
   const double tol = default_tolerance(part, params);
   ContainmentReport report;
   if (part.num_solids() != 1)
-    throw Error(ErrorCode::InvalidShape,
-                "the part must be exactly one solid; it has " + std::to_string(part.num_solids()) +
-                    " (fuse them into one, or pick one)");
+    throw Error(ErrorCode::InvalidShape, "the part must be exactly one solid; it has " +
+                                             std::to_string(part.num_solids()) + " (fuse them into one, or pick one)");
   const TopoDS_Shape& whole = part.solids(1);
   const int n = nondesign.num_solids();
   ensure_triangulated(nondesign.shape);
@@ -256,9 +258,8 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
       std::string amount = outside_volume > 0
                                ? " (" + fmt(outside_volume) + " mm³, " + fmt(100 * outside_volume / vi) + " % of it)"
                                : "";
-      throw Error(ErrorCode::NonDesignOutside,
-                  "non-design solid " + std::to_string(i + 1) + " is not inside the part" + amount +
-                      ": move or trim it so that it lies within the part");
+      throw Error(ErrorCode::NonDesignOutside, "non-design solid " + std::to_string(i + 1) + " is not inside the part" +
+                                                   amount + ": move or trim it so that it lies within the part");
     }
   }
 
@@ -270,9 +271,9 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
       double vc = common_volume(a, b);
       double vmin = std::min(std::abs(nondesign.solid_volume[i]), std::abs(nondesign.solid_volume[j]));
       if (vc > 1e-5 * vmin)
-        throw Error(ErrorCode::NonDesignOverlap,
-                    "non-design solids " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
-                        " overlap (" + fmt(vc) + " mm³ in common): make them disjoint; they may touch");
+        throw Error(ErrorCode::NonDesignOverlap, "non-design solids " + std::to_string(i + 1) + " and " +
+                                                     std::to_string(j + 1) + " overlap (" + fmt(vc) +
+                                                     " mm³ in common): make them disjoint; they may touch");
       BRepExtrema_DistShapeShape dist(a, b);
       if (!dist.IsDone() || dist.Value() > tol) continue;
       Contact contact{i, j, {}};
@@ -289,8 +290,8 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
         }
       }
       if (contact.faces.empty())
-        report.warnings.push_back("non-design solids " + std::to_string(i + 1) + " and " +
-                                  std::to_string(j + 1) + " touch along an edge or at a point only");
+        report.warnings.push_back("non-design solids " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
+                                  " touch along an edge or at a point only");
       report.contacts.push_back(std::move(contact));
     }
   }

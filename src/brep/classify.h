@@ -22,7 +22,7 @@ struct Location {
   /// Parameters on that entity: a vertex on an edge: t[0] = curve parameter; a vertex on a
   /// face: (t[0], t[1]) = (u, v); an edge on an edge: [t[0], t[1]] = curve range covered.
   double t[2]{0, 0};
-  double distance = 0;   ///< largest distance of the samples to that entity
+  double distance = 0;  ///< largest distance of the samples to that entity
 };
 
 struct ClassifyParams {
@@ -46,19 +46,18 @@ struct Classification {
 /// no entity of `base` is Interior (whether it is inside base at all is check_containment's
 /// business). A vertex is tested against vertices, then edges, then faces; an edge and a face
 /// are "on" an entity only when all their samples are on that one entity.
-Classification classify(const TopologyIndex& base, const TopologyIndex& other,
-                        const ClassifyParams& params = {});
+Classification classify(const TopologyIndex& base, const TopologyIndex& other, const ClassifyParams& params = {});
 
 /// Contact between two non-design solids: the faces of solid a that lie on faces of solid b.
 struct Contact {
-  int solid_a = -1, solid_b = -1;            ///< 0-based solid indices in the non-design model
-  std::vector<std::pair<int, int>> faces;    ///< (face of a, face of b), 0-based model indices
+  int solid_a = -1, solid_b = -1;          ///< 0-based solid indices in the non-design model
+  std::vector<std::pair<int, int>> faces;  ///< (face of a, face of b), 0-based model indices
 };
 
 /// Relations among the non-design solids and with the part.
 struct ContainmentReport {
-  std::vector<Contact> contacts;       ///< pairs of solids that touch (allowed)
-  std::vector<std::string> warnings;   ///< things worth telling the user
+  std::vector<Contact> contacts;      ///< pairs of solids that touch (allowed)
+  std::vector<std::string> warnings;  ///< things worth telling the user
 };
 
 /// Checks that every solid of `nondesign` lies inside the single solid of `part` and that no

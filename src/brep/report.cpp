@@ -7,10 +7,14 @@ namespace {
 
 const char* entity_prefix(On on) {
   switch (on) {
-    case On::Vertex: return "Vertex";
-    case On::Edge: return "Edge";
-    case On::Face: return "Face";
-    default: return "";
+    case On::Vertex:
+      return "Vertex";
+    case On::Edge:
+      return "Edge";
+    case On::Face:
+      return "Face";
+    default:
+      return "";
   }
 }
 
@@ -41,9 +45,10 @@ nlohmann::json face_json(const TopologyIndex& t, int f) {
 nlohmann::json two_breps_report(const TwoBReps& m) {
   const TopologyIndex& p = m.part;
   const TopologyIndex& n = m.nondesign;
-  nlohmann::json part{{"solids", p.num_solids()}, {"shells", p.num_shells()}, {"faces", p.num_faces()},
-                      {"edges", p.num_edges()},   {"vertices", p.num_vertices()},
-                      {"volume", p.num_solids() ? p.solid_volume[0] : 0.0}, {"bbox", bbox_json(p)}};
+  nlohmann::json part{{"solids", p.num_solids()},     {"shells", p.num_shells()},
+                      {"faces", p.num_faces()},       {"edges", p.num_edges()},
+                      {"vertices", p.num_vertices()}, {"volume", p.num_solids() ? p.solid_volume[0] : 0.0},
+                      {"bbox", bbox_json(p)}};
   nlohmann::json part_faces = nlohmann::json::array();
   for (int f = 0; f < p.num_faces(); ++f) part_faces.push_back(face_json(p, f));
   part["faces_detail"] = part_faces;
@@ -67,8 +72,8 @@ nlohmann::json two_breps_report(const TwoBReps& m) {
     edges.push_back(location_json("Edge" + std::to_string(e + 1), m.nd_on_part.edge[e]));
   for (int v = 0; v < n.num_vertices(); ++v)
     vertices.push_back(location_json("Vertex" + std::to_string(v + 1), m.nd_on_part.vertex[v]));
-  nlohmann::json nondesign{{"solids", solids}, {"faces", n.num_faces()}, {"volume", nd_volume},
-                           {"edges", edges},   {"vertices", vertices}};
+  nlohmann::json nondesign{
+      {"solids", solids}, {"faces", n.num_faces()}, {"volume", nd_volume}, {"edges", edges}, {"vertices", vertices}};
 
   nlohmann::json contacts = nlohmann::json::array();
   for (const Contact& c : m.relations.contacts) {
@@ -102,8 +107,8 @@ std::string two_breps_summary(const TwoBReps& m) {
         ++interior;
       }
     }
-    s << "  solid " << i + 1 << ": volume " << n.solid_volume[i] << " mm³, " << on_face
-      << " faces on the part's faces," << where.str() << "; " << interior << " interior\n";
+    s << "  solid " << i + 1 << ": volume " << n.solid_volume[i] << " mm³, " << on_face << " faces on the part's faces,"
+      << where.str() << "; " << interior << " interior\n";
   }
   for (const Contact& c : m.relations.contacts) {
     s << "  solids " << c.solid_a + 1 << " and " << c.solid_b + 1 << " touch";

@@ -25,20 +25,18 @@ std::string lower_extension(const std::string& path) {
 template <class Reader>
 TopoDS_Shape read_with(Reader& reader, const std::string& path, const char* format) {
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
-    throw Error(ErrorCode::Io, "cannot read '" + path + "' as " + format +
-                                   ": the file is damaged or not in that format");
+    throw Error(ErrorCode::Io,
+                "cannot read '" + path + "' as " + format + ": the file is damaged or not in that format");
   reader.TransferRoots();
   TopoDS_Shape shape = reader.OneShape();
-  if (shape.IsNull())
-    throw Error(ErrorCode::Io, "'" + path + "' holds no shape that can be transferred");
+  if (shape.IsNull()) throw Error(ErrorCode::Io, "'" + path + "' holds no shape that can be transferred");
   return shape;
 }
 
 }  // namespace
 
 TopoDS_Shape read_shape_file(const std::string& path) {
-  if (!std::filesystem::exists(path))
-    throw Error(ErrorCode::Io, "file not found: '" + path + "'");
+  if (!std::filesystem::exists(path)) throw Error(ErrorCode::Io, "file not found: '" + path + "'");
   const std::string ext = lower_extension(path);
   if (ext == ".step" || ext == ".stp") {
     STEPControl_Reader reader;
@@ -55,8 +53,7 @@ TopoDS_Shape read_shape_file(const std::string& path) {
       throw Error(ErrorCode::Io, "cannot read '" + path + "' as BREP");
     return shape;
   }
-  throw Error(ErrorCode::Io, "unknown file type '" + ext + "' for '" + path +
-                                 "': use .step/.stp, .iges/.igs or .brep");
+  throw Error(ErrorCode::Io, "unknown file type '" + ext + "' for '" + path + "': use .step/.stp, .iges/.igs or .brep");
 }
 
 TopoDS_Shape read_brep_string(const std::string& text, const std::string& what) {
@@ -66,11 +63,10 @@ TopoDS_Shape read_brep_string(const std::string& text, const std::string& what) 
   try {
     BRepTools::Read(shape, in, builder);
   } catch (const Standard_Failure& e) {
-    throw Error(ErrorCode::Io, "the " + what + " is not a valid BREP text: " +
-                                   (e.GetMessageString() ? e.GetMessageString() : "?"));
+    throw Error(ErrorCode::Io,
+                "the " + what + " is not a valid BREP text: " + (e.GetMessageString() ? e.GetMessageString() : "?"));
   }
-  if (shape.IsNull())
-    throw Error(ErrorCode::Io, "the " + what + " is not a valid BREP text (empty shape)");
+  if (shape.IsNull()) throw Error(ErrorCode::Io, "the " + what + " is not a valid BREP text (empty shape)");
   return shape;
 }
 

@@ -46,12 +46,18 @@ double signed_volume(const TopoDS_Shape& s) {
 
 const char* type_name(TopAbs_ShapeEnum t) {
   switch (t) {
-    case TopAbs_SHELL: return "a shell";
-    case TopAbs_FACE: return "a face";
-    case TopAbs_WIRE: return "a wire";
-    case TopAbs_EDGE: return "an edge";
-    case TopAbs_VERTEX: return "a vertex";
-    default: return "not a solid";
+    case TopAbs_SHELL:
+      return "a shell";
+    case TopAbs_FACE:
+      return "a face";
+    case TopAbs_WIRE:
+      return "a wire";
+    case TopAbs_EDGE:
+      return "an edge";
+    case TopAbs_VERTEX:
+      return "a vertex";
+    default:
+      return "not a solid";
   }
 }
 
@@ -87,8 +93,9 @@ TopoDS_Shape check_one(TopoDS_Shape item, const std::string& label, std::vector<
     BRepCheck_Analyzer recheck(healed);
     if (!recheck.IsValid())
       throw Error(ErrorCode::InvalidShape,
-                  label + " is not a valid B-Rep and could not be healed: run Part > Check geometry in "
-                          "FreeCAD and repair it");
+                  label +
+                      " is not a valid B-Rep and could not be healed: run Part > Check geometry in "
+                      "FreeCAD and repair it");
     TopTools_IndexedMapOfShape before, after;
     TopExp::MapShapes(item, TopAbs_FACE, before);
     TopExp::MapShapes(healed, TopAbs_FACE, after);
@@ -113,15 +120,13 @@ TopoDS_Shape check_one(TopoDS_Shape item, const std::string& label, std::vector<
     volume = -volume;
     notes.push_back(label + ": solid was inside out; turned outwards");
   }
-  if (!(volume > 0))
-    throw Error(ErrorCode::InvalidShape, label + " has zero volume: give a solid with thickness");
+  if (!(volume > 0)) throw Error(ErrorCode::InvalidShape, label + " has zero volume: give a solid with thickness");
   return item;
 }
 
 }  // namespace
 
-TopoDS_Shape check_solids(const TopoDS_Shape& shape, const std::string& what,
-                          std::vector<std::string>& notes) {
+TopoDS_Shape check_solids(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes) {
   if (shape.IsNull()) throw Error(ErrorCode::InvalidShape, "the " + what + " is empty");
   std::vector<TopoDS_Shape> items;
   flatten(shape, items);

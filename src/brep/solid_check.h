@@ -13,7 +13,6 @@ namespace topopt::brep {
 /// `what` names the input in messages ("part", "non-design input").
 /// Returns the checked (possibly healed) shape: a solid, or a compound of solids in the
 /// input order. Throws Error(InvalidShape) saying which item is wrong and how.
-TopoDS_Shape check_solids(const TopoDS_Shape& shape, const std::string& what,
-                          std::vector<std::string>& notes);
+TopoDS_Shape check_solids(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes);
 
 }  // namespace topopt::brep

@@ -17,17 +17,28 @@ namespace topopt::brep {
 std::string surface_type_name(const TopoDS_Shape& face) {
   BRepAdaptor_Surface surface(TopoDS::Face(face), false);
   switch (surface.GetType()) {
-    case GeomAbs_Plane: return "Plane";
-    case GeomAbs_Cylinder: return "Cylinder";
-    case GeomAbs_Cone: return "Cone";
-    case GeomAbs_Sphere: return "Sphere";
-    case GeomAbs_Torus: return "Torus";
-    case GeomAbs_BezierSurface: return "Bezier";
-    case GeomAbs_BSplineSurface: return "BSpline";
-    case GeomAbs_SurfaceOfRevolution: return "Revolution";
-    case GeomAbs_SurfaceOfExtrusion: return "Extrusion";
-    case GeomAbs_OffsetSurface: return "Offset";
-    default: return "Other";
+    case GeomAbs_Plane:
+      return "Plane";
+    case GeomAbs_Cylinder:
+      return "Cylinder";
+    case GeomAbs_Cone:
+      return "Cone";
+    case GeomAbs_Sphere:
+      return "Sphere";
+    case GeomAbs_Torus:
+      return "Torus";
+    case GeomAbs_BezierSurface:
+      return "Bezier";
+    case GeomAbs_BSplineSurface:
+      return "BSpline";
+    case GeomAbs_SurfaceOfRevolution:
+      return "Revolution";
+    case GeomAbs_SurfaceOfExtrusion:
+      return "Extrusion";
+    case GeomAbs_OffsetSurface:
+      return "Offset";
+    default:
+      return "Other";
   }
 }
 
@@ -40,8 +51,7 @@ double TopologyIndex::diagonal() const {
 namespace {
 
 /// Indices (0-based) in `map` of the sub-shapes of `shape` of type `type`, in explorer order.
-std::vector<int> sub_indices(const TopoDS_Shape& shape, TopAbs_ShapeEnum type,
-                             const TopTools_IndexedMapOfShape& map) {
+std::vector<int> sub_indices(const TopoDS_Shape& shape, TopAbs_ShapeEnum type, const TopTools_IndexedMapOfShape& map) {
   std::vector<int> out;
   for (TopExp_Explorer ex(shape, type); ex.More(); ex.Next()) out.push_back(map.FindIndex(ex.Current()) - 1);
   return out;
@@ -109,8 +119,7 @@ TopologyIndex index_topology(const TopoDS_Shape& shape) {
     t.face_tolerance[i] = BRep_Tool::Tolerance(f);
   }
 
-  for (int i = 0; i < t.num_shells(); ++i)
-    t.shell_faces.push_row(sub_indices(t.shells(i + 1), TopAbs_FACE, t.faces));
+  for (int i = 0; i < t.num_shells(); ++i) t.shell_faces.push_row(sub_indices(t.shells(i + 1), TopAbs_FACE, t.faces));
 
   t.face_solid = VecXi::Constant(nf, -1);
   t.solid_volume.resize(ns);

@@ -30,23 +30,23 @@ struct TopologyIndex {
   TopoDS_Shape shape;
   TopTools_IndexedMapOfShape vertices, edges, faces, shells, solids;
 
-  MatX3d vertex_point;             ///< #V by 3
-  VecXd vertex_tolerance;          ///< #V
-  MatX2i edge_vertices;            ///< #E by 2: first, last vertex (-1 if the edge has none)
-  std::vector<bool> edge_degenerate;  ///< #E: collapsed edge (cone apex, sphere pole)
-  VecXd edge_length;               ///< #E
-  VecXd edge_tolerance;            ///< #E
-  Adjacency face_edges;            ///< per face: its edges (a seam edge appears twice)
-  Adjacency face_wires;            ///< per face: the number of edges of each wire, outer first
-  VecXd face_area;                 ///< #F
-  MatX3d face_centre;              ///< #F by 3: centre of area (may lie off a curved face)
+  MatX3d vertex_point;                    ///< #V by 3
+  VecXd vertex_tolerance;                 ///< #V
+  MatX2i edge_vertices;                   ///< #E by 2: first, last vertex (-1 if the edge has none)
+  std::vector<bool> edge_degenerate;      ///< #E: collapsed edge (cone apex, sphere pole)
+  VecXd edge_length;                      ///< #E
+  VecXd edge_tolerance;                   ///< #E
+  Adjacency face_edges;                   ///< per face: its edges (a seam edge appears twice)
+  Adjacency face_wires;                   ///< per face: the number of edges of each wire, outer first
+  VecXd face_area;                        ///< #F
+  MatX3d face_centre;                     ///< #F by 3: centre of area (may lie off a curved face)
   std::vector<std::string> face_surface;  ///< #F: "Plane", "Cylinder", "BSpline", ...
-  VecXd face_tolerance;            ///< #F
-  Adjacency shell_faces;           ///< per shell: its faces
-  Adjacency solid_shells;          ///< per solid: its shells, outer first
-  Adjacency solid_faces;           ///< per solid: all its faces
-  VecXi face_solid;                ///< #F: the first solid that holds the face (-1: none)
-  VecXd solid_volume;              ///< #S (signed: negative means reversed)
+  VecXd face_tolerance;                   ///< #F
+  Adjacency shell_faces;                  ///< per shell: its faces
+  Adjacency solid_shells;                 ///< per solid: its shells, outer first
+  Adjacency solid_faces;                  ///< per solid: all its faces
+  VecXi face_solid;                       ///< #F: the first solid that holds the face (-1: none)
+  VecXd solid_volume;                     ///< #S (signed: negative means reversed)
   double bbox_min[3]{0, 0, 0}, bbox_max[3]{0, 0, 0};
 
   int num_vertices() const { return vertices.Extent(); }

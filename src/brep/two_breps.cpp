@@ -7,8 +7,8 @@
 
 namespace topopt::brep {
 
-TwoBReps load_two_breps(const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
-                        const ClassifyParams& params, const Progress& progress) {
+TwoBReps load_two_breps(const TopoDS_Shape& part, const TopoDS_Shape& nondesign, const ClassifyParams& params,
+                        const Progress& progress) {
   TwoBReps m;
   progress.say("brep", 0.0, "checking the part");
   m.part = index_topology(check_solids(part, "part", m.notes));

@@ -36,7 +36,8 @@ int cmd_optimize(const Args& args) {
     if (!quiet || stage != "simp") std::cerr << "[" << stage << "] " << msg << "\n";
   };
   progress.log = [verbose](LogLevel level, const std::string& msg) {
-    if (verbose || level == LogLevel::Warning) std::cerr << (level != LogLevel::Warning ? "  " : "warning: ") << msg << "\n";
+    if (verbose || level == LogLevel::Warning)
+      std::cerr << (level != LogLevel::Warning ? "  " : "warning: ") << msg << "\n";
   };
   auto t0 = std::chrono::steady_clock::now();
   TetMesh mesh = pipeline::job_mesh(job, progress);

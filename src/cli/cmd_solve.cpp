@@ -28,9 +28,12 @@ int cmd_solve(const Args& args) {
   io::Job job = io::read_job(pos[0]);
   if (!out.empty()) job.output_dir = std::filesystem::absolute(out).string();
   fem::SolverParams sp;
-  if (solver == "direct") sp.kind = fem::SolverKind::Direct;
-  else if (solver == "iterative") sp.kind = fem::SolverKind::Iterative;
-  else if (solver != "auto") throw Error(ErrorCode::InvalidParameter, "--solver takes auto, direct or iterative");
+  if (solver == "direct")
+    sp.kind = fem::SolverKind::Direct;
+  else if (solver == "iterative")
+    sp.kind = fem::SolverKind::Iterative;
+  else if (solver != "auto")
+    throw Error(ErrorCode::InvalidParameter, "--solver takes auto, direct or iterative");
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) {
     std::cerr << "[" << stage << "] " << msg << "\n";
@@ -47,7 +50,8 @@ int cmd_solve(const Args& args) {
               << umax << " mm, max von Mises " << r.von_mises[c].maxCoeff() << " MPa\n";
   }
   std::cout << "time: setup " << r.seconds_setup << " s, solve " << r.seconds_solve << " s\n";
-  for (const auto& p : pipeline::write_solve_outputs(job, mesh, r, job.output_dir, inp)) std::cout << "wrote " << p << "\n";
+  for (const auto& p : pipeline::write_solve_outputs(job, mesh, r, job.output_dir, inp))
+    std::cout << "wrote " << p << "\n";
   return 0;
 }
 

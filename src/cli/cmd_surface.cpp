@@ -49,7 +49,8 @@ int cmd_surface(const Args& args) {
   // clamp pads), where their separate faces coincide by design
   std::vector<std::pair<int, int>> crossings;
   for (int s = 0; s < topo.num_solids() && crossings.size() < 100; ++s) {
-    const auto c = mesh::self_intersections(m.V, mesh::solid_triangles(topo, m, s), 100 - static_cast<long>(crossings.size()));
+    const auto c =
+        mesh::self_intersections(m.V, mesh::solid_triangles(topo, m, s), 100 - static_cast<long>(crossings.size()));
     crossings.insert(crossings.end(), c.begin(), c.end());
   }
   const mesh::SurfaceQuality q = mesh::surface_quality(m.V, m.F);
@@ -76,8 +77,10 @@ int cmd_surface(const Args& args) {
     j["failed_faces"] = m.failed_faces;
     j["open_edges_per_solid"] = open;
     j["self_intersecting_pairs"] = crossings.size();
-    j["quality"] = {{"min_angle_deg", q.min_angle}, {"mean_min_angle_deg", q.mean_min_angle},
-                    {"share_below_20deg", q.share_below_20}, {"mean_shape", q.mean_quality}};
+    j["quality"] = {{"min_angle_deg", q.min_angle},
+                    {"mean_min_angle_deg", q.mean_min_angle},
+                    {"share_below_20deg", q.share_below_20},
+                    {"mean_shape", q.mean_quality}};
     j["seconds"] = {{"read", sec(t0, t1)}, {"mesh", sec(t1, t2)}};
     std::ofstream f(stats);
     f << j.dump(2) << "\n";

@@ -18,8 +18,7 @@ ArgReader::ArgReader(const Args& args, std::string usage)
 std::string ArgReader::option(const std::string& name, const std::string& fallback) {
   for (size_t i = 0; i < args_.size(); ++i) {
     if (args_[i] != "--" + name) continue;
-    if (i + 1 >= args_.size())
-      throw Error(ErrorCode::InvalidParameter, "--" + name + " needs a value\n" + usage_);
+    if (i + 1 >= args_.size()) throw Error(ErrorCode::InvalidParameter, "--" + name + " needs a value\n" + usage_);
     used_[i] = used_[i + 1] = true;
     return args_[i + 1];
   }
@@ -84,9 +83,12 @@ const char* kUsage =
 /// Exit codes: 0 success, 1 user error (message printed), 2 usage, 3 internal error.
 int exit_code_for(topopt::ErrorCode code) {
   switch (code) {
-    case topopt::ErrorCode::InvalidParameter: return 2;
-    case topopt::ErrorCode::Internal: return 3;
-    default: return 1;
+    case topopt::ErrorCode::InvalidParameter:
+      return 2;
+    case topopt::ErrorCode::Internal:
+      return 3;
+    default:
+      return 1;
   }
 }
 
@@ -98,8 +100,11 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
   }
-  const std::map<std::string, int (*)(const Args&)> commands{
-      {"info", cmd_info}, {"mesh", cmd_mesh}, {"solve", cmd_solve}, {"optimize", cmd_optimize}, {"surface", cmd_surface}};
+  const std::map<std::string, int (*)(const Args&)> commands{{"info", cmd_info},
+                                                             {"mesh", cmd_mesh},
+                                                             {"solve", cmd_solve},
+                                                             {"optimize", cmd_optimize},
+                                                             {"surface", cmd_surface}};
   auto it = commands.find(argv[1]);
   if (it == commands.end()) {
     std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;
@@ -109,12 +114,11 @@ int main(int argc, char** argv) {
   try {
     return it->second(args);
   } catch (const topopt::Error& e) {
-    std::cerr << "topopt " << argv[1] << ": error (" << topopt::error_code_name(e.code()) << "): " << e.what()
-              << "\n";
+    std::cerr << "topopt " << argv[1] << ": error (" << topopt::error_code_name(e.code()) << "): " << e.what() << "\n";
     return exit_code_for(e.code());
   } catch (const Standard_Failure& e) {
-    std::cerr << "topopt " << argv[1] << ": geometry kernel error: "
-              << (e.GetMessageString() ? e.GetMessageString() : "unknown") << "\n";
+    std::cerr << "topopt " << argv[1]
+              << ": geometry kernel error: " << (e.GetMessageString() ? e.GetMessageString() : "unknown") << "\n";
     return 3;
   } catch (const std::bad_alloc&) {
     std::cerr << "topopt " << argv[1] << ": out of memory: use a coarser mesh size\n";

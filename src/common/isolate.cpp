@@ -79,8 +79,8 @@ std::string run_isolated(const std::string& what, double seconds, const std::fun
   pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]), ::close(fds[1]);
-    throw Error(ErrorCode::TooLarge, what + ": cannot start a child process (" + std::strerror(errno) +
-                                         "): free some memory and try again");
+    throw Error(ErrorCode::TooLarge,
+                what + ": cannot start a child process (" + std::strerror(errno) + "): free some memory and try again");
   }
   if (pid == 0) {
     ::close(fds[0]);
@@ -97,12 +97,12 @@ std::string run_isolated(const std::string& what, double seconds, const std::fun
   }
   if (cancelled) throw Error(ErrorCode::Cancelled, "cancelled during " + what);
   if (!finished)
-    throw Error(ErrorCode::Timeout, what + " did not finish within " + std::to_string(static_cast<int>(seconds)) +
-                                        " s and was stopped");
+    throw Error(ErrorCode::Timeout,
+                what + " did not finish within " + std::to_string(static_cast<int>(seconds)) + " s and was stopped");
   if (WIFSIGNALED(status) || answer.empty())
-    throw Error(ErrorCode::Crashed, what + " crashed" +
-                                        (WIFSIGNALED(status) ? " with " + signal_name(WTERMSIG(status)) : std::string()) +
-                                        " and was stopped; nothing else was affected");
+    throw Error(ErrorCode::Crashed,
+                what + " crashed" + (WIFSIGNALED(status) ? " with " + signal_name(WTERMSIG(status)) : std::string()) +
+                    " and was stopped; nothing else was affected");
   char kind = answer[0];
   if (kind == 'R') return answer.substr(1);
   if (kind == 'E' && answer.size() >= 2) throw Error(static_cast<ErrorCode>(answer[1]), answer.substr(2));

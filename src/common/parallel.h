@@ -44,7 +44,8 @@ void parallel_for(long n, int threads, Fn&& fn, long min_chunk = 2048) {
 /// with `what` in the message); the others get a quiet Progress whose only callback says
 /// whether to stop. The first exception stops the queue and is rethrown here.
 template <class Task>
-void parallel_tasks(const std::vector<int>& order, int threads, const Progress& progress, const char* what, Task&& task) {
+void parallel_tasks(const std::vector<int>& order, int threads, const Progress& progress, const char* what,
+                    Task&& task) {
   const int n = static_cast<int>(order.size());
   std::atomic<int> next{0};
   std::atomic<bool> stop{false};

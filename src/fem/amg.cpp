@@ -24,28 +24,34 @@ void sparse_product(const CsrMatrix& M, const Value* val, const double* x, doubl
   const std::vector<int>& ptr = M.ptr;
   const std::vector<int>& col = M.col;
   if (M.blocks.empty()) {
-    parallel_for(M.rows, threads, [&](long b, long e) {
-      for (long i = b; i < e; ++i) {
-        double s = 0;
-        for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
-        y[i] = s;
-      }
-    }, 4096);
+    parallel_for(
+        M.rows, threads,
+        [&](long b, long e) {
+          for (long i = b; i < e; ++i) {
+            double s = 0;
+            for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
+            y[i] = s;
+          }
+        },
+        4096);
     return;
   }
   const long nb = static_cast<long>(M.blocks.size()) - 1;
-  parallel_for(nb, threads, [&](long bb, long be) {
-    for (long blk = bb; blk < be; ++blk) {
-      const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
-      const int* c = &col[ptr[r0]];
-      for (int r = 0; r < nr; ++r) {
-        const Value* v = &val[ptr[r0 + r]];
-        double acc = 0;
-        for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
-        y[r0 + r] = acc;
-      }
-    }
-  }, 1024);
+  parallel_for(
+      nb, threads,
+      [&](long bb, long be) {
+        for (long blk = bb; blk < be; ++blk) {
+          const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
+          const int* c = &col[ptr[r0]];
+          for (int r = 0; r < nr; ++r) {
+            const Value* v = &val[ptr[r0 + r]];
+            double acc = 0;
+            for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
+            y[r0 + r] = acc;
+          }
+        }
+      },
+      1024);
 }
 
 }  // namespace
@@ -93,48 +99,51 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
     std::vector<double> val;
   };
   std::vector<Part> parts(chunks);
-  parallel_for(chunks, chunks, [&](long cb, long ce) {
-    std::vector<int> mark(B.cols, -1), slot(B.cols), touched;
-    std::vector<double> acc;
-    for (long c = cb; c < ce; ++c) {
-      Part& part = parts[c];
-      const long b0 = nblocks * c / chunks, b1 = nblocks * (c + 1) / chunks;
-      part.count.reserve(blocks[b1] - blocks[b0]);
-      part.col.reserve(static_cast<size_t>(A.ptr[blocks[b1]] - A.ptr[blocks[b0]]) * 4);
-      part.val.reserve(part.col.capacity());
-      for (long blk = b0; blk < b1; ++blk) {
-        const int r0 = blocks[blk], nr = blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
-        touched.clear();
-        for (int k = 0; k < len; ++k) {
-          const int cc = A.col[A.ptr[r0] + k];
-          double a[kB];
-          for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
-          for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
-            const int j = B.col[kb];
-            const double v = B.val[kb];
-            if (mark[j] != blk) {
-              mark[j] = static_cast<int>(blk);
-              slot[j] = static_cast<int>(touched.size());
-              touched.push_back(j);
-              if (acc.size() < touched.size() * kB) acc.resize(2 * touched.size() * kB);
-              double* q = &acc[kB * slot[j]];
-              for (int r = 0; r < nr; ++r) q[r] = a[r] * v;
-            } else {
-              double* q = &acc[kB * slot[j]];
-              for (int r = 0; r < nr; ++r) q[r] += a[r] * v;
+  parallel_for(
+      chunks, chunks,
+      [&](long cb, long ce) {
+        std::vector<int> mark(B.cols, -1), slot(B.cols), touched;
+        std::vector<double> acc;
+        for (long c = cb; c < ce; ++c) {
+          Part& part = parts[c];
+          const long b0 = nblocks * c / chunks, b1 = nblocks * (c + 1) / chunks;
+          part.count.reserve(blocks[b1] - blocks[b0]);
+          part.col.reserve(static_cast<size_t>(A.ptr[blocks[b1]] - A.ptr[blocks[b0]]) * 4);
+          part.val.reserve(part.col.capacity());
+          for (long blk = b0; blk < b1; ++blk) {
+            const int r0 = blocks[blk], nr = blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
+            touched.clear();
+            for (int k = 0; k < len; ++k) {
+              const int cc = A.col[A.ptr[r0] + k];
+              double a[kB];
+              for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
+              for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
+                const int j = B.col[kb];
+                const double v = B.val[kb];
+                if (mark[j] != blk) {
+                  mark[j] = static_cast<int>(blk);
+                  slot[j] = static_cast<int>(touched.size());
+                  touched.push_back(j);
+                  if (acc.size() < touched.size() * kB) acc.resize(2 * touched.size() * kB);
+                  double* q = &acc[kB * slot[j]];
+                  for (int r = 0; r < nr; ++r) q[r] = a[r] * v;
+                } else {
+                  double* q = &acc[kB * slot[j]];
+                  for (int r = 0; r < nr; ++r) q[r] += a[r] * v;
+                }
+              }
+            }
+            for (int r = 0; r < nr; ++r) {
+              part.count.push_back(static_cast<int>(touched.size()));
+              for (size_t t = 0; t < touched.size(); ++t) {
+                part.col.push_back(touched[t]);
+                part.val.push_back(acc[kB * t + r]);
+              }
             }
           }
         }
-        for (int r = 0; r < nr; ++r) {
-          part.count.push_back(static_cast<int>(touched.size()));
-          for (size_t t = 0; t < touched.size(); ++t) {
-            part.col.push_back(touched[t]);
-            part.val.push_back(acc[kB * t + r]);
-          }
-        }
-      }
-    }
-  }, 1);
+      },
+      1);
   C.ptr.assign(A.rows + 1, 0);
   long nnz = 0, row = 0;
   for (const Part& p : parts) nnz += static_cast<long>(p.col.size());
@@ -178,9 +187,9 @@ struct Level {
   CsrMatrix own;                 // this level's matrix (unused on level 0)
   const CsrMatrix* A = nullptr;  // the matrix of this level
   std::vector<double> inv_diag;
-  double lambda = 1;             // estimate of λmax(D⁻¹A)
-  std::vector<double> eigvec;    // its eigenvector estimate (restarts the power iteration)
-  CsrMatrix P, R;                // to/from the next coarser level
+  double lambda = 1;           // estimate of λmax(D⁻¹A)
+  std::vector<double> eigvec;  // its eigenvector estimate (restarts the power iteration)
+  CsrMatrix P, R;              // to/from the next coarser level
   // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
@@ -206,9 +215,7 @@ struct SmoothedAggregationAmg::Impl {
   /// level does not coarsen any more.
   bool coarsen(Level& L, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
-  static void to_float(const CsrMatrix& M, std::vector<float>& out) {
-    out.assign(M.val.begin(), M.val.end());
-  }
+  static void to_float(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
   void cycle(size_t l) const;
 };
@@ -261,8 +268,9 @@ void SmoothedAggregationAmg::Impl::factor_coarsest() {
   coarse.cholmod().method[0].ordering = CHOLMOD_AMD;
   coarse.compute(S);
   if (coarse.info() != Eigen::Success)
-    throw Error(ErrorCode::NoSupport, "the coarse multigrid matrix is not positive definite: the supports "
-                                      "do not hold the structure, or the mesh has degenerate elements");
+    throw Error(ErrorCode::NoSupport,
+                "the coarse multigrid matrix is not positive definite: the supports "
+                "do not hold the structure, or the mesh has degenerate elements");
 }
 
 void SmoothedAggregationAmg::Impl::inverse_diagonal(Level& L) const {
@@ -273,15 +281,16 @@ void SmoothedAggregationAmg::Impl::inverse_diagonal(Level& L) const {
       if (A.col[k] == i) L.inv_diag[i] += A.val[k];
   for (int i = 0; i < A.rows; ++i) {
     if (!(L.inv_diag[i] > 0))
-      throw Error(ErrorCode::NoSupport, "the stiffness matrix has a zero or negative diagonal entry: "
-                                        "an unknown is not held by any element; check the mesh and supports");
+      throw Error(ErrorCode::NoSupport,
+                  "the stiffness matrix has a zero or negative diagonal entry: "
+                  "an unknown is not held by any element; check the mesh and supports");
     L.inv_diag[i] = 1 / L.inv_diag[i];
   }
 }
 
-bool SmoothedAggregationAmg::Impl::coarsen(Level& L, const std::vector<int>& node_ptr,
-                                           const std::vector<double>& modes, std::vector<int>& coarse_ptr,
-                                           std::vector<double>& coarse_modes, CsrMatrix& Pt) const {
+bool SmoothedAggregationAmg::Impl::coarsen(Level& L, const std::vector<int>& node_ptr, const std::vector<double>& modes,
+                                           std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes,
+                                           CsrMatrix& Pt) const {
   const CsrMatrix& A = *L.A;
   const int nnode = static_cast<int>(node_ptr.size()) - 1;
   std::vector<int> node_of(A.rows);
@@ -536,8 +545,7 @@ void SmoothedAggregationAmg::refresh_finest() {
   if (m.levels.size() > 1) {
     m.estimate_lambda(m.levels[0], 5);
     Impl::to_float(*m.levels[0].A, m.levels[0].Af);
-  }
-  else
+  } else
     m.factor_coarsest();
 }
 
@@ -564,8 +572,8 @@ std::vector<int> SmoothedAggregationAmg::level_sizes() const {
   return n;
 }
 
-PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x,
-                  double tolerance, int max_iterations, int threads, const Progress& progress) {
+PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x, double tolerance,
+                  int max_iterations, int threads, const Progress& progress) {
   const int n = A.rows;
   using Vec = Eigen::VectorXd;
   Eigen::Map<const Vec> bv(b, n);

@@ -100,7 +100,7 @@ struct PcgResult {
 /// Conjugate gradients on A x = b preconditioned by `amg`, starting from x (warm start).
 /// Stops when ||b - A x|| <= tolerance ||b|| or after max_iterations. Checks `progress` for
 /// cancellation every few iterations.
-PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x,
-                  double tolerance, int max_iterations, int threads, const Progress& progress = {});
+PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x, double tolerance,
+                  int max_iterations, int threads, const Progress& progress = {});
 
 }  // namespace topopt::fem

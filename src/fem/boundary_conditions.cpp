@@ -13,8 +13,8 @@ namespace {
 
 /// Triangles of the mesh boundary on the given Ω faces and Ω̄ faces. Throws FaceNotFound
 /// naming the first face that has no triangle. `what` names the support or load.
-std::vector<int> triangles_on(const TetMesh& mesh, const std::vector<int>& faces,
-                              const std::vector<int>& nd_faces, const std::string& what) {
+std::vector<int> triangles_on(const TetMesh& mesh, const std::vector<int>& faces, const std::vector<int>& nd_faces,
+                              const std::string& what) {
   std::vector<int> out;
   int max_face = mesh.face.size() ? mesh.face.maxCoeff() : 0;
   for (int f : faces) {
@@ -23,8 +23,8 @@ std::vector<int> triangles_on(const TetMesh& mesh, const std::vector<int>& faces
       if (mesh.face[t] == f) out.push_back(static_cast<int>(t));
     if (out.size() == before) {
       std::ostringstream s;
-      s << what << ": the part has no face Face" << f << " (its mesh has faces Face1 to Face"
-        << max_face << "); pick a face of the part";
+      s << what << ": the part has no face Face" << f << " (its mesh has faces Face1 to Face" << max_face
+        << "); pick a face of the part";
       throw Error(ErrorCode::FaceNotFound, s.str());
     }
   }
@@ -47,8 +47,7 @@ std::vector<int> triangles_on(const TetMesh& mesh, const std::vector<int>& faces
 
 /// Area-weighted normal (length = area) of boundary triangle t.
 Eigen::Vector3d area_normal(const TetMesh& mesh, int t) {
-  Eigen::Vector3d a = mesh.V.row(mesh.F(t, 0)), b = mesh.V.row(mesh.F(t, 1)),
-                  c = mesh.V.row(mesh.F(t, 2));
+  Eigen::Vector3d a = mesh.V.row(mesh.F(t, 0)), b = mesh.V.row(mesh.F(t, 1)), c = mesh.V.row(mesh.F(t, 2));
   return 0.5 * (b - a).cross(c - a);
 }
 
@@ -77,20 +76,18 @@ Supports make_supports(const TetMesh& mesh, const std::vector<SupportSpec>& spec
       for (int t : tris) {
         Eigen::Vector3d nt = area_normal(mesh, t);
         if (nt.norm() > 0 && nt.normalized().dot(n) < 1 - 1e-6)
-          throw Error(ErrorCode::InvalidParameter,
-                      what + ": a symmetry plane must be planar; these faces are not");
+          throw Error(ErrorCode::InvalidParameter, what + ": a symmetry plane must be planar; these faces are not");
       }
       int axis = 0;
       n.cwiseAbs().maxCoeff(&axis);
       if (std::abs(n[axis]) < 1 - 1e-6)
-        throw Error(ErrorCode::InvalidParameter,
-                    what + ": a symmetry plane must be perpendicular to x, y or z (model the "
-                           "part so that its symmetry plane is a coordinate plane)");
+        throw Error(ErrorCode::InvalidParameter, what +
+                                                     ": a symmetry plane must be perpendicular to x, y or z (model the "
+                                                     "part so that its symmetry plane is a coordinate plane)");
       fix = {false, false, false};
       fix[axis] = true;
     }
-    if (!fix[0] && !fix[1] && !fix[2])
-      throw Error(ErrorCode::InvalidParameter, what + ": no component is fixed");
+    if (!fix[0] && !fix[1] && !fix[2]) throw Error(ErrorCode::InvalidParameter, what + ": no component is fixed");
     for (int t : tris)
       for (int k = 0; k < 3; ++k)
         for (int c = 0; c < 3; ++c)
@@ -115,8 +112,7 @@ Eigen::Matrix3Xd gravity_of(const std::vector<LoadCase>& cases) {
   return g;
 }
 
-Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
-                           const std::vector<LoadCase>& cases) {
+Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material, const std::vector<LoadCase>& cases) {
   Eigen::MatrixXd F = Eigen::MatrixXd::Zero(3 * mesh.V.rows(), static_cast<long>(cases.size()));
   for (size_t k = 0; k < cases.size(); ++k) {
     for (const LoadSpec& item : cases[k].items) {
@@ -133,8 +129,8 @@ Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
         }
         continue;
       }
-      const std::string what = std::string(item.kind == LoadSpec::Kind::Force ? "force" : "pressure") +
-                               " on " + face_list(item.faces, item.nd_faces);
+      const std::string what = std::string(item.kind == LoadSpec::Kind::Force ? "force" : "pressure") + " on " +
+                               face_list(item.faces, item.nd_faces);
       std::vector<int> tris = triangles_on(mesh, item.faces, item.nd_faces, what);
       double area = 0;
       for (int t : tris) area += area_normal(mesh, t).norm();
@@ -143,7 +139,7 @@ Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
       for (int t : tris) {
         Eigen::Vector3d an = area_normal(mesh, t);
         Eigen::Vector3d f = item.kind == LoadSpec::Kind::Force ? Eigen::Vector3d(total * (an.norm() / area))
-                                                              : Eigen::Vector3d(-item.value * an);
+                                                               : Eigen::Vector3d(-item.value * an);
         for (int a = 0; a < 3; ++a)
           for (int c = 0; c < 3; ++c) F(3 * mesh.F(t, a) + c, k) += f[c] / 3.0;
       }

@@ -14,7 +14,7 @@ namespace topopt::fem {
 /// One support on a set of faces.
 struct SupportSpec {
   enum class Kind { Fixed, Components, Symmetry } kind = Kind::Fixed;
-  std::vector<int> faces;              ///< 1-based face numbers of Ω (FreeCAD FaceN)
+  std::vector<int> faces;                     ///< 1-based face numbers of Ω (FreeCAD FaceN)
   std::array<bool, 3> fix{true, true, true};  ///< Components: which of x, y, z are fixed
   // Symmetry: the faces must be planar and perpendicular to x, y or z; the normal
   // component is fixed.
@@ -26,11 +26,11 @@ struct SupportSpec {
 /// One load item; a load case is a list of them.
 struct LoadSpec {
   enum class Kind { Force, Pressure, Gravity } kind = Kind::Force;
-  std::vector<int> faces;               ///< Force, Pressure: 1-based face numbers of Ω
-  std::array<double, 3> vector{0, 0, 0};///< Force: total force (N) spread by area;
-                                        ///< Gravity: acceleration (mm/s²)
-  double value = 0;                     ///< Pressure: MPa, positive pushes into the part
-  std::vector<int> nd_faces;            ///< as SupportSpec::nd_faces
+  std::vector<int> faces;                 ///< Force, Pressure: 1-based face numbers of Ω
+  std::array<double, 3> vector{0, 0, 0};  ///< Force: total force (N) spread by area;
+                                          ///< Gravity: acceleration (mm/s²)
+  double value = 0;                       ///< Pressure: MPa, positive pushes into the part
+  std::vector<int> nd_faces;              ///< as SupportSpec::nd_faces
 };
 
 struct LoadCase {
@@ -48,8 +48,7 @@ Supports make_supports(const TetMesh& mesh, const std::vector<SupportSpec>& spec
 /// acts along each triangle's inward normal, gravity loads every tet with ρ·vol/4 per node
 /// (SIMP then scales each design tet's share by its density, see gravity_of).
 /// Throws Error(FaceNotFound) for a face the mesh lacks.
-Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material,
-                           const std::vector<LoadCase>& cases);
+Eigen::MatrixXd make_loads(const TetMesh& mesh, const Material& material, const std::vector<LoadCase>& cases);
 
 /// 3 by #cases: each case's gravity accelerations summed (mm/s²); zero where it has none.
 Eigen::Matrix3Xd gravity_of(const std::vector<LoadCase>& cases);

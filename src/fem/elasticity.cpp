@@ -24,8 +24,8 @@
 
 #include "fem/amg.h"
 
-#include <Eigen/CholmodSupport>
 #include <xmmintrin.h>
+#include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Sparse>
 #include <algorithm>
@@ -97,13 +97,13 @@ struct Elasticity::Impl {
   std::vector<double> vol;   // #T
   VecXd scale;               // #T
 
-  std::vector<int> free_index;  // 3#V: index among free dofs, or -1 if prescribed
-  std::vector<int> free_dofs;   // inverse map
+  std::vector<int> free_index;     // 3#V: index among free dofs, or -1 if prescribed
+  std::vector<int> free_dofs;      // inverse map
   std::vector<double> prescribed;  // 3#V: prescribed value (0 where free)
   bool nonzero_prescribed = false;
 
-  SpMat K;                      // free-free, lower triangle
-  std::vector<int> slot;        // #T * 78: index into K's values, or -1
+  SpMat K;                                // free-free, lower triangle
+  std::vector<int> slot;                  // #T * 78: index into K's values, or -1
   std::vector<std::vector<int>> colours;  // element ids per colour
 
   std::string singular_reason;  // non-empty: the supports do not hold the structure
@@ -122,9 +122,9 @@ struct Elasticity::Impl {
   bool amg_rebuild = false;  // the last solve was slow: rebuild at the next new matrix
   int amg_baseline = -1;     // CG iterations of the first solve after the last full setup
   bool amg_kept = false;     // the hierarchy in use was built for an earlier matrix
-  Eigen::MatrixXd last;  // previous free solution, for warm starts
+  Eigen::MatrixXd last;      // previous free solution, for warm starts
   bool use_direct = true;
-  bool factor_valid = false;  // the factor exists (perhaps of an earlier matrix)
+  bool factor_valid = false;    // the factor exists (perhaps of an earlier matrix)
   bool factor_current = false;  // the factor is of the current matrix
   int skip_recycle = 0;         // solves to factorise directly after a failed recycling
 
@@ -203,12 +203,15 @@ void Elasticity::Impl::build_full() {
 
 void Elasticity::Impl::refill_full() {
   const double* v = K.valuePtr();
-  parallel_for(K.nonZeros(), threads, [&](long b, long e) {
-    for (long k = b; k < e; ++k) {
-      full.val[full_pos[2 * k]] = v[k];
-      if (full_pos[2 * k + 1] >= 0) full.val[full_pos[2 * k + 1]] = v[k];
-    }
-  }, 1 << 16);
+  parallel_for(
+      K.nonZeros(), threads,
+      [&](long b, long e) {
+        for (long k = b; k < e; ++k) {
+          full.val[full_pos[2 * k]] = v[k];
+          if (full_pos[2 * k + 1] >= 0) full.val[full_pos[2 * k + 1]] = v[k];
+        }
+      },
+      1 << 16);
 }
 
 void Elasticity::Impl::compute_geometry() {
@@ -344,10 +347,10 @@ void Elasticity::Impl::build_colours() {
         if (c - 64 >= static_cast<int>(overflow_nodes.size())) overflow_nodes.emplace_back();
         auto& used = overflow_nodes[c - 64];
         bool clash = false;
-        for (int a = 0; a < 4 && !clash; ++a)
-          clash = std::binary_search(used.begin(), used.end(), mesh.T(e, a));
+        for (int a = 0; a < 4 && !clash; ++a) clash = std::binary_search(used.begin(), used.end(), mesh.T(e, a));
         if (!clash) {
-          for (int a = 0; a < 4; ++a) used.insert(std::lower_bound(used.begin(), used.end(), mesh.T(e, a)), mesh.T(e, a));
+          for (int a = 0; a < 4; ++a)
+            used.insert(std::lower_bound(used.begin(), used.end(), mesh.T(e, a)), mesh.T(e, a));
           break;
         }
       }
@@ -436,11 +439,10 @@ void Elasticity::Impl::check_rigid_body_modes() {
     ++unheld;
     Eigen::Vector3d c = pieces[k].sum / pieces[k].nodes;
     if (unheld <= 3) {
-      why << "\n  piece " << k + 1 << " of " << pieces.size() << " (" << pieces[k].nodes
-          << " nodes, around (" << c.x() << ", " << c.y() << ", " << c.z() << ")): "
+      why << "\n  piece " << k + 1 << " of " << pieces.size() << " (" << pieces[k].nodes << " nodes, around (" << c.x()
+          << ", " << c.y() << ", " << c.z() << ")): "
           << (free_modes == 6 ? std::string("no support at all")
-                              : std::to_string(free_modes) + " rigid-body motion(s) not held, e.g. " +
-                                    names[example]);
+                              : std::to_string(free_modes) + " rigid-body motion(s) not held, e.g. " + names[example]);
     }
   }
   if (unheld) {
@@ -455,20 +457,23 @@ void Elasticity::Impl::assemble() {
   double* val = K.valuePtr();
   std::fill(val, val + K.nonZeros(), 0.0);
   for (const auto& list : colours) {
-    parallel_for(static_cast<long>(list.size()), threads, [&](long b, long e) {
-      double Ke[144];
-      for (long k = b; k < e; ++k) {
-        int t = list[k];
-        element_matrix(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
-        const int* s = &slot[kPairs * static_cast<long>(t)];
-        for (int p = 0; p < kPairs; ++p)
-          if (s[p] >= 0) {
-            // a diagonal block pair (i,j) and (j,i) of different dofs map to one lower slot only
-            // once, because the 78 pairs are the element's upper triangle
-            val[s[p]] += Ke[kLocalPairs[p].i * 12 + kLocalPairs[p].j];
+    parallel_for(
+        static_cast<long>(list.size()), threads,
+        [&](long b, long e) {
+          double Ke[144];
+          for (long k = b; k < e; ++k) {
+            int t = list[k];
+            element_matrix(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+            const int* s = &slot[kPairs * static_cast<long>(t)];
+            for (int p = 0; p < kPairs; ++p)
+              if (s[p] >= 0) {
+                // a diagonal block pair (i,j) and (j,i) of different dofs map to one lower slot only
+                // once, because the 78 pairs are the element's upper triangle
+                val[s[p]] += Ke[kLocalPairs[p].i * 12 + kLocalPairs[p].j];
+              }
           }
-      }
-    }, 512);
+        },
+        512);
   }
 }
 
@@ -476,8 +481,7 @@ Elasticity::Elasticity(const TetMesh& mesh, const Material& material, const Supp
                        const SolverParams& params)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  if (!(material.young > 0))
-    throw Error(ErrorCode::InvalidParameter, "Young's modulus must be positive (MPa)");
+  if (!(material.young > 0)) throw Error(ErrorCode::InvalidParameter, "Young's modulus must be positive (MPa)");
   if (!(material.poisson > -1 && material.poisson < 0.5))
     throw Error(ErrorCode::InvalidParameter, "Poisson's ratio must lie in (-1, 0.5)");
   if (mesh.T.rows() == 0) throw Error(ErrorCode::InvalidParameter, "the mesh has no tetrahedra");
@@ -494,8 +498,7 @@ Elasticity::Elasticity(const TetMesh& mesh, const Material& material, const Supp
   m.build_colours();
   m.check_rigid_body_modes();
   const int nf = static_cast<int>(m.free_dofs.size());
-  m.use_direct = params.kind == SolverKind::Direct ||
-                 (params.kind == SolverKind::Auto && nf <= kDirectDofLimit);
+  m.use_direct = params.kind == SolverKind::Direct || (params.kind == SolverKind::Auto && nf <= kDirectDofLimit);
 }
 
 Elasticity::~Elasticity() = default;
@@ -503,10 +506,8 @@ Elasticity::Elasticity(Elasticity&&) noexcept = default;
 Elasticity& Elasticity::operator=(Elasticity&&) noexcept = default;
 
 void Elasticity::set_scale(const VecXd& scale) {
-  if (scale.size() != impl_->mesh.T.rows())
-    throw Error(ErrorCode::Internal, "set_scale: one factor per tet expected");
-  if (!(scale.minCoeff() > 0))
-    throw Error(ErrorCode::InvalidParameter, "element stiffness factors must be positive");
+  if (scale.size() != impl_->mesh.T.rows()) throw Error(ErrorCode::Internal, "set_scale: one factor per tet expected");
+  if (!(scale.minCoeff() > 0)) throw Error(ErrorCode::InvalidParameter, "element stiffness factors must be positive");
   impl_->scale = scale;
   impl_->dirty = true;
 }
@@ -615,8 +616,7 @@ Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& 
       const double r0 = r.norm();
       for (; r.norm() > goal && bnorm > 0; ++k) {
         const int limit = m.params.recycle_iterations;
-        if (k >= limit ||
-            (k == 6 && std::pow(r.norm() / r0, static_cast<double>(limit) / 6) > goal / r0)) {
+        if (k >= limit || (k == 6 && std::pow(r.norm() / r0, static_cast<double>(limit) / 6) > goal / r0)) {
           ok = false;
           break;
         }
@@ -648,11 +648,11 @@ Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& 
     // OpenBLAS's spinning workers leave the cores to our sparse products.
     BlasThreadLimit blas_limit(1);
     for (int c = 0; c < b.cols(); ++c) {
-      Eigen::VectorXd xc = (m.last.rows() == nf && c < m.last.cols()) ? Eigen::VectorXd(m.last.col(c))
-                                                                      : Eigen::VectorXd::Zero(nf);
+      Eigen::VectorXd xc =
+          (m.last.rows() == nf && c < m.last.cols()) ? Eigen::VectorXd(m.last.col(c)) : Eigen::VectorXd::Zero(nf);
       Eigen::VectorXd bc = b.col(c);
-      PcgResult r = amg_pcg(m.full, m.amg, bc.data(), xc.data(), m.params.tolerance, m.params.max_iterations,
-                            m.threads, progress);
+      PcgResult r = amg_pcg(m.full, m.amg, bc.data(), xc.data(), m.params.tolerance, m.params.max_iterations, m.threads,
+                            progress);
       if (!r.converged && m.amg_kept) {
         // the kept hierarchy no longer fits this matrix: rebuild it and solve again
         progress.info("multigrid CG stalled with the kept hierarchy; rebuilding it");
@@ -679,8 +679,7 @@ Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& 
     m.last = x;
   }
   if (m.use_direct) m.last = x;
-  if (!x.allFinite())
-    throw Error(ErrorCode::NoSupport, "the solution is not finite: the structure is not held");
+  if (!x.allFinite()) throw Error(ErrorCode::NoSupport, "the solution is not finite: the structure is not held");
   Eigen::MatrixXd U(ndof, loads.cols());
   for (int d = 0; d < ndof; ++d) {
     int k = m.free_index[d];

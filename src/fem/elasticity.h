@@ -16,9 +16,9 @@ namespace topopt::fem {
 
 /// Isotropic linear elastic material. Units: N, mm, MPa (N/mm²), tonne/mm³.
 struct Material {
-  double young = 210000.0;  ///< Young's modulus E, MPa (steel)
-  double poisson = 0.3;     ///< Poisson's ratio ν, in (-1, 0.5)
-  double density = 7.85e-9; ///< mass density, t/mm³ (for gravity loads)
+  double young = 210000.0;   ///< Young's modulus E, MPa (steel)
+  double poisson = 0.3;      ///< Poisson's ratio ν, in (-1, 0.5)
+  double density = 7.85e-9;  ///< mass density, t/mm³ (for gravity loads)
 };
 
 enum class SolverKind { Auto, Direct, Iterative };
@@ -48,8 +48,7 @@ class Elasticity {
  public:
   /// mesh: #V nodes, #T tets (positive orientation). Throws Error(NoSupport) later, at solve,
   /// if the supports leave rigid-body motion free.
-  Elasticity(const TetMesh& mesh, const Material& material, const Supports& supports,
-             const SolverParams& params = {});
+  Elasticity(const TetMesh& mesh, const Material& material, const Supports& supports, const SolverParams& params = {});
   ~Elasticity();
   Elasticity(Elasticity&&) noexcept;
   Elasticity& operator=(Elasticity&&) noexcept;

@@ -11,14 +11,14 @@
 namespace topopt::io {
 
 void write_inp(const std::string& path, const TetMesh& mesh, const fem::Material& material,
-               const fem::Supports& supports, const Eigen::MatrixXd& loads, int load_case,
-               const VecXd& scale) {
+               const fem::Supports& supports, const Eigen::MatrixXd& loads, int load_case, const VecXd& scale) {
   FILE* f = std::fopen(path.c_str(), "w");
   if (!f) throw Error(ErrorCode::Io, "cannot write " + path);
   const long nv = mesh.V.rows(), nt = mesh.T.rows();
   std::fprintf(f, "** Written by TopOpt: linear static analysis on C3D4 tets (units N, mm, MPa)\n*HEADING\nTopOpt\n");
   std::fprintf(f, "*NODE, NSET=NALL\n");
-  for (long i = 0; i < nv; ++i) std::fprintf(f, "%ld, %.13g, %.13g, %.13g\n", i + 1, mesh.V(i, 0), mesh.V(i, 1), mesh.V(i, 2));
+  for (long i = 0; i < nv; ++i)
+    std::fprintf(f, "%ld, %.13g, %.13g, %.13g\n", i + 1, mesh.V(i, 0), mesh.V(i, 1), mesh.V(i, 2));
   // Elements grouped by (domain, material); a material per distinct stiffness factor.
   std::map<double, int> mat_of;
   if (scale.size() == nt)
@@ -34,10 +34,12 @@ void write_inp(const std::string& path, const TetMesh& mesh, const fem::Material
     std::string name = g.first.first == 0 ? "DESIGN" : "NONDESIGN" + std::to_string(g.first.first);
     std::fprintf(f, "*ELEMENT, TYPE=C3D4, ELSET=%s_M%d\n", name.c_str(), g.first.second);
     for (long t : g.second)
-      std::fprintf(f, "%ld, %d, %d, %d, %d\n", t + 1, mesh.T(t, 0) + 1, mesh.T(t, 1) + 1, mesh.T(t, 2) + 1, mesh.T(t, 3) + 1);
+      std::fprintf(f, "%ld, %d, %d, %d, %d\n", t + 1, mesh.T(t, 0) + 1, mesh.T(t, 1) + 1, mesh.T(t, 2) + 1,
+                   mesh.T(t, 3) + 1);
   }
   for (const auto& kv : mat_of) {
-    std::fprintf(f, "*MATERIAL, NAME=M%d\n*ELASTIC\n%.13g, %.13g\n", kv.second, material.young * kv.first, material.poisson);
+    std::fprintf(f, "*MATERIAL, NAME=M%d\n*ELASTIC\n%.13g, %.13g\n", kv.second, material.young * kv.first,
+                 material.poisson);
     std::fprintf(f, "*DENSITY\n%.13g\n", material.density);
   }
   for (const auto& g : groups) {

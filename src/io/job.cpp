@@ -65,8 +65,9 @@ void parse_face_name(const std::string& name, std::vector<int>& faces, std::vect
       return;
     }
   }
-  throw Error(ErrorCode::FaceNotFound, "\"" + name + "\" is not a face name; write faces as FreeCAD does: "
-                                       "\"Face7\" (or \"NonDesign:Face2\" for a face of the non-design solids)");
+  throw Error(ErrorCode::FaceNotFound, "\"" + name +
+                                           "\" is not a face name; write faces as FreeCAD does: "
+                                           "\"Face7\" (or \"NonDesign:Face2\" for a face of the non-design solids)");
 }
 
 Job parse_job(const std::string& text, const std::string& base_dir) {
@@ -124,13 +125,18 @@ Job parse_job(const std::string& text, const std::string& base_dir) {
       } else if (type == "components") {
         spec.kind = fem::SupportSpec::Kind::Components;
         spec.fix = {false, false, false};
-        if (!s.contains("fix") || !s["fix"].is_array()) bad(where + "fix", "must list the fixed components, e.g. [\"x\", \"z\"]");
+        if (!s.contains("fix") || !s["fix"].is_array())
+          bad(where + "fix", "must list the fixed components, e.g. [\"x\", \"z\"]");
         for (const auto& c : s["fix"]) {
           std::string n = c.is_string() ? c.get<std::string>() : "";
-          if (n == "x") spec.fix[0] = true;
-          else if (n == "y") spec.fix[1] = true;
-          else if (n == "z") spec.fix[2] = true;
-          else bad(where + "fix", "must hold \"x\", \"y\" or \"z\"");
+          if (n == "x")
+            spec.fix[0] = true;
+          else if (n == "y")
+            spec.fix[1] = true;
+          else if (n == "z")
+            spec.fix[2] = true;
+          else
+            bad(where + "fix", "must hold \"x\", \"y\" or \"z\"");
         }
       } else if (type == "symmetry") {
         spec.kind = fem::SupportSpec::Kind::Symmetry;

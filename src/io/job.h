@@ -15,21 +15,21 @@ namespace topopt::io {
 /// the whole document for the stages that read their own section ("optimization").
 struct Job {
   nlohmann::json raw;
-  std::string base_dir;           ///< folder of the job file ("" for a job given as text)
-  std::string part;               ///< Ω: STEP/IGES/BREP path ("" if a mesh file is given, or the
-                                  ///< shapes come separately, as from the workbench)
-  std::string nondesign;          ///< Ω̄: path, or "" for none
-  std::string mesh_file;          ///< a ready MSH 4.1 mesh, or ""
-  double mesh_size = 0;           ///< target element size (mm); 0 = automatic
-  int mesh_wall_layers = 0;       ///< layers across thin walls (native mesher; 0 = no refinement)
-  double mesh_min_size = 0;       ///< smallest size (mm); 0 = automatic
+  std::string base_dir;      ///< folder of the job file ("" for a job given as text)
+  std::string part;          ///< Ω: STEP/IGES/BREP path ("" if a mesh file is given, or the
+                             ///< shapes come separately, as from the workbench)
+  std::string nondesign;     ///< Ω̄: path, or "" for none
+  std::string mesh_file;     ///< a ready MSH 4.1 mesh, or ""
+  double mesh_size = 0;      ///< target element size (mm); 0 = automatic
+  int mesh_wall_layers = 0;  ///< layers across thin walls (native mesher; 0 = no refinement)
+  double mesh_min_size = 0;  ///< smallest size (mm); 0 = automatic
   /// "native": the two-B-Rep advancing front (14 steps); "gmsh": OCC fragments + Gmsh;
   /// "auto": native, falling back to gmsh with a warning where native cannot close a mesh.
   std::string mesher = "auto";
   fem::Material material;
   std::vector<fem::SupportSpec> supports;
   std::vector<fem::LoadCase> load_cases;
-  std::string output_dir;         ///< absolute; default "<job folder>/out"
+  std::string output_dir;  ///< absolute; default "<job folder>/out"
   bool write_vtu = true;
   bool write_inp = false;
 };

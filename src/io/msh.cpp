@@ -85,14 +85,14 @@ void write_msh(const std::string& path, const TetMesh& mesh) {
     std::vector<int> phys;
     if (kv.first.first > 0) phys.push_back(kv.first.first);
     if (kv.first.second > 0) phys.push_back(kNonDesignFaceTag + kv.first.second);
-    std::fprintf(f, "%d %.17g %.17g %.17g %.17g %.17g %.17g %zu", kv.second, lo[0], lo[1], lo[2], hi[0],
-                 hi[1], hi[2], phys.size());
+    std::fprintf(f, "%d %.17g %.17g %.17g %.17g %.17g %.17g %zu", kv.second, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                 phys.size());
     for (int p : phys) std::fprintf(f, " %d", p);
     std::fprintf(f, " 0\n");
   }
   for (int d = 0; d < ndom; ++d)
-    std::fprintf(f, "%d %.17g %.17g %.17g %.17g %.17g %.17g 1 %d 0\n", d + 1, lo[0], lo[1], lo[2], hi[0],
-                 hi[1], hi[2], d + 1);
+    std::fprintf(f, "%d %.17g %.17g %.17g %.17g %.17g %.17g 1 %d 0\n", d + 1, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                 d + 1);
   std::fprintf(f, "$EndEntities\n");
   // Nodes: one block on volume entity 1.
   std::fprintf(f, "$Nodes\n1 %ld 1 %ld\n3 1 0 %ld\n", nv, nv, nv);
@@ -101,8 +101,7 @@ void write_msh(const std::string& path, const TetMesh& mesh) {
   std::fprintf(f, "$EndNodes\n");
   // Elements: triangles by surface entity, tets by domain.
   std::map<int, std::vector<long>> tri_by_entity;
-  for (long t = 0; t < nf; ++t)
-    tri_by_entity[surf[{mesh.face[t], has_nd ? mesh.nd_face[t] : 0}]].push_back(t);
+  for (long t = 0; t < nf; ++t) tri_by_entity[surf[{mesh.face[t], has_nd ? mesh.nd_face[t] : 0}]].push_back(t);
   std::vector<std::vector<long>> tet_by_domain(ndom);
   for (long t = 0; t < nt; ++t) tet_by_domain[mesh.domain[t]].push_back(t);
   size_t blocks = tri_by_entity.size();
@@ -180,8 +179,8 @@ class Tokens {
   }
   [[noreturn]] void fail(const std::string& what) const {
     long line = 1 + std::count(text_.begin(), text_.begin() + std::min(pos_, text_.size()), '\n');
-    throw Error(ErrorCode::Io, path_ + ":" + std::to_string(line) + ": " + what +
-                                   " (expected a Gmsh MSH 4.1 ASCII file)");
+    throw Error(ErrorCode::Io,
+                path_ + ":" + std::to_string(line) + ": " + what + " (expected a Gmsh MSH 4.1 ASCII file)");
   }
 
  private:
@@ -256,8 +255,8 @@ TetMesh read_msh(const std::string& path) {
     } else if (sec == "$Elements") {
       long blocks = in.integer();
       in.integer(), in.integer(), in.integer();
-      static const std::map<long, int> kNodesOf = {
-          {1, 2}, {2, 3}, {3, 4}, {4, 4}, {5, 8}, {6, 6}, {7, 5}, {8, 3}, {9, 6}, {10, 9}, {11, 10}, {15, 1}};
+      static const std::map<long, int> kNodesOf = {{1, 2}, {2, 3}, {3, 4}, {4, 4},  {5, 8},   {6, 6},
+                                                   {7, 5}, {8, 3}, {9, 6}, {10, 9}, {11, 10}, {15, 1}};
       for (long b = 0; b < blocks; ++b) {
         int dim = static_cast<int>(in.integer());
         int entity = static_cast<int>(in.integer());
@@ -299,7 +298,8 @@ TetMesh read_msh(const std::string& path) {
   for (size_t i = 0; i < nodes.size(); ++i) m.V.row(i) << nodes[i][0], nodes[i][1], nodes[i][2];
   auto idx = [&](long tag) {
     auto it = node_index.find(tag);
-    if (it == node_index.end()) throw Error(ErrorCode::Io, path + ": an element uses node " + std::to_string(tag) + " which is not defined");
+    if (it == node_index.end())
+      throw Error(ErrorCode::Io, path + ": an element uses node " + std::to_string(tag) + " which is not defined");
     return it->second;
   };
   m.T.resize(tets.size(), 4);

@@ -10,7 +10,8 @@
 
 namespace topopt::io {
 
-void write_stl(const std::string& path, const MatX3d& V, const MatX3i& F, const std::string& header, const VecXi* tags) {
+void write_stl(const std::string& path, const MatX3d& V, const MatX3i& F, const std::string& header,
+               const VecXi* tags) {
   FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw Error(ErrorCode::Io, "cannot write " + path);
   char head[80] = {};

@@ -34,17 +34,20 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<V
                "NumberOfComponents=\"3\" format=\"ascii\">\n",
                nv, nt);
   for (long i = 0; i < nv; ++i) std::fprintf(f, " %.12g %.12g %.12g\n", mesh.V(i, 0), mesh.V(i, 1), mesh.V(i, 2));
-  std::fprintf(f, "        </DataArray>\n      </Points>\n      <Cells>\n"
-                  "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-  for (long t = 0; t < nt; ++t) std::fprintf(f, " %d %d %d %d\n", mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3));
+  std::fprintf(f,
+               "        </DataArray>\n      </Points>\n      <Cells>\n"
+               "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+  for (long t = 0; t < nt; ++t)
+    std::fprintf(f, " %d %d %d %d\n", mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3));
   std::fprintf(f, "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
   for (long t = 0; t < nt; ++t) std::fprintf(f, " %ld", 4 * (t + 1));
   std::fprintf(f, "\n        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
   for (long t = 0; t < nt; ++t) std::fprintf(f, " 10");
   std::fprintf(f, "\n        </DataArray>\n      </Cells>\n      <PointData>\n");
   for (const auto& fd : point_data) write_field(f, fd, nv, path);
-  std::fprintf(f, "      </PointData>\n      <CellData>\n"
-                  "        <DataArray type=\"Int32\" Name=\"domain\" format=\"ascii\">\n");
+  std::fprintf(f,
+               "      </PointData>\n      <CellData>\n"
+               "        <DataArray type=\"Int32\" Name=\"domain\" format=\"ascii\">\n");
   for (long t = 0; t < nt; ++t) std::fprintf(f, " %d", mesh.domain.size() == nt ? mesh.domain[t] : 0);
   std::fprintf(f, "\n        </DataArray>\n");
   for (const auto& fd : cell_data) write_field(f, fd, nt, path);

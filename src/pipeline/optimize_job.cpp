@@ -41,9 +41,12 @@ OptimizeSettings optimize_settings(const io::Job& job) {
   p.law.e_min = num(o, "emin", 1e-9);
   if (!(p.law.e_min > 0 && p.law.e_min < 0.1)) bad("emin", "must lie in (0, 0.1)");
   std::string filter = o.value("filter", "gaussian");
-  if (filter == "gaussian") p.filter.kind = simp::FilterKind::Gaussian;
-  else if (filter == "cone") p.filter.kind = simp::FilterKind::Cone;
-  else bad("filter", "must be \"gaussian\" or \"cone\"");
+  if (filter == "gaussian")
+    p.filter.kind = simp::FilterKind::Gaussian;
+  else if (filter == "cone")
+    p.filter.kind = simp::FilterKind::Cone;
+  else
+    bad("filter", "must be \"gaussian\" or \"cone\"");
   p.filter.radius = num(o, "filter_radius", 0);
   if (p.filter.radius < 0) bad("filter_radius", "must be positive (mm), or 0 for automatic");
   p.sensitivity_filter = o.value("sensitivity_filter", false);
@@ -56,19 +59,27 @@ OptimizeSettings optimize_settings(const io::Job& job) {
     }
   }
   std::string update = o.value("update", "oc");
-  if (update == "oc") p.update = simp::UpdateKind::OC;
-  else if (update == "mma") p.update = simp::UpdateKind::MMA;
-  else bad("update", "must be \"oc\" or \"mma\"");
+  if (update == "oc")
+    p.update = simp::UpdateKind::OC;
+  else if (update == "mma")
+    p.update = simp::UpdateKind::MMA;
+  else
+    bad("update", "must be \"oc\" or \"mma\"");
   std::string solver = o.value("solver", "auto");
-  if (solver == "auto") p.solver.kind = fem::SolverKind::Auto;
-  else if (solver == "direct") p.solver.kind = fem::SolverKind::Direct;
-  else if (solver == "iterative") p.solver.kind = fem::SolverKind::Iterative;
-  else bad("solver", "must be \"auto\", \"direct\" (sparse Cholesky) or \"iterative\" (multigrid CG)");
+  if (solver == "auto")
+    p.solver.kind = fem::SolverKind::Auto;
+  else if (solver == "direct")
+    p.solver.kind = fem::SolverKind::Direct;
+  else if (solver == "iterative")
+    p.solver.kind = fem::SolverKind::Iterative;
+  else
+    bad("solver", "must be \"auto\", \"direct\" (sparse Cholesky) or \"iterative\" (multigrid CG)");
   // SIMP needs the displacements to a few digits only: on the rocker (114 k tets) a relative
   // residual of 1e-5 instead of 1e-6 changed no compliance of the 54-iteration history by more
   // than 6e-8 relative, and took 17 % fewer CG iterations (docs/optimization.md).
   p.solver.tolerance = num(o, "solver_tolerance", 1e-5);
-  if (!(p.solver.tolerance >= 1e-14 && p.solver.tolerance <= 1e-2)) bad("solver_tolerance", "must lie in [1e-14, 1e-2]");
+  if (!(p.solver.tolerance >= 1e-14 && p.solver.tolerance <= 1e-2))
+    bad("solver_tolerance", "must lie in [1e-14, 1e-2]");
   p.solver.recycle_tolerance = p.solver.tolerance;
   p.move = num(o, "move", 0.2);
   if (!(p.move > 0 && p.move <= 1)) bad("move", "must lie in (0, 1]");
@@ -83,9 +94,8 @@ OptimizeSettings optimize_settings(const io::Job& job) {
   return s;
 }
 
-result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
-                                   double volume_fraction, const result::SmoothParams& smooth,
-                                   double* threshold_used) {
+result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
+                                  const result::SmoothParams& smooth, double* threshold_used) {
   VecXd nd = result::node_densities(mesh, density);
   double t = threshold > 0 ? threshold : result::threshold_for_volume(mesh, nd, volume_fraction);
   if (threshold_used) *threshold_used = t;
@@ -123,7 +133,8 @@ std::vector<std::string> write_optimize_outputs(const TetMesh& mesh, const Optim
   if (ec) throw Error(ErrorCode::Io, "cannot create the output folder " + dir + ": " + ec.message());
   std::vector<std::string> out;
   std::string vtu = (fs::path(dir) / "density.vtu").string();
-  io::VtuField d{"density", 1, std::vector<double>(r.simp.density.data(), r.simp.density.data() + r.simp.density.size())};
+  io::VtuField d{"density", 1,
+                 std::vector<double>(r.simp.density.data(), r.simp.density.data() + r.simp.density.size())};
   io::write_vtu(vtu, mesh, {}, {d});
   out.push_back(vtu);
   std::string csv = (fs::path(dir) / "history.csv").string();
@@ -145,8 +156,12 @@ std::vector<std::string> write_optimize_outputs(const TetMesh& mesh, const Optim
     j["seconds"] = {{"simp", r.seconds_simp}, {"surface", r.seconds_surface}};
     j["history"] = json::array();
     for (const auto& h : r.simp.history)
-      j["history"].push_back({{"iteration", h.iteration}, {"compliance", h.compliance}, {"volume", h.volume_fraction},
-                              {"change", h.change}, {"beta", h.beta}, {"seconds", h.seconds}});
+      j["history"].push_back({{"iteration", h.iteration},
+                              {"compliance", h.compliance},
+                              {"volume", h.volume_fraction},
+                              {"change", h.change},
+                              {"beta", h.beta},
+                              {"seconds", h.seconds}});
     std::ofstream f(js);
     f << j.dump(2) << "\n";
     if (!f) throw Error(ErrorCode::Io, "cannot write " + js);

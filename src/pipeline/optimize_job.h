@@ -7,16 +7,16 @@
 
 #include "common/progress.h"
 #include "io/job.h"
-#include "simp/optimizer.h"
 #include "result/iso_surface.h"
 #include "result/smoothing.h"
+#include "simp/optimizer.h"
 
 namespace topopt::pipeline {
 
 /// The "optimization" section of a job (docs/optimization.md), validated.
 struct OptimizeSettings {
   simp::SimpParams simp;
-  double threshold = -1;        ///< < 0: the one that meets the volume fraction
+  double threshold = -1;  ///< < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
 };
 
@@ -38,9 +38,8 @@ OptimizeResult optimize_job(const io::Job& job, const TetMesh& mesh, const Progr
 
 /// The result shape of given element densities at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain), smoothed.
-result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold,
-                                   double volume_fraction, const result::SmoothParams& smooth,
-                                   double* threshold_used = nullptr);
+result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
+                                  const result::SmoothParams& smooth, double* threshold_used = nullptr);
 
 /// Writes DIR/density.vtu, DIR/history.csv, DIR/history.json and DIR/result.stl.
 /// Returns the paths written.

@@ -7,14 +7,14 @@
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
 #include "brep/two_breps.h"
-#include "mesh/two_brep/gmsh_fragments.h"
-#include "mesh/two_brep/native_mesher.h"
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "io/inp.h"
 #include "io/msh.h"
-#include "mesh/core/reorder.h"
 #include "io/vtu.h"
+#include "mesh/core/reorder.h"
+#include "mesh/two_brep/gmsh_fragments.h"
+#include "mesh/two_brep/native_mesher.h"
 
 namespace topopt::pipeline {
 namespace fs = std::filesystem;
@@ -41,8 +41,9 @@ TetMesh job_mesh(const io::Job& job, const Progress& progress) {
     return mesh;
   }
   if (job.part.empty())
-    throw Error(ErrorCode::InvalidParameter,
-                "job file: \"part\" is missing: give the part's STEP/BREP file, or a mesh with \"mesh\": {\"file\": ...}");
+    throw Error(
+        ErrorCode::InvalidParameter,
+        "job file: \"part\" is missing: give the part's STEP/BREP file, or a mesh with \"mesh\": {\"file\": ...}");
   TopoDS_Shape part = brep::read_shape_file(job.part);
   TopoDS_Shape nd = job.nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(job.nondesign);
   return mesh_job_shapes(job, part, nd, progress);
@@ -54,15 +55,15 @@ TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const Topo
   brep::TwoBReps model = brep::load_two_breps(part, nondesign, {}, progress);
   io::check_faces(job, model.part.num_faces(), model.nondesign.num_faces());
   TetMesh mesh = mesh::mesh_two_breps(model, job.mesher, job.mesh_size, job.mesh_min_size, progress, nullptr,
-                                         job.mesh_wall_layers);
+                                      job.mesh_wall_layers);
   // The fronts and Gmsh number nodes in the order they make them; the solver, filter and
   // surface run faster on a numbering that follows space (bench/simp: see BENCHMARKS.md).
   mesh::reorder_for_locality(mesh);
   return mesh;
 }
 
-SolveResult solve_job(const io::Job& job, const TetMesh& mesh, const fem::SolverParams& solver,
-                      const VecXd& scale, const Progress& progress) {
+SolveResult solve_job(const io::Job& job, const TetMesh& mesh, const fem::SolverParams& solver, const VecXd& scale,
+                      const Progress& progress) {
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
   auto t0 = std::chrono::steady_clock::now();

@@ -13,9 +13,9 @@
 namespace topopt::pipeline {
 
 /// The mesh of a job: the MSH file of "mesh.file" if given, else the conformal tagged mesh
-/// of the part and non-design solids (interim: mesh/gmsh_fragments.h). Checks that supports and loads name faces that exist.
-/// Throws Error(Io) for an unreadable file, Error(MeshingFailed) if meshing fails,
-/// Error(FaceNotFound) for a face the part lacks.
+/// of the part and non-design solids (interim: mesh/gmsh_fragments.h). Checks that supports and loads name faces that
+/// exist. Throws Error(Io) for an unreadable file, Error(MeshingFailed) if meshing fails, Error(FaceNotFound) for a
+/// face the part lacks.
 TetMesh job_mesh(const io::Job& job, const Progress& progress = {});
 
 /// The mesh of a job whose shapes are given (the workbench passes them as BREP strings):
@@ -26,7 +26,7 @@ TetMesh mesh_job_shapes(const io::Job& job, const TopoDS_Shape& part, const Topo
 /// Results of a linear static analysis, one entry per load case.
 struct SolveResult {
   std::vector<std::string> case_names;
-  Eigen::MatrixXd U;            ///< (3*#V) by #cases displacements (mm), node-major
+  Eigen::MatrixXd U;               ///< (3*#V) by #cases displacements (mm), node-major
   std::vector<double> compliance;  ///< F·U per case (N·mm)
   std::vector<VecXd> von_mises;    ///< #T per case (MPa)
   double seconds_setup = 0, seconds_solve = 0;

@@ -78,7 +78,8 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
     Eigen::Vector3d p0 = mesh.V.row(mesh.T(t, 0));
     double v = std::abs((Eigen::Vector3d(mesh.V.row(mesh.T(t, 1))) - p0)
                             .dot((Eigen::Vector3d(mesh.V.row(mesh.T(t, 2))) - p0)
-                                     .cross(Eigen::Vector3d(mesh.V.row(mesh.T(t, 3))) - p0))) / 6.0;
+                                     .cross(Eigen::Vector3d(mesh.V.row(mesh.T(t, 3))) - p0))) /
+               6.0;
     for (int a = 0; a < 4; ++a) {
       sum[mesh.T(t, a)] += v * density[t];
       wsum[mesh.T(t, a)] += v;
@@ -122,7 +123,7 @@ TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double thre
   std::vector<int> lock, pface;
   std::vector<std::array<int, 3>> tris;
   std::vector<int> tags;
-  std::unordered_map<int, int> node_point;  // mesh node -> point
+  std::unordered_map<int, int> node_point;        // mesh node -> point
   std::map<std::pair<int, int>, int> edge_point;  // sorted mesh edge -> point
   auto node_pt = [&](int n) {
     auto [it, fresh] = node_point.emplace(n, static_cast<int>(pts.size()));
@@ -135,7 +136,8 @@ TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double thre
     if (fresh) {
       double fa = level(nd, a, threshold), fb = level(nd, b, threshold);
       double w = fa / (fa - fb);
-      pts.push_back(Eigen::Vector3d(mesh.V.row(a)) + w * (Eigen::Vector3d(mesh.V.row(b)) - Eigen::Vector3d(mesh.V.row(a))));
+      pts.push_back(Eigen::Vector3d(mesh.V.row(a)) +
+                    w * (Eigen::Vector3d(mesh.V.row(b)) - Eigen::Vector3d(mesh.V.row(a))));
       lock.push_back(0), pface.push_back(0);
     }
     return it->second;
@@ -211,12 +213,14 @@ TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double thre
       if (fresh) continue;
       long u = it->second.first;
       int ui = it->second.second;
-      if (is_design(t) != is_design(u)) interfaces.push_back(is_design(t) ? std::array<long, 2>{u, ui} : std::array<long, 2>{t, i});
+      if (is_design(t) != is_design(u))
+        interfaces.push_back(is_design(t) ? std::array<long, 2>{u, ui} : std::array<long, 2>{t, i});
       face_owner.erase(it);
     }
   // what is left in face_owner is the boundary of the mesh; Ω's face tags from mesh.F
   std::unordered_map<std::array<int, 3>, int, Hash3> face_tag;
-  for (long k = 0; k < mesh.F.rows(); ++k) face_tag[sorted3(mesh.F(k, 0), mesh.F(k, 1), mesh.F(k, 2))] = mesh.face.size() ? mesh.face[k] : 0;
+  for (long k = 0; k < mesh.F.rows(); ++k)
+    face_tag[sorted3(mesh.F(k, 0), mesh.F(k, 1), mesh.F(k, 2))] = mesh.face.size() ? mesh.face[k] : 0;
   for (const auto& [key, owner] : face_owner) {
     long t = owner.first;
     const int* o = kFace[owner.second];
@@ -243,7 +247,8 @@ TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double thre
       continue;
     }
     int centre = static_cast<int>(pts.size());
-    pts.push_back((Eigen::Vector3d(mesh.V.row(x)) + Eigen::Vector3d(mesh.V.row(y)) + Eigen::Vector3d(mesh.V.row(z))) / 3);
+    pts.push_back((Eigen::Vector3d(mesh.V.row(x)) + Eigen::Vector3d(mesh.V.row(y)) + Eigen::Vector3d(mesh.V.row(z))) /
+                  3);
     lock.push_back(2), pface.push_back(0);
     for (size_t k = 0; k < poly.size(); ++k) emit(centre, poly[k], poly[(k + 1) % poly.size()], tag);
   }
@@ -294,8 +299,10 @@ SurfaceCheck check_surface(const MatX3d& V, const MatX3i& F) {
     auto back = directed.find({e.second, e.first});
     int m = back == directed.end() ? 0 : back->second;
     if (n > 1) c.overshared_edges++;
-    if (m == 0) c.open_edges++;
-    else if (n != m) c.misoriented_edges++;
+    if (m == 0)
+      c.open_edges++;
+    else if (n != m)
+      c.misoriented_edges++;
   }
   for (long t = 0; t < F.rows(); ++t) {
     Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), d = V.row(F(t, 2));

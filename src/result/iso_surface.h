@@ -21,9 +21,9 @@ double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, doub
 
 /// A triangle surface with a tag per triangle and what may move when smoothing.
 struct TriSurface {
-  MatX3d V;         ///< #P by 3 points
-  MatX3i F;         ///< #Q by 3 triangles, oriented outwards
-  VecXi tag;        ///< #Q: 0 iso-surface, f > 0 Ω's face f, -k face of non-design solid k
+  MatX3d V;   ///< #P by 3 points
+  MatX3i F;   ///< #Q by 3 triangles, oriented outwards
+  VecXi tag;  ///< #Q: 0 iso-surface, f > 0 Ω's face f, -k face of non-design solid k
   /// #P: 0 free (iso-surface inside Ω), 1 on Ω's boundary, 2 on a non-design solid (fixed).
   VecXi lock;
   /// #P: for the points where the iso-surface meets Ω's face f (the cut line), f; else 0.

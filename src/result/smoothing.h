@@ -6,9 +6,9 @@
 namespace topopt::result {
 
 struct SmoothParams {
-  int iterations = 20;     ///< λ|μ pairs
-  double lambda = 0.5;     ///< shrinking step
-  double mu = -0.53;       ///< inflating step (|μ| > λ)
+  int iterations = 20;  ///< λ|μ pairs
+  double lambda = 0.5;  ///< shrinking step
+  double mu = -0.53;    ///< inflating step (|μ| > λ)
   /// Vertices on Ω's boundary faces: slide within their face's plane when it is planar
   /// (true), or stay fixed (false). Non-design vertices never move.
   bool slide_on_planar_faces = true;

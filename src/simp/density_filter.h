@@ -24,8 +24,7 @@ class DensityFilter {
  public:
   /// mesh: the tagged mesh; design: #D indices of the design tets in mesh.T (the order of the
   /// design variables); volume: #T element volumes.
-  DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                const FilterParams& params);
+  DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params);
 
   /// ρ̃ = H x: x and the result are #D. Weighted by w_ij v_j and normalised per row.
   VecXd apply(const VecXd& x) const;
@@ -37,8 +36,8 @@ class DensityFilter {
   double mean_neighbours() const;
 
  private:
-  Eigen::SparseMatrix<double, Eigen::RowMajor> H_;   // normalised, with volumes
-  Eigen::SparseMatrix<double, Eigen::RowMajor> W_;   // raw weights (sensitivity filter)
+  Eigen::SparseMatrix<double, Eigen::RowMajor> H_;  // normalised, with volumes
+  Eigen::SparseMatrix<double, Eigen::RowMajor> W_;  // raw weights (sensitivity filter)
 };
 
 /// #T element volumes (positive for positively oriented tets).

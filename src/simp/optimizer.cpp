@@ -19,10 +19,10 @@ double mean_edge_length(const TetMesh& mesh) {
   return n ? s / n : 0;
 }
 
-ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& material,
-                                     const fem::Supports& supports, const Eigen::MatrixXd& loads,
-                                     const std::vector<double>& weights, const SimpParams& params,
-                                     const Progress& progress, const Eigen::Matrix3Xd& gravity)
+ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
+                                     const Eigen::MatrixXd& loads, const std::vector<double>& weights,
+                                     const SimpParams& params, const Progress& progress,
+                                     const Eigen::Matrix3Xd& gravity)
     : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
   if (!(params.volume_fraction > 0 && params.volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1 (e.g. 0.3)");
@@ -41,8 +41,8 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   FilterParams fp = params.filter;
   if (fp.radius <= 0) fp.radius = 1.5 * mean_edge_length(mesh);
   filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
-  progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " +
-                std::to_string(filter_->mean_neighbours()) + " neighbours per element");
+  progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " + std::to_string(filter_->mean_neighbours()) +
+                " neighbours per element");
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())

@@ -18,18 +18,18 @@ namespace topopt::simp {
 enum class UpdateKind { OC, MMA };
 
 struct SimpParams {
-  double volume_fraction = 0.3;  ///< of the design domain (Ω0), in (0, 1)
-  SimpLaw law;                   ///< penalty 3, e_min 1e-9
-  FilterParams filter;           ///< Gaussian; radius <= 0: 1.5 × mean edge length
+  double volume_fraction = 0.3;     ///< of the design domain (Ω0), in (0, 1)
+  SimpLaw law;                      ///< penalty 3, e_min 1e-9
+  FilterParams filter;              ///< Gaussian; radius <= 0: 1.5 × mean edge length
   bool sensitivity_filter = false;  ///< filter sensitivities instead of densities
-  bool heaviside = false;        ///< Heaviside projection with β continuation
-  double beta_max = 32;          ///< continuation doubles β from 1 up to this
-  int beta_every = 20;           ///< iterations between doublings
+  bool heaviside = false;           ///< Heaviside projection with β continuation
+  double beta_max = 32;             ///< continuation doubles β from 1 up to this
+  int beta_every = 20;              ///< iterations between doublings
   UpdateKind update = UpdateKind::OC;
-  double move = 0.2;             ///< move limit per iteration
+  double move = 0.2;  ///< move limit per iteration
   int max_iterations = 100;
-  double tol_change = 0.01;      ///< stop when max |Δx| falls below this
-  double tol_objective = 1e-4;   ///< ... or the relative objective change stays below this for 5 iterations
+  double tol_change = 0.01;     ///< stop when max |Δx| falls below this
+  double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
 };
 
@@ -44,12 +44,12 @@ struct IterationRecord {
 };
 
 struct SimpResult {
-  VecXd density;        ///< #T physical densities ρ̄ (non-design tets 1)
-  VecXd variables;      ///< #D design variables x
+  VecXd density;            ///< #T physical densities ρ̄ (non-design tets 1)
+  VecXd variables;          ///< #D design variables x
   std::vector<int> design;  ///< #D tet index of each variable
   std::vector<IterationRecord> history;
   bool converged = false;
-  std::string status;   ///< "converged after N iterations" / "iteration cap (N) reached"
+  std::string status;  ///< "converged after N iterations" / "iteration cap (N) reached"
 };
 
 /// The objective and constraint of SIMP as functions of the design variables x (#D): the
@@ -85,9 +85,9 @@ class ComplianceProblem {
   double design_volume_ = 0;
   std::unique_ptr<DensityFilter> filter_;
   std::unique_ptr<fem::Elasticity> fe_;
-  Eigen::MatrixXd loads_;        // as given: with every tet's full weight
-  Eigen::Matrix3Xd gravity_;     // 3 x #cases, empty without self-weight
-  VecXd quarter_mass_;           // #D: ρ_material vol / 4 of each design tet (t)
+  Eigen::MatrixXd loads_;     // as given: with every tet's full weight
+  Eigen::Matrix3Xd gravity_;  // 3 x #cases, empty without self-weight
+  VecXd quarter_mass_;        // #D: ρ_material vol / 4 of each design tet (t)
   std::vector<double> weights_;
   Heaviside proj_;
   Progress progress_;
@@ -102,8 +102,7 @@ class ComplianceProblem {
 /// outside (0, 1) or a mesh without design tets, Error(NoSupport) for a singular system.
 SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
-                    const Progress& progress = {},
-                    const std::function<void(const IterationRecord&)>& on_iteration = {},
+                    const Progress& progress = {}, const std::function<void(const IterationRecord&)>& on_iteration = {},
                     const Eigen::Matrix3Xd& gravity = {});
 
 /// Mean edge length of the mesh's tets (for default filter radii).

@@ -10,9 +10,9 @@ namespace topopt::simp {
 /// vanish faster than its weight and near-void elements would carry huge displacements
 /// (Bruyneel & Duysinx 2005).
 struct SimpLaw {
-  double penalty = 3.0;      ///< p
-  double e_min = 1e-9;       ///< stiffness of void relative to solid, keeps K regular
-  double linear_below = 0;   ///< ρ0; 0: the power law everywhere
+  double penalty = 3.0;     ///< p
+  double e_min = 1e-9;      ///< stiffness of void relative to solid, keeps K regular
+  double linear_below = 0;  ///< ρ0; 0: the power law everywhere
 
   double stiffness(double rho) const {
     if (rho < linear_below) return e_min + rho * std::pow(linear_below, penalty - 1) * (1 - e_min);

@@ -49,7 +49,9 @@ double signed_volume(const TetMesh& m, int t) {
 int count_duplicates(const MatX3d& V, double tol) {
   // Hash nodes into cells of size tol; compare with the 27 neighbouring cells.
   std::unordered_map<long long, std::vector<int>> cells;
-  auto key = [&](long long i, long long j, long long k) { return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL); };
+  auto key = [&](long long i, long long j, long long k) {
+    return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
+  };
   auto cell = [&](double x) { return static_cast<long long>(std::floor(x / tol)); };
   int dup = 0;
   for (int v = 0; v < V.rows(); ++v) {

@@ -21,14 +21,14 @@ struct ConformityParams {
 
 struct ConformityReport {
   int nodes = 0, tets = 0, boundary_triangles = 0;
-  int inverted_tets = 0;           ///< signed volume <= 0
-  int duplicate_nodes = 0;         ///< nodes within tolerance of another node
-  int overshared_faces = 0;        ///< tet faces used by more than two tets
-  int boundary_not_in_F = 0;       ///< faces used by one tet that F does not list
-  int F_not_boundary = 0;          ///< triangles of F that are not a single tet's face
-  int open_boundary_edges = 0;     ///< edges of the boundary not used by exactly two of its triangles
-  int interface_triangles = 0;     ///< faces between tets of different domains
-  int interface_off_nondesign = 0; ///< of the sampled ones, those not on any face of Ω̄
+  int inverted_tets = 0;            ///< signed volume <= 0
+  int duplicate_nodes = 0;          ///< nodes within tolerance of another node
+  int overshared_faces = 0;         ///< tet faces used by more than two tets
+  int boundary_not_in_F = 0;        ///< faces used by one tet that F does not list
+  int F_not_boundary = 0;           ///< triangles of F that are not a single tet's face
+  int open_boundary_edges = 0;      ///< edges of the boundary not used by exactly two of its triangles
+  int interface_triangles = 0;      ///< faces between tets of different domains
+  int interface_off_nondesign = 0;  ///< of the sampled ones, those not on any face of Ω̄
   int interface_sampled = 0;
   std::vector<double> domain_volume;    ///< mesh volume per domain (0 design, 1.. Ωi)
   std::vector<double> expected_volume;  ///< B-Rep volume per domain (Ω − Ω̄, Ωi), if known

@@ -44,8 +44,10 @@ class Components {
     ++n_;
   }
   void resize_down(size_t n) {  // n <= size()
-    if (n_ > kInline && n <= kInline) std::copy(heap_.begin(), heap_.begin() + n, buf_), heap_.clear();
-    else if (n_ > kInline) heap_.resize(n);
+    if (n_ > kInline && n <= kInline)
+      std::copy(heap_.begin(), heap_.begin() + n, buf_), heap_.clear();
+    else if (n_ > kInline)
+      heap_.resize(n);
     n_ = n;
   }
 
@@ -107,9 +109,7 @@ class Expansion {
     for (double b : o.c_) r = r + scaled(b);
     return r;
   }
-  int sign() const {
-    return c_.empty() ? 0 : (c_.back() > 0 ? 1 : -1);
-  }
+  int sign() const { return c_.empty() ? 0 : (c_.back() > 0 ? 1 : -1); }
 
  private:
   Components c_;
@@ -160,9 +160,7 @@ class Expansion {
   }
 };
 
-Expansion det2(const Expansion& a, const Expansion& b, const Expansion& c, const Expansion& d) {
-  return a * d - b * c;
-}
+Expansion det2(const Expansion& a, const Expansion& b, const Expansion& c, const Expansion& d) { return a * d - b * c; }
 
 Expansion det3(const Expansion m[3][3]) {
   return m[0][0] * det2(m[1][1], m[1][2], m[2][1], m[2][2]) - m[0][1] * det2(m[1][0], m[1][2], m[2][0], m[2][2]) +

@@ -79,8 +79,10 @@ double TriangleRays::first_hit(const double* o, const double* d, long skip, doub
       const double tl = enter(nd.left), tr = enter(nd.right);
       if (top + 2 > 128) continue;  // deeper than any tree built here
       if (tl >= 0 && tr >= 0) {
-        if (tl <= tr) stack[top++] = {tr, nd.right}, stack[top++] = {tl, nd.left};
-        else stack[top++] = {tl, nd.left}, stack[top++] = {tr, nd.right};
+        if (tl <= tr)
+          stack[top++] = {tr, nd.right}, stack[top++] = {tl, nd.left};
+        else
+          stack[top++] = {tl, nd.left}, stack[top++] = {tr, nd.right};
       } else if (tl >= 0) {
         stack[top++] = {tl, nd.left};
       } else if (tr >= 0) {

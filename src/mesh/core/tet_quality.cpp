@@ -19,8 +19,8 @@ double radius_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
   return 3 * r_in / R;
 }
 
-std::pair<double, double> dihedral_range(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                         const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+std::pair<double, double> dihedral_range(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                         const Eigen::Vector3d& d) {
   const Eigen::Vector3d p[4] = {a, b, c, d};
   double lo = 180, hi = 0;
   // the dihedral angle at edge (i, j) is between the faces that contain it
@@ -64,9 +64,11 @@ QualityReport tet_quality(const TetMesh& m) {
 }
 
 nlohmann::json QualityReport::to_json() const {
-  return {{"tets", tets},
-          {"radius_ratio", {{"min", min_radius_ratio}, {"mean", mean_radius_ratio}, {"share_below_0.1", share_radius_ratio_below_01}}},
-          {"dihedral_deg", {{"min", min_dihedral}, {"max", max_dihedral}, {"share_below_10", share_dihedral_below_10}}}};
+  return {
+      {"tets", tets},
+      {"radius_ratio",
+       {{"min", min_radius_ratio}, {"mean", mean_radius_ratio}, {"share_below_0.1", share_radius_ratio_below_01}}},
+      {"dihedral_deg", {{"min", min_dihedral}, {"max", max_dihedral}, {"share_below_10", share_dihedral_below_10}}}};
 }
 
 }  // namespace topopt::mesh

@@ -12,15 +12,15 @@ double radius_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
                     const Eigen::Vector3d& d);
 
 /// Smallest and largest dihedral angle of one tet, in degrees.
-std::pair<double, double> dihedral_range(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                         const Eigen::Vector3d& c, const Eigen::Vector3d& d);
+std::pair<double, double> dihedral_range(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                         const Eigen::Vector3d& d);
 
 struct QualityReport {
   long tets = 0;
   double min_radius_ratio = 0, mean_radius_ratio = 0;
-  double share_radius_ratio_below_01 = 0;  ///< share of tets with ρ < 0.1
+  double share_radius_ratio_below_01 = 0;     ///< share of tets with ρ < 0.1
   double min_dihedral = 0, max_dihedral = 0;  ///< degrees
-  double share_dihedral_below_10 = 0;      ///< share of tets with a dihedral angle < 10°
+  double share_dihedral_below_10 = 0;         ///< share of tets with a dihedral angle < 10°
   nlohmann::json to_json() const;
 };
 

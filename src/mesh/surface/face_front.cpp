@@ -16,7 +16,9 @@ namespace {
 using predicates::incircle;
 using predicates::orient2d;
 
-inline uint64_t edge_key(int a, int b) { return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b); }
+inline uint64_t edge_key(int a, int b) {
+  return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+}
 
 /// Shape quality of a triangle: 4√3·area / (sum of squared edge lengths); 1 for equilateral.
 double quality(const double* a, const double* b, const double* c) {
@@ -67,8 +69,10 @@ class Front {
     ++degree_[a];
     ++degree_[b];
     // in every cell its bounding box overlaps, so searches need not widen by the longest edge
-    const long i0 = cell_index(std::min(p(a)[0], p(b)[0]) - lo_[0]), i1 = cell_index(std::max(p(a)[0], p(b)[0]) - lo_[0]);
-    const long j0 = cell_index(std::min(p(a)[1], p(b)[1]) - lo_[1]), j1 = cell_index(std::max(p(a)[1], p(b)[1]) - lo_[1]);
+    const long i0 = cell_index(std::min(p(a)[0], p(b)[0]) - lo_[0]),
+               i1 = cell_index(std::max(p(a)[0], p(b)[0]) - lo_[0]);
+    const long j0 = cell_index(std::min(p(a)[1], p(b)[1]) - lo_[1]),
+               j1 = cell_index(std::max(p(a)[1], p(b)[1]) - lo_[1]);
     for (long i = i0; i <= i1; ++i)
       for (long j = j0; j <= j1; ++j) edge_cells_[cell_key(i, j)].push_back(id);
     ++alive_count_;
@@ -108,8 +112,10 @@ class Front {
   uint64_t cell_of(const double* q) const { return cell_key(cell_index(q[0] - lo_[0]), cell_index(q[1] - lo_[1])); }
   template <class Fn>
   void visit(const Cells& cells, const double* q, double r, Fn&& fn) const {
-    const long i0 = static_cast<long>(std::floor((q[0] - r - lo_[0]) / cell_)), i1 = static_cast<long>(std::floor((q[0] + r - lo_[0]) / cell_));
-    const long j0 = static_cast<long>(std::floor((q[1] - r - lo_[1]) / cell_)), j1 = static_cast<long>(std::floor((q[1] + r - lo_[1]) / cell_));
+    const long i0 = static_cast<long>(std::floor((q[0] - r - lo_[0]) / cell_)),
+               i1 = static_cast<long>(std::floor((q[0] + r - lo_[0]) / cell_));
+    const long j0 = static_cast<long>(std::floor((q[1] - r - lo_[1]) / cell_)),
+               j1 = static_cast<long>(std::floor((q[1] + r - lo_[1]) / cell_));
     if ((i1 - i0 + 1) * (j1 - j0 + 1) > static_cast<long>(4 * cells.size() + 16)) {
       for (const auto& kv : cells)
         for (int x : kv.second) fn(x);
@@ -331,11 +337,15 @@ FaceFrontResult fill_face(const FaceFrontInput& in, const FaceFrontParams& param
     front.remove_edge(e);
     front.clear_pending(c);
     const int bc = front.find(b, c);
-    if (bc >= 0) front.remove_edge(bc);
-    else enqueue(front.add_edge(c, b));
+    if (bc >= 0)
+      front.remove_edge(bc);
+    else
+      enqueue(front.add_edge(c, b));
     const int ca = front.find(c, a);
-    if (ca >= 0) front.remove_edge(ca);
-    else enqueue(front.add_edge(a, c));
+    if (ca >= 0)
+      front.remove_edge(ca);
+    else
+      enqueue(front.add_edge(a, c));
   }
   for (int n : in.isolated)
     if (front.pending(n)) {
@@ -382,7 +392,8 @@ FaceFrontResult fill_face(const FaceFrontInput& in, const FaceFrontParams& param
       if (p < 0 || r < 0 || s < 0) continue;
       if (incircle(front.p(p), front.p(q), front.p(r), front.p(s)) <= 0) continue;
       // the flipped pair (r, p, s) and (s, q, r) must both be counter-clockwise
-      if (orient2d(front.p(r), front.p(p), front.p(s)) <= 0 || orient2d(front.p(s), front.p(q), front.p(r)) <= 0) continue;
+      if (orient2d(front.p(r), front.p(p), front.p(s)) <= 0 || orient2d(front.p(s), front.p(q), front.p(r)) <= 0)
+        continue;
       tris[t0] = {r, p, s};
       tris[t1] = {s, q, r};
       touched[t0] = touched[t1] = 1;

@@ -24,21 +24,21 @@ namespace topopt::mesh {
 struct FaceFrontParams {
   /// Target edge length at a point (u, v); empty: the mean length of the front's edges.
   std::function<double(const double*)> size;
-  int passes = 5;                 ///< rounds over edges that failed, each wider and less strict
+  int passes = 5;  ///< rounds over edges that failed, each wider and less strict
   long max_triangles = 20'000'000;
-  int flip_sweeps = 8;            ///< Delaunay flip sweeps over the new triangles
-  int smoothing_iterations = 4;   ///< Laplacian sweeps over the new nodes (never invert)
+  int flip_sweeps = 8;           ///< Delaunay flip sweeps over the new triangles
+  int smoothing_iterations = 4;  ///< Laplacian sweeps over the new nodes (never invert)
 };
 
 /// What is already on the face. Triangles and boundary segments are oriented so that the
 /// region to mesh lies to the LEFT of a boundary segment (outer loop counter-clockwise, holes
 /// clockwise) and triangles are counter-clockwise.
 struct FaceFrontInput {
-  MatX2d P;                  ///< #P by 2: every given point (boundary, pre-placed, isolated)
-  MatX2i boundary;           ///< #B by 2 directed boundary segments
-  MatX3i triangles;          ///< #K by 3 pre-placed triangles (kept)
-  MatX2i segments;           ///< #S by 2 isolated segments inside the region (kept as edges)
-  std::vector<int> isolated; ///< nodes that must become vertices of the mesh
+  MatX2d P;                   ///< #P by 2: every given point (boundary, pre-placed, isolated)
+  MatX2i boundary;            ///< #B by 2 directed boundary segments
+  MatX3i triangles;           ///< #K by 3 pre-placed triangles (kept)
+  MatX2i segments;            ///< #S by 2 isolated segments inside the region (kept as edges)
+  std::vector<int> isolated;  ///< nodes that must become vertices of the mesh
 };
 
 struct FaceFrontResult {

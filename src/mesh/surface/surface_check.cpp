@@ -114,7 +114,9 @@ std::vector<std::pair<int, int>> self_intersections(const MatX3d& V, const MatX3
   for (long t = 0; t < nf; ++t) mean_edge += (V.row(F(t, 0)) - V.row(F(t, 1))).norm();
   mean_edge /= static_cast<double>(nf);
   const double cell = std::max(2 * mean_edge, 1e-12 + (hi - lo).maxCoeff() / 1024);
-  auto key = [](long i, long j, long k) { return (static_cast<uint64_t>(i) << 42) ^ (static_cast<uint64_t>(j) << 21) ^ static_cast<uint64_t>(k); };
+  auto key = [](long i, long j, long k) {
+    return (static_cast<uint64_t>(i) << 42) ^ (static_cast<uint64_t>(j) << 21) ^ static_cast<uint64_t>(k);
+  };
   std::unordered_map<uint64_t, std::vector<int>> cells;
   std::vector<std::array<long, 6>> range(nf);
   for (long t = 0; t < nf; ++t) {

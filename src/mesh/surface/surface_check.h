@@ -17,10 +17,10 @@ std::vector<std::pair<int, int>> self_intersections(const MatX3d& V, const MatX3
 
 struct SurfaceQuality {
   long triangles = 0;
-  double min_angle = 0;         ///< smallest angle of any triangle (degrees)
-  double mean_min_angle = 0;    ///< mean over triangles of their smallest angle (degrees)
-  double share_below_20 = 0;    ///< fraction of triangles whose smallest angle is below 20°
-  double mean_quality = 0;      ///< mean of 4√3·area / Σ edge² (1 = equilateral)
+  double min_angle = 0;       ///< smallest angle of any triangle (degrees)
+  double mean_min_angle = 0;  ///< mean over triangles of their smallest angle (degrees)
+  double share_below_20 = 0;  ///< fraction of triangles whose smallest angle is below 20°
+  double mean_quality = 0;    ///< mean of 4√3·area / Σ edge² (1 = equilateral)
 };
 SurfaceQuality surface_quality(const MatX3d& V, const MatX3i& F);
 

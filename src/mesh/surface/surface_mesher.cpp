@@ -2,20 +2,20 @@
 #include "mesh/surface/surface_mesher.h"
 
 #include <BRepAdaptor_Curve.hxx>
-#include <BRepBuilderAPI_Copy.hxx>
-#include <BRepMesh_IncrementalMesh.hxx>
-#include <Poly_Triangulation.hxx>
 #include <BRepAdaptor_Surface.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepClass_FaceClassifier.hxx>
 #include <BRepLProp_CLProps.hxx>
 #include <BRepLProp_SLProps.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
-#include <BRepClass_FaceClassifier.hxx>
 #include <BRep_Tool.hxx>
-#include <ShapeAnalysis_Curve.hxx>
-#include <ShapeAnalysis_Surface.hxx>
+#include <Geom2d_Curve.hxx>
 #include <Geom_Curve.hxx>
 #include <Geom_Surface.hxx>
-#include <Geom2d_Curve.hxx>
+#include <Poly_Triangulation.hxx>
+#include <ShapeAnalysis_Curve.hxx>
+#include <ShapeAnalysis_Surface.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
@@ -24,13 +24,13 @@
 #include <TopoDS_Vertex.hxx>
 #include <algorithm>
 #include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
 #include <cmath>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -157,13 +157,15 @@ class SizeRaster {
     for (long i = 0; i < nx_; ++i)
       for (long j = 0; j < ny_; ++j) {
         float& x = at(i, j);
-        if (i > 0) x = std::min({x, at(i - 1, j) + a, j > 0 ? at(i - 1, j - 1) + b : x, j + 1 < ny_ ? at(i - 1, j + 1) + b : x});
+        if (i > 0)
+          x = std::min({x, at(i - 1, j) + a, j > 0 ? at(i - 1, j - 1) + b : x, j + 1 < ny_ ? at(i - 1, j + 1) + b : x});
         if (j > 0) x = std::min(x, at(i, j - 1) + a);
       }
     for (long i = nx_ - 1; i >= 0; --i)
       for (long j = ny_ - 1; j >= 0; --j) {
         float& x = at(i, j);
-        if (i + 1 < nx_) x = std::min({x, at(i + 1, j) + a, j + 1 < ny_ ? at(i + 1, j + 1) + b : x, j > 0 ? at(i + 1, j - 1) + b : x});
+        if (i + 1 < nx_)
+          x = std::min({x, at(i + 1, j) + a, j + 1 < ny_ ? at(i + 1, j + 1) + b : x, j > 0 ? at(i + 1, j - 1) + b : x});
         if (j + 1 < ny_) x = std::min(x, at(i, j + 1) + a);
       }
   }
@@ -212,7 +214,7 @@ constexpr double kCuspAngle = 5 * M_PI / 180;
 /// The angle (rad) the surface of `face` sweeps around a collapsed edge (cone apex, sphere
 /// pole) whose parameter curve is pc on [t0, t1]: the turning of the surface's derivative
 /// across that curve, summed over samples.
-double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve)& pc, double t0, double t1) {
+double apex_angle(const TopoDS_Face& face, const Handle(Geom2d_Curve) & pc, double t0, double t1) {
   BRepAdaptor_Surface s(face, Standard_False);
   double u0, u1, v0, v1;
   BRepTools::UVBounds(face, u0, u1, v0, v1);
@@ -275,7 +277,8 @@ double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
 int wall_layers_option(double value) {
   if (!(value >= 0 && value <= 4 && value == std::floor(value)))
     throw Error(ErrorCode::InvalidParameter,
-                "wall layers must be a whole number from 0 (no refinement by wall thickness) to 4; 2 gives thin walls two element layers across");
+                "wall layers must be a whole number from 0 (no refinement by wall thickness) to 4; 2 gives thin walls "
+                "two element layers across");
   return static_cast<int>(value);
 }
 
@@ -478,7 +481,8 @@ double ModelSurface::edge_parameter(int e, const double* x, double* distance) co
   }
   gp_Pnt proj;
   double t = first;
-  const double d = ShapeAnalysis_Curve().Project(curve, gp_Pnt(x[0], x[1], x[2]), 1e-9, proj, t, first, last, Standard_False);
+  const double d =
+      ShapeAnalysis_Curve().Project(curve, gp_Pnt(x[0], x[1], x[2]), 1e-9, proj, t, first, last, Standard_False);
   if (distance) *distance = d;
   return std::clamp(t, std::min(first, last), std::max(first, last));
 }
@@ -495,7 +499,9 @@ void ModelSurface::set_edge_mesh(int e, const std::vector<int>& ids) {
   BRepAdaptor_Curve c(E);
   std::vector<double> par(ids.size());
   for (size_t i = 0; i < ids.size(); ++i)
-    par[i] = i == 0 ? c.FirstParameter() : i + 1 == ids.size() ? c.LastParameter() : edge_parameter(e, nodes_[ids[i]].data());
+    par[i] = i == 0                ? c.FirstParameter()
+             : i + 1 == ids.size() ? c.LastParameter()
+                                   : edge_parameter(e, nodes_[ids[i]].data());
   edge_param_[e] = std::move(par);
   edge_node_[e] = ids;
   edge_kind_[e] = EdgeKind::Given;
@@ -549,7 +555,8 @@ std::vector<std::pair<double, int>> ModelSurface::division(int e) const {
   // break points: the ends and the fixed nodes, in order along the edge
   std::vector<std::pair<double, int>> breaks{{S.t.front(), vertex_node_[S.va]}};
   std::vector<std::pair<double, int>> fixed = fixed_[e];
-  std::sort(fixed.begin(), fixed.end(), [&](const auto& a, const auto& b) { return increasing ? a.first < b.first : a.first > b.first; });
+  std::sort(fixed.begin(), fixed.end(),
+            [&](const auto& a, const auto& b) { return increasing ? a.first < b.first : a.first > b.first; });
   for (const auto& fx : fixed)
     if (fx.second != vertex_node_[S.va] && fx.second != vertex_node_[S.vb]) breaks.push_back(fx);
   breaks.push_back({S.t.back(), vertex_node_[S.vb]});
@@ -660,7 +667,8 @@ ModelSurface::Loops ModelSurface::face_loops(int f) const {
       const int vid = vertex_node_[topo_.vertices.FindIndex(va) - 1];
       // as many pieces as the fan needs for angles of about 50° at the apex: the angle the
       // surface sweeps around it, from the derivative across the collapsed edge
-      const int n = std::clamp(static_cast<int>(std::ceil(apex_angle(fwd, pc, pf, pl) / (50.0 * M_PI / 180))), 2, kMaxApexPieces);
+      const int n =
+          std::clamp(static_cast<int>(std::ceil(apex_angle(fwd, pc, pf, pl) / (50.0 * M_PI / 180))), 2, kMaxApexPieces);
       par.clear();
       ids.assign(n + 1, vid);
       for (int i = 0; i <= n; ++i) par.push_back(pf + (pl - pf) * i / n);
@@ -716,7 +724,7 @@ void ModelSurface::mesh_edges(const Progress& progress) {
   // below kCuspAngle the pieces near it are only split where they cross: that close to a
   // cusp, splitting makes ever thinner triangles, while longer chords open the corner up.
   std::vector<std::array<char, 2>> needle_end(ne, {0, 0});  // first / last piece of each edge
-  std::unordered_set<int> cusp;                            // nodes of corners below kCuspAngle
+  std::unordered_set<int> cusp;                             // nodes of corners below kCuspAngle
   for (int f = 0; f < nf; ++f) {
     if (face_given_[f]) continue;
     const Loops L = face_loops(f);
@@ -748,7 +756,8 @@ void ModelSurface::mesh_edges(const Progress& progress) {
     }
   }
   auto is_needle = [&](int e, int piece) {
-    return (piece == 0 && needle_end[e][0]) || (piece + 2 == static_cast<int>(edge_node_[e].size()) && needle_end[e][1]);
+    return (piece == 0 && needle_end[e][0]) ||
+           (piece + 2 == static_cast<int>(edge_node_[e].size()) && needle_end[e][1]);
   };
   std::vector<char> stale(nf, 1);
   for (int round = 0; round < 10; ++round) {
@@ -771,7 +780,8 @@ void ModelSurface::mesh_edges(const Progress& progress) {
         order[i] = static_cast<int>(i);
       }
       std::sort(order.begin(), order.end(), [&](int p, int q) { return xlo[p] < xlo[q]; });
-      auto point_seg = [&](const std::array<double, 2>& P, const std::array<double, 2>& A, const std::array<double, 2>& B) {
+      auto point_seg = [&](const std::array<double, 2>& P, const std::array<double, 2>& A,
+                           const std::array<double, 2>& B) {
         const double dx = B[0] - A[0], dy = B[1] - A[1], l2 = dx * dx + dy * dy;
         const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
         return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
@@ -780,14 +790,16 @@ void ModelSurface::mesh_edges(const Progress& progress) {
         return std::sqrt(sqdist(nodes_[LL.global[LL.segs[i][0]]], nodes_[LL.global[LL.segs[i][1]]]));
       };
       auto dist3 = [&](int v, const Loops& LL, int i) {  // from node v to the nearer end of segment i
-        return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]), sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
+        return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]),
+                                  sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
       };
       // segments i and j of two different edges that end at one cusp's node, both within four
       // of their lengths of it (3D)
       auto near_cusp = [&](int i, int j) {
         const int ei = L.seg_edge[i], ej = L.seg_edge[j];
         if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
-        const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()}, vj{edge_node_[ej].front(), edge_node_[ej].back()};
+        const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()},
+            vj{edge_node_[ej].front(), edge_node_[ej].back()};
         const double reach = 4 * std::max(len3(L, i), len3(L, j));
         for (int v : vi)
           for (int w : vj)
@@ -823,11 +835,13 @@ void ModelSurface::mesh_edges(const Progress& progress) {
           const auto &si = L.segs[i], &sj = L.segs[j];
           if (si[0] == sj[0] || si[0] == sj[1] || si[1] == sj[0] || si[1] == sj[1]) continue;
           const auto &A = L.uv[si[0]], &B = L.uv[si[1]], &C = L.uv[sj[0]], &D = L.uv[sj[1]];
-          const bool cross = predicates::orient2d(A.data(), B.data(), C.data()) *
-                                     predicates::orient2d(A.data(), B.data(), D.data()) <= 0 &&
-                             predicates::orient2d(C.data(), D.data(), A.data()) *
-                                     predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
-          const double d = cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
+          const bool cross =
+              predicates::orient2d(A.data(), B.data(), C.data()) * predicates::orient2d(A.data(), B.data(), D.data()) <=
+                  0 &&
+              predicates::orient2d(C.data(), D.data(), A.data()) * predicates::orient2d(C.data(), D.data(), B.data()) <=
+                  0;
+          const double d =
+              cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
           if (d >= gap || (!cross && near_cusp(i, j))) continue;
           // the longer one is what leaves no room; both when they cross
           if (cross || len[i] >= 0.7 * len[j]) mark(i, cross);
@@ -946,7 +960,8 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
   in.P.resize(static_cast<long>(uv.size()), 2);
   for (size_t i = 0; i < uv.size(); ++i) in.P.row(static_cast<long>(i)) << uv[i][0], uv[i][1];
   in.boundary.resize(static_cast<long>(loops.segs.size()), 2);
-  for (size_t i = 0; i < loops.segs.size(); ++i) in.boundary.row(static_cast<long>(i)) << loops.segs[i][0], loops.segs[i][1];
+  for (size_t i = 0; i < loops.segs.size(); ++i)
+    in.boundary.row(static_cast<long>(i)) << loops.segs[i][0], loops.segs[i][1];
   in.segments.resize(static_cast<long>(csegs.size()), 2);
   for (size_t i = 0; i < csegs.size(); ++i) in.segments.row(static_cast<long>(i)) << csegs[i][0], csegs[i][1];
   in.isolated = isolated;
@@ -1096,7 +1111,8 @@ SurfaceMesh ModelSurface::result() const {
       out.face[row++] = f + 1;
     }
   out.V.resize(static_cast<long>(used.size()), 3);
-  for (size_t i = 0; i < used.size(); ++i) out.V.row(static_cast<long>(i)) << nodes_[used[i]][0], nodes_[used[i]][1], nodes_[used[i]][2];
+  for (size_t i = 0; i < used.size(); ++i)
+    out.V.row(static_cast<long>(i)) << nodes_[used[i]][0], nodes_[used[i]][1], nodes_[used[i]][2];
   return out;
 }
 
@@ -1116,8 +1132,10 @@ MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh,
   for (long t = 0; t < mesh.F.rows(); ++t) {
     auto it = flip.find(mesh.face[t]);
     if (it == flip.end()) continue;
-    if (it->second) rows.push_back({mesh.F(t, 0), mesh.F(t, 2), mesh.F(t, 1)});
-    else rows.push_back({mesh.F(t, 0), mesh.F(t, 1), mesh.F(t, 2)});
+    if (it->second)
+      rows.push_back({mesh.F(t, 0), mesh.F(t, 2), mesh.F(t, 1)});
+    else
+      rows.push_back({mesh.F(t, 0), mesh.F(t, 1), mesh.F(t, 2)});
   }
   MatX3i out(static_cast<long>(rows.size()), 3);
   for (size_t i = 0; i < rows.size(); ++i) out.row(i) << rows[i][0], rows[i][1], rows[i][2];

@@ -8,9 +8,9 @@
 // vertices and inside faces from finer boundary pieces (gradation); boundary pieces are split
 // where a face's loops come close to each other (proximity) or run longer than the face's
 // graded size; on request (wall_layers) walls thinner than two sizes are refined from their
-// thickness, measured by rays across the model. The parameter scaling is exact for planes and cylinders and approximate on
-// other surfaces; the triangles are then improved on the surface itself (surface_optimize.h).
-// A collapsed edge (cone apex, sphere pole) becomes a fan of triangles around its apex.
+// thickness, measured by rays across the model. The parameter scaling is exact for planes and cylinders and approximate
+// on other surfaces; the triangles are then improved on the surface itself (surface_optimize.h). A collapsed edge (cone
+// apex, sphere pole) becomes a fan of triangles around its apex.
 #pragma once
 #include <array>
 #include <string>
@@ -25,21 +25,21 @@
 namespace topopt::mesh {
 
 struct SurfaceMeshParams {
-  double size = 0;                   ///< target edge length (mm); <= 0: the model's diagonal / 50
-  double min_size = 0;               ///< smallest edge length (mm); <= 0: size / 10
+  double size = 0;                                     ///< target edge length (mm); <= 0: the model's diagonal / 50
+  double min_size = 0;                                 ///< smallest edge length (mm); <= 0: size / 10
   double max_angle = 2 * 3.14159265358979323846 / 16;  ///< turning of the surface or edge per element (rad)
-  double gradation = 1.3;            ///< how fast sizes may grow away from finer regions (ratio per element)
-  int wall_layers = 0;               ///< walls thinner than two sizes get about this many element
-                                     ///< layers across (0: no refinement by wall thickness)
-  int optimize_rounds = 3;           ///< flip + smoothing rounds judged on the surface (0: none)
-  int threads = 0;                   ///< faces meshed in parallel; 0 = all cores
-  FaceFrontParams front;             ///< the face engine's settings (its size is set per face)
+  double gradation = 1.3;   ///< how fast sizes may grow away from finer regions (ratio per element)
+  int wall_layers = 0;      ///< walls thinner than two sizes get about this many element
+                            ///< layers across (0: no refinement by wall thickness)
+  int optimize_rounds = 3;  ///< flip + smoothing rounds judged on the surface (0: none)
+  int threads = 0;          ///< faces meshed in parallel; 0 = all cores
+  FaceFrontParams front;    ///< the face engine's settings (its size is set per face)
 };
 
 struct SurfaceMesh {
-  MatX3d V;      ///< #V by 3 nodes; the first #vertices are the model's vertices, in order
-  MatX3i F;      ///< #F by 3 triangles, normals pointing out of the solid that holds the face
-  VecXi face;    ///< #F: the face's number, 1-based as FreeCAD's FaceN
+  MatX3d V;                       ///< #V by 3 nodes; the first #vertices are the model's vertices, in order
+  MatX3i F;                       ///< #F by 3 triangles, normals pointing out of the solid that holds the face
+  VecXi face;                     ///< #F: the face's number, 1-based as FreeCAD's FaceN
   std::vector<int> failed_faces;  ///< faces that could not be meshed (1-based), with reasons below
   std::vector<std::string> reasons;
 };
@@ -107,7 +107,7 @@ class ModelSurface {
   void mesh_faces(const Progress& progress = {});
   /// Face f's triangles, normals out of the solid that holds the face (the index's first).
   const std::vector<std::array<int, 3>>& face_triangles(int f) const { return face_tris_[f]; }
-  const std::vector<int>& failed_faces() const { return failed_; }      ///< 1-based
+  const std::vector<int>& failed_faces() const { return failed_; }  ///< 1-based
   /// With wall_layers: (x, y, z, size) at the middle of each thin wall sample, for the
   /// volume's size (BackgroundSize seeds), so the fill puts nodes inside the wall.
   const std::vector<std::array<double, 4>>& wall_points() const { return wall_points_; }
@@ -159,11 +159,11 @@ class ModelSurface {
   std::vector<double> face_size_;
   std::vector<EdgeSamples> samples_;
   std::vector<double> vsize_;
-  std::vector<std::vector<std::array<double, 3>>> thin_uv_;   ///< per face: (scaled u, v, size)
-  std::vector<std::array<double, 4>> wall_points_;            ///< see wall_points()
+  std::vector<std::vector<std::array<double, 3>>> thin_uv_;  ///< per face: (scaled u, v, size)
+  std::vector<std::array<double, 4>> wall_points_;           ///< see wall_points()
   std::vector<int> vertex_node_;
   std::vector<EdgeKind> edge_kind_;
-  std::vector<std::array<int, 2>> alias_of_;  ///< (rep, reversed) per aliased edge
+  std::vector<std::array<int, 2>> alias_of_;                ///< (rep, reversed) per aliased edge
   std::vector<std::vector<std::pair<double, int>>> fixed_;  ///< (parameter, node) per edge
   std::vector<std::vector<double>> edge_param_;
   std::vector<std::vector<int>> edge_node_;

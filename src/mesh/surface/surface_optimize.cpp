@@ -43,7 +43,8 @@ bool ccw(const MatX2d& P, int a, int b, int c) {
 /// surfaces that turn a lot within one triangle).
 bool faces_out(const MatX3d& X, const MatX3d& N, int a, int b, int c) {
   if (collapsed(X.row(a), X.row(b), X.row(c))) return true;  // no normal: judged in the parameters only
-  const Eigen::Vector3d n = (Eigen::Vector3d(X.row(b)) - Eigen::Vector3d(X.row(a))).cross(Eigen::Vector3d(X.row(c)) - Eigen::Vector3d(X.row(a)));
+  const Eigen::Vector3d n = (Eigen::Vector3d(X.row(b)) - Eigen::Vector3d(X.row(a)))
+                                .cross(Eigen::Vector3d(X.row(c)) - Eigen::Vector3d(X.row(a)));
   const Eigen::Vector3d s = Eigen::Vector3d(N.row(a)) + Eigen::Vector3d(N.row(b)) + Eigen::Vector3d(N.row(c));
   return n.dot(s) > 0.5 * n.norm() * s.norm();
 }
@@ -112,9 +113,12 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     Eigen::Vector3d u, v;
   };
   auto save = [&](long i) { return NodeState{P.row(i), X.row(i), N.row(i), Xu[i], Xv[i]}; };
-  auto restore = [&](long i, const NodeState& s) { P.row(i) = s.p, X.row(i) = s.x, N.row(i) = s.n, Xu[i] = s.u, Xv[i] = s.v; };
+  auto restore = [&](long i, const NodeState& s) {
+    P.row(i) = s.p, X.row(i) = s.x, N.row(i) = s.n, Xu[i] = s.u, Xv[i] = s.v;
+  };
   st.min_angle_before = 180;
-  for (long t = 0; t < nt; ++t) st.min_angle_before = std::min(st.min_angle_before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+  for (long t = 0; t < nt; ++t)
+    st.min_angle_before = std::min(st.min_angle_before, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
   std::unordered_set<uint64_t> locked;
   for (const auto& e : constrained) locked.insert(ekey(e[0], e[1]));
 
@@ -360,7 +364,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       std::sort(order, order + 3, [&](int p, int q) { return l[p] < l[q]; });
       const int k = order[0];
       // the triangle's shortest edge, if clearly shorter than the other two
-      if (l[k] <= 0.7 * std::min(l[(k + 1) % 3], l[(k + 2) % 3]) && try_collapse(T(t0, k), T(t0, (k + 1) % 3))) continue;
+      if (l[k] <= 0.7 * std::min(l[(k + 1) % 3], l[(k + 2) % 3]) && try_collapse(T(t0, k), T(t0, (k + 1) % 3)))
+        continue;
       if (min_angle(X, T(t0, 0), T(t0, 1), T(t0, 2)) >= kBadAngle) continue;
       bool gone = false;
       for (int e = 0; e < 3 && !gone; ++e) gone = try_collapse(T(t0, order[e]), T(t0, (order[e] + 1) % 3));
@@ -420,7 +425,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
   auto split_sweep = [&]() {
     std::vector<int> cand;
     for (int t = 0; t < nt; ++t)
-      if (keep_node[T(t, 0)] && keep_node[T(t, 1)] && keep_node[T(t, 2)] && min_angle(X, T(t, 0), T(t, 1), T(t, 2)) < 40)
+      if (keep_node[T(t, 0)] && keep_node[T(t, 1)] && keep_node[T(t, 2)] &&
+          min_angle(X, T(t, 0), T(t, 1), T(t, 2)) < 40)
         cand.push_back(t);
     if (cand.empty()) return 0L;
     std::unordered_map<uint64_t, std::array<int, 2>> edge_tris;
@@ -451,7 +457,10 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
       int d = -1, holds = 0;
       for (int j = 0; j < 3; ++j) {
         const int v = T(t1, j);
-        if (v == a || v == b) ++holds; else d = v;
+        if (v == a || v == b)
+          ++holds;
+        else
+          d = v;
       }
       if (holds != 2 || d < 0) continue;
       const double before = std::min(min_angle(X, a, b, c), min_angle(X, b, a, d));
@@ -495,7 +504,8 @@ SurfaceOptimizeStats optimize_on_surface(MatX2d& P, MatX3i& T, MatX3d& X, int fi
     st.flips += flip_sweep();
   }
   st.min_angle_after = 180;
-  for (long t = 0; t < nt; ++t) st.min_angle_after = std::min(st.min_angle_after, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
+  for (long t = 0; t < nt; ++t)
+    st.min_angle_after = std::min(st.min_angle_after, min_angle(X, T(t, 0), T(t, 1), T(t, 2)));
   return st;
 }
 

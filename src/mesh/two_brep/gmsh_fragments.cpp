@@ -58,10 +58,11 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
   double volume = std::abs(model.part.solid_volume.sum());
   double estimate = 6.0 * volume / (h * h * h) * 1.2;  // ~6 tets per h³ cube for a good mesh
   if (estimate > params.max_tets)
-    throw Error(ErrorCode::TooLarge, "a mesh size of " + std::to_string(h) + " mm would give about " +
-                                         std::to_string(static_cast<long>(estimate)) +
-                                         " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
-                                         std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
+    throw Error(ErrorCode::TooLarge,
+                "a mesh size of " + std::to_string(h) + " mm would give about " +
+                    std::to_string(static_cast<long>(estimate)) +
+                    " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
+                    std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
   progress.say("mesh", 0, "meshing with size " + std::to_string(h) + " mm (Gmsh fragments)");
   std::lock_guard<std::mutex> lock(gmsh_mutex());
   GmshSession session;
@@ -83,8 +84,9 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
       for (size_t i = 0; i < nd.size(); ++i) {
         const auto& m = out_map[part.size() + i];
         if (m.size() != 1 || m[0].first != 3)
-          throw Error(ErrorCode::MeshingFailed, "non-design solid " + std::to_string(i + 1) +
-                                                    " did not fragment into one volume; check that it lies inside the part");
+          throw Error(ErrorCode::MeshingFailed,
+                      "non-design solid " + std::to_string(i + 1) +
+                          " did not fragment into one volume; check that it lies inside the part");
         nd_volume.push_back(m[0].second);
       }
     }
@@ -95,7 +97,9 @@ TetMesh mesh_with_gmsh_fragments(const brep::TwoBReps& model, const FragmentMesh
       if (std::find(nd_volume.begin(), nd_volume.end(), t) == nd_volume.end()) design.insert(t);
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
     gmsh::option::setNumber("Mesh.MeshSizeMin", hmin);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 40);  // elements per 2π: the faceting error of a bore (≈ (2π/N)²/6 of a ring's volume) stays under 0.5 %
+    gmsh::option::setNumber(
+        "Mesh.MeshSizeFromCurvature",
+        40);  // elements per 2π: the faceting error of a bore (≈ (2π/N)²/6 of a ring's volume) stays under 0.5 %
     gmsh::option::setNumber("Mesh.Optimize", 1);
     gmsh::model::mesh::generate(params.native_volume ? 2 : 3);
   } catch (const Error&) {

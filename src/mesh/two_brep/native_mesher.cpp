@@ -5,20 +5,20 @@
 #include <BRepClass_FaceClassifier.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
-#include <chrono>
 #include <array>
+#include <chrono>
 #include <map>
-#include <set>
-#include <string>
 #include <memory>
+#include <set>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "common/error.h"
 #include "common/parallel.h"
-#include "mesh/volume/background_size.h"
 #include "mesh/core/conformity.h"
 #include "mesh/two_brep/gmsh_fragments.h"
+#include "mesh/volume/background_size.h"
 
 namespace topopt::mesh {
 namespace {
@@ -33,13 +33,17 @@ struct Steps {
   ModelSurface part, nd;  // Ω and Ω̄
   std::vector<std::array<int, 4>> tets;
   std::vector<int> domain;
-  MatX4i tets_in_part;  // step 13: Ω̄'s tets as tets already present in Ω
+  MatX4i tets_in_part;                           // step 13: Ω̄'s tets as tets already present in Ω
   std::map<std::array<int, 3>, int> nd_face_of;  // Ω triangle (sorted nodes) -> Ω̄ face (1-based)
   double tol;
   std::shared_ptr<BackgroundSize> background;
 
   Steps(const brep::TwoBReps& model, const NativeMeshParams& p, const SurfaceMeshParams& sp, const Progress& prog)
-      : in(model), params(p), progress(prog), part(model.part, nodes, sp), nd(model.nondesign, nodes, sp),
+      : in(model),
+        params(p),
+        progress(prog),
+        part(model.part, nodes, sp),
+        nd(model.nondesign, nodes, sp),
         tol(1e-6 * model.part.diagonal()) {}
 };
 
@@ -96,7 +100,8 @@ void step6_transfer_edge_segments(Steps& s) {
     const int a = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 0));
     const int b = s.nd.vertex_node(s.in.nondesign.edge_vertices(e, 1));
     const int ia = static_cast<int>(std::find(ids.begin(), ids.end(), a) - ids.begin());
-    const double t_start = BRepAdaptor_Curve(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD))).FirstParameter();
+    const double t_start =
+        BRepAdaptor_Curve(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD))).FirstParameter();
     std::vector<int> best;
     double best_score = 1e300;
     for (int dir : {1, -1}) {
@@ -152,7 +157,8 @@ void step7_mesh_nondesign_edges(Steps& s) {
       const double tq = s.nd.edge_parameter(e1, q.data(), &d);
       if (d > 1e-3 * s.part.size() + s.tol) continue;
       BRepAdaptor_Curve c1(TopoDS::Edge(t.edges(e1 + 1).Oriented(TopAbs_FORWARD)));
-      const bool reversed = a1 != b1 ? a1 != a2 : (tq - c1.FirstParameter()) > 0.5 * (c1.LastParameter() - c1.FirstParameter());
+      const bool reversed =
+          a1 != b1 ? a1 != a2 : (tq - c1.FirstParameter()) > 0.5 * (c1.LastParameter() - c1.FirstParameter());
       s.nd.alias_edge(e2, e1, reversed);
       break;
     }
@@ -261,8 +267,9 @@ void step11_mesh_nondesign_faces(Steps& s) {
     for (const auto& [fa, fb] : c.faces) s.nd.alias_face(fb, fa, true);
   s.nd.mesh_faces(s.progress);
   if (!s.nd.failed_faces().empty())
-    throw Error(ErrorCode::MeshingFailed, "the surface mesher could not mesh" +
-                                              face_list(s.nd.failed_faces(), s.nd.failure_reasons(), "non-design solids"));
+    throw Error(ErrorCode::MeshingFailed,
+                "the surface mesher could not mesh" +
+                    face_list(s.nd.failed_faces(), s.nd.failure_reasons(), "non-design solids"));
   for (int i = 0; i < s.in.nondesign.num_solids(); ++i)
     if (const long open = open_edges(rows_of(s.nd.solid_triangles(i)))) {
       std::ostringstream m;
@@ -274,8 +281,8 @@ void step11_mesh_nondesign_faces(Steps& s) {
 
 /// One fill by the 3D front of the region bounded by `boundary` (around the tets T0) on the
 /// nodes V; a front that cannot close is reported with `what` in front of its message.
-VolumeFillResult fill(const Steps& s, const MatX3d& V, const std::vector<std::array<int, 3>>& boundary, const MatX4i& T0,
-                      const std::string& what, const Progress& progress) {
+VolumeFillResult fill(const Steps& s, const MatX3d& V, const std::vector<std::array<int, 3>>& boundary,
+                      const MatX4i& T0, const std::string& what, const Progress& progress) {
   VolumeFillParams vp = s.params.volume;
   if (!vp.size) {
     auto bg = s.background;
@@ -354,10 +361,11 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
     const double h = sp.size, volume = std::abs(model.part.solid_volume.sum());
     const double estimate = 6.0 * volume / (h * h * h) * 1.2;  // ~6 tets per h³ for a good mesh
     if (estimate > params.max_tets)
-      throw Error(ErrorCode::TooLarge, "a mesh size of " + std::to_string(h) + " mm would give about " +
-                                           std::to_string(static_cast<long>(estimate)) +
-                                           " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
-                                           std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
+      throw Error(ErrorCode::TooLarge,
+                  "a mesh size of " + std::to_string(h) + " mm would give about " +
+                      std::to_string(static_cast<long>(estimate)) +
+                      " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
+                      std::to_string(h * std::cbrt(estimate / params.max_tets)) + " mm");
   }
   NativeMeshParams bounded = params;
   bounded.volume.max_tets = static_cast<long>(std::min<double>(params.volume.max_tets, 2 * params.max_tets));
@@ -388,7 +396,8 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
     // and the middle of thin walls when wall_layers asks for layers across them
     std::vector<std::array<double, 4>> walls = s.part.wall_points();
     walls.insert(walls.end(), s.nd.wall_points().begin(), s.nd.wall_points().end());
-    s.background = std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1, walls);
+    s.background =
+        std::make_shared<BackgroundSize>(pool_matrix(s.nodes), rows_of(all), sp.size, sp.gradation - 1, walls);
   }
   step12_fill_nondesign(s);
   lap("step 12: non-design volumes");
@@ -465,7 +474,8 @@ TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, d
       reason = e.what();
     }
     if (run) run->fallback_reason = reason;
-    progress.warn("the native mesher could not mesh this part (" + reason + "); meshing with Gmsh's OCC fragments instead");
+    progress.warn("the native mesher could not mesh this part (" + reason +
+                  "); meshing with Gmsh's OCC fragments instead");
   }
   FragmentMeshParams mp;
   mp.size = size;
@@ -474,7 +484,8 @@ TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, d
   TetMesh m = mesh_with_gmsh_fragments(model, mp, progress);
   if (run) {
     run->mesher = "gmsh";
-    run->seconds = {{"gmsh fragments, surface and volume", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
+    run->seconds = {{"gmsh fragments, surface and volume",
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
   }
   return m;
 }

@@ -30,9 +30,9 @@ struct NativeMeshParams {
 
 /// What a run did: the mesher that made the mesh and the seconds of each stage.
 struct MeshRun {
-  std::string mesher;  ///< "native" or "gmsh"
+  std::string mesher;                                   ///< "native" or "gmsh"
   std::vector<std::pair<std::string, double>> seconds;  ///< (stage, seconds) in order
-  std::string fallback_reason;  ///< why "auto" fell back to Gmsh, if it did
+  std::string fallback_reason;                          ///< why "auto" fell back to Gmsh, if it did
 };
 
 /// The 14 steps: one conformal tet mesh of Ω, every tet tagged 0 (design, Ω − Ω̄) or i (the

@@ -37,14 +37,17 @@ BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, doubl
     const bool node = i < V.rows();
     const double s = node ? spacing[i] : seeds[i - V.rows()][3];
     if (s <= 0) continue;
-    const Eigen::Vector3d x = node ? Eigen::Vector3d(V.row(i).transpose())
-                                   : Eigen::Vector3d(seeds[i - V.rows()][0], seeds[i - V.rows()][1], seeds[i - V.rows()][2]);
+    const Eigen::Vector3d x =
+        node ? Eigen::Vector3d(V.row(i).transpose())
+             : Eigen::Vector3d(seeds[i - V.rows()][0], seeds[i - V.rows()][1], seeds[i - V.rows()][2]);
     long c[3];
-    for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<long>(std::floor((x[d] - lo_[d]) / cell_ - 0.5)), 0L, n_[d] - 1);
+    for (int d = 0; d < 3; ++d)
+      c[d] = std::clamp(static_cast<long>(std::floor((x[d] - lo_[d]) / cell_ - 0.5)), 0L, n_[d] - 1);
     for (long di = 0; di < 2; ++di)
       for (long dj = 0; dj < 2; ++dj)
         for (long dk = 0; dk < 2; ++dk) {
-          const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
+          const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1),
+                     ck = std::min(c[2] + dk, n_[2] - 1);
           const Eigen::Vector3d centre = lo_ + cell_ * Eigen::Vector3d(ci + 0.5, cj + 0.5, ck + 0.5);
           float& v = size_[(ci * n_[1] + cj) * n_[2] + ck];
           v = std::min(v, static_cast<float>(s + g * (centre - x).norm()));
@@ -76,8 +79,10 @@ double BackgroundSize::at(const double* x) const {
   for (int di = 0; di < 2; ++di)
     for (int dj = 0; dj < 2; ++dj)
       for (int dk = 0; dk < 2; ++dk) {
-        const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1), ck = std::min(c[2] + dk, n_[2] - 1);
-        s += (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]) * size_[(ci * n_[1] + cj) * n_[2] + ck];
+        const long ci = std::min(c[0] + di, n_[0] - 1), cj = std::min(c[1] + dj, n_[1] - 1),
+                   ck = std::min(c[2] + dk, n_[2] - 1);
+        s += (di ? w[0] : 1 - w[0]) * (dj ? w[1] : 1 - w[1]) * (dk ? w[2] : 1 - w[2]) *
+             size_[(ci * n_[1] + cj) * n_[2] + ck];
       }
   return s;
 }
@@ -96,7 +101,8 @@ double expected_tets(const MatX3d& V, const MatX3i& F, const std::function<doubl
   const double ox = 0.5 + 0.00731, oy = 0.5 + 0.00419;
   std::vector<std::vector<double>> crossings(nx * ny);
   for (long t = 0; t < F.rows(); ++t) {
-    const Eigen::Vector3d a = V.row(F(t, 0)).transpose(), b = V.row(F(t, 1)).transpose(), c = V.row(F(t, 2)).transpose();
+    const Eigen::Vector3d a = V.row(F(t, 0)).transpose(), b = V.row(F(t, 1)).transpose(),
+                          c = V.row(F(t, 2)).transpose();
     const double det = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
     if (det == 0) continue;  // vertical: no crossing with a vertical line in general position
     const double xlo = std::min({a.x(), b.x(), c.x()}), xhi = std::max({a.x(), b.x(), c.x()});

@@ -138,7 +138,8 @@ class Tets {
       edges_.push_back({std::min(a, c), std::max(a, c), n, 2});
       if (created) created->push_back(n);
     }
-    std::sort(edges_.begin(), edges_.end(), [](const Edge& l, const Edge& r) { return l.u != r.u ? l.u < r.u : l.w < r.w; });
+    std::sort(edges_.begin(), edges_.end(),
+              [](const Edge& l, const Edge& r) { return l.u != r.u ? l.u < r.u : l.w < r.w; });
     for (size_t k = 0; k + 1 < edges_.size(); k += 2) {
       nb[edges_[k].t][edges_[k].face] = edges_[k + 1].t;
       nb[edges_[k + 1].t][edges_[k + 1].face] = edges_[k].t;
@@ -237,7 +238,8 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
   const Vec3 mid = (lo + hi) / 2;
   const double D = std::max((hi - lo).maxCoeff(), 1e-12);
   const int far0 = static_cast<int>(P.size());
-  for (const Vec3& s : {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)}) P.push_back(mid + 20 * D * s);
+  for (const Vec3& s : {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)})
+    P.push_back(mid + 20 * D * s);
   hs.resize(P.size(), 20 * D);
   Tets m(P);
   if (orient3d(P[far0].data(), P[far0 + 1].data(), P[far0 + 2].data(), P[far0 + 3].data()) > 0)

@@ -23,7 +23,7 @@ struct DelaunayBulkParams {
   /// A tet is refined while its circumradius exceeds this × the size (the regular tet of edge
   /// h has 0.61 h; 0.95 gives about as many tets as Gmsh and the front at the same size).
   double refine_above = 0.95;
-  long max_tets = 20'000'000;   ///< stop refining beyond (the caller checks memory)
+  long max_tets = 20'000'000;  ///< stop refining beyond (the caller checks memory)
   /// Give up before refining (no tets, P as it was) when more than this share of the boundary
   /// triangles is missing from the tetrahedralisation.
   double max_missing_share = 1.0;
@@ -31,10 +31,11 @@ struct DelaunayBulkParams {
 
 struct DelaunayBulkResult {
   std::vector<std::array<int, 4>> tets;  ///< positively oriented, inside the boundary
-  std::vector<std::array<int, 3>> free_faces;  ///< faces of one tet only, turned out of it: boundary triangles and the holes' faces
-  long missing_triangles = 0;            ///< boundary triangles the tetrahedralisation lacked
-  long points = 0;                       ///< points inserted inside
-  bool gave_up = false;                  ///< over max_missing_share missing: no tets, P as it was
+  std::vector<std::array<int, 3>>
+      free_faces;              ///< faces of one tet only, turned out of it: boundary triangles and the holes' faces
+  long missing_triangles = 0;  ///< boundary triangles the tetrahedralisation lacked
+  long points = 0;             ///< points inserted inside
+  bool gave_up = false;        ///< over max_missing_share missing: no tets, P as it was
 };
 
 /// Tets for the region bounded by B (triangles on nodes P, oriented with normals OUT of the

@@ -12,10 +12,10 @@
 
 #include "common/error.h"
 #include "common/face_key.h"
-#include "mesh/volume/background_size.h"
-#include "mesh/volume/delaunay_bulk.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/tet_quality.h"
+#include "mesh/volume/background_size.h"
+#include "mesh/volume/delaunay_bulk.h"
 
 namespace topopt::mesh {
 namespace {
@@ -45,7 +45,8 @@ class Grid {
     const double ext = std::max(size, (hi - lo).maxCoeff());
     int k = 0;
     while (k < 48 && base_ * std::ldexp(1.0, k) < ext) ++k;
-    while (static_cast<int>(levels_.size()) <= k) levels_.emplace_back(1.0 / (base_ * std::ldexp(1.0, static_cast<int>(levels_.size()))));
+    while (static_cast<int>(levels_.size()) <= k)
+      levels_.emplace_back(1.0 / (base_ * std::ldexp(1.0, static_cast<int>(levels_.size()))));
     Level& L = levels_[k];
     const auto a = L.cell(lo, origin_), b = L.cell(hi, origin_);
     for (long x = a[0]; x <= b[0]; ++x)
@@ -118,7 +119,8 @@ class Grid {
   /// may share a bucket, which only costs time (callers test the geometry).
   static uint64_t key(long x, long y, long z) {
     const uint64_t m = (1ull << 21) - 1;
-    return ((static_cast<uint64_t>(x) & m) << 42) | ((static_cast<uint64_t>(y) & m) << 21) | (static_cast<uint64_t>(z) & m);
+    return ((static_cast<uint64_t>(x) & m) << 42) | ((static_cast<uint64_t>(y) & m) << 21) |
+           (static_cast<uint64_t>(z) & m);
   }
   Vec3 origin_;
   double base_;
@@ -153,14 +155,17 @@ bool segment_meets_triangle(const std::vector<Vec3>& P, int u, int v, int x, int
     auto U = q(u), Vv = q(v), X = q(x), Y = q(y), Z = q(z);
     int o = predicates::orient2d(X.data(), Y.data(), Z.data());
     auto inside = [&](const std::array<double, 2>& p) {
-      int a = predicates::orient2d(X.data(), Y.data(), p.data()) * o, b = predicates::orient2d(Y.data(), Z.data(), p.data()) * o,
+      int a = predicates::orient2d(X.data(), Y.data(), p.data()) * o,
+          b = predicates::orient2d(Y.data(), Z.data(), p.data()) * o,
           c = predicates::orient2d(Z.data(), X.data(), p.data()) * o;
       return a > 0 && b > 0 && c > 0;
     };
     auto crosses = [&](const std::array<double, 2>& a, const std::array<double, 2>& b, const std::array<double, 2>& c,
                        const std::array<double, 2>& d) {  // proper crossing of ab and cd
-      int s1 = predicates::orient2d(a.data(), b.data(), c.data()), s2 = predicates::orient2d(a.data(), b.data(), d.data());
-      int s3 = predicates::orient2d(c.data(), d.data(), a.data()), s4 = predicates::orient2d(c.data(), d.data(), b.data());
+      int s1 = predicates::orient2d(a.data(), b.data(), c.data()),
+          s2 = predicates::orient2d(a.data(), b.data(), d.data());
+      int s3 = predicates::orient2d(c.data(), d.data(), a.data()),
+          s4 = predicates::orient2d(c.data(), d.data(), b.data());
       return s1 * s2 < 0 && s3 * s4 < 0;
     };
     if ((!u_shared && inside(U)) || (!v_shared && inside(Vv))) return true;
@@ -180,7 +185,8 @@ bool segment_meets_triangle(const std::vector<Vec3>& P, int u, int v, int x, int
 
 class Front {
  public:
-  Front(std::vector<Vec3>& P, double cell, const Vec3& origin) : P_(P), faces_grid_(origin, cell), nodes_grid_(origin, cell) {}
+  Front(std::vector<Vec3>& P, double cell, const Vec3& origin)
+      : P_(P), faces_grid_(origin, cell), nodes_grid_(origin, cell) {}
 
   int add_face(int a, int b, int c) {
     TriKey k = key_of(a, b, c);
@@ -218,14 +224,16 @@ class Front {
   void faces_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) {
     out.clear();
     if (face_stamp_.size() < faces_.size()) face_stamp_.resize(faces_.size() + faces_.size() / 2 + 16, 0);
-    faces_grid_.query(lo, hi, out, [&](int f) { return alive_[f] != 0; }, face_stamp_, ++face_ticket_);
+    faces_grid_.query(
+        lo, hi, out, [&](int f) { return alive_[f] != 0; }, face_stamp_, ++face_ticket_);
   }
   /// Active front nodes in the box. A node that left the front may come back (a removed
   /// tet), so nodes stay in the grid and are filtered here, not dropped.
   void nodes_near(const Vec3& lo, const Vec3& hi, std::vector<int>& out) {
     out.clear();
     if (node_stamp_.size() < P_.size()) node_stamp_.resize(P_.size() + P_.size() / 2 + 16, 0);
-    nodes_grid_.query(lo, hi, out, [&](int v) { return in_grid_keep(v); }, node_stamp_, ++node_ticket_);
+    nodes_grid_.query(
+        lo, hi, out, [&](int v) { return in_grid_keep(v); }, node_stamp_, ++node_ticket_);
     out.erase(std::remove_if(out.begin(), out.end(), [&](int v) { return !active(v); }), out.end());
   }
   int any_alive() const {
@@ -251,7 +259,6 @@ class Front {
 };
 
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
-
 
 /// The tets around each node as one flat array (CSR): tets of node v are
 /// items[start[v] .. start[v + 1]). Removed tets (first index < 0) are left out.
@@ -356,8 +363,10 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
               int nxt = pairs[q][0] == ring.back() ? pairs[q][1] : (pairs[q][1] == ring.back() ? pairs[q][0] : -1);
               if (nxt < 0) continue;
               used[q] = 1, closed = true;
-              if (step < k - 1) ring.push_back(nxt);
-              else closed = nxt == ring.front();
+              if (step < k - 1)
+                ring.push_back(nxt);
+              else
+                closed = nxt == ring.front();
               break;
             }
           }
@@ -366,7 +375,8 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
           for (int x : ring) any |= locked[x] != 0;
           if (any) continue;
           // orient the ring so that (u, w, r_i, r_i+1) are the positive tets
-          if (orient3d(P[u].data(), P[w].data(), P[ring[0]].data(), P[ring[1]].data()) < 0) std::reverse(ring.begin(), ring.end());
+          if (orient3d(P[u].data(), P[w].data(), P[ring[0]].data(), P[ring[1]].data()) < 0)
+            std::reverse(ring.begin(), ring.end());
           double before = 1;
           for (int rt : ring_tets) before = std::min(before, rho(tets[rt]));
           std::vector<std::array<int, 4>> best, cand;
@@ -422,7 +432,8 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
         const int s3 = orient3d(P[d].data(), P[e].data(), P[c].data(), P[a].data());
         if (s1 == 0 || s1 != s2 || s2 != s3) continue;
         if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[d].data()) *
-                orient3d(P[a].data(), P[b].data(), P[c].data(), P[e].data()) >= 0)
+                orient3d(P[a].data(), P[b].data(), P[c].data(), P[e].data()) >=
+            0)
           continue;
         std::array<int, 4> n1{a, b, d, e}, n2{b, c, d, e}, n3{c, a, d, e};
         if (!positive(n1) || !positive(n2) || !positive(n3)) continue;
@@ -435,7 +446,8 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
         ++here, done = true;
       }
     }
-    tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& x) { return x[0] < 0; }), tets.end());
+    tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& x) { return x[0] < 0; }),
+               tets.end());
     flips += here;
     if (!here) break;
   }
@@ -455,8 +467,10 @@ double compass_maximise(Vec3& x, double step, int iterations, F&& f) {
       const Vec3 old = x;
       x[d / 2] += (d % 2 ? -step : step);
       const double now = f();
-      if (now > best) best = now, moved = true;
-      else x = old;
+      if (now > best)
+        best = now, moved = true;
+      else
+        x = old;
     }
     if (!moved) step *= 0.5;
   }
@@ -670,9 +684,8 @@ constexpr double kMaxMissingShare = 0.02;
 /// The fill itself (fill_volume below retries without the bulk when this fails with it).
 /// `budget`: the front stops with a named error past this many tets (a front whose faces keep
 /// shrinking instead of closing), 0 for none.
-VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params,
-                      long budget, const Progress& progress) {
-
+VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params, long budget,
+                      const Progress& progress) {
   std::vector<Vec3> P(V.rows());
   for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
   if (F.rows() == 0) throw Error(ErrorCode::MeshingFailed, "nothing to fill: the boundary has no triangles");
@@ -725,9 +738,9 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
       tets = std::move(bulk.tets);
       bulk_free = std::move(bulk.free_faces);  // only these can meet the boundary or T0's faces
       for (const auto& f : bulk_free) covered[key_of(f[0], f[1], f[2])]++;
-      progress.info("volume: Delaunay bulk of " + std::to_string(tets.size()) + " tets (" + std::to_string(bulk.points) +
-                    " points); the front fills around " + std::to_string(bulk.missing_triangles) +
-                    " boundary triangles it did not hold");
+      progress.info("volume: Delaunay bulk of " + std::to_string(tets.size()) + " tets (" +
+                    std::to_string(bulk.points) + " points); the front fills around " +
+                    std::to_string(bulk.missing_triangles) + " boundary triangles it did not hold");
     }
   }
   // ---- the initial front: boundary triangles reversed (normals into the region), then the
@@ -766,7 +779,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
   auto valid = [&](int a, int b, int c, int p, double qmin, int self) {
     if (orient3d(P[a].data(), P[b].data(), P[c].data(), P[p].data()) <= 0) return false;
     if (tet_rho(P, a, b, c, p) < qmin) return false;
-    Vec3 tlo = P[a].cwiseMin(P[b]).cwiseMin(P[c]).cwiseMin(P[p]), thi = P[a].cwiseMax(P[b]).cwiseMax(P[c]).cwiseMax(P[p]);
+    Vec3 tlo = P[a].cwiseMin(P[b]).cwiseMin(P[c]).cwiseMin(P[p]),
+         thi = P[a].cwiseMax(P[b]).cwiseMax(P[c]).cwiseMax(P[p]);
     Vec3 pad = Vec3::Constant(1e-9 * (thi - tlo).norm());
     front.faces_near(tlo - pad, thi + pad, near_faces);
     // The edges ab, bc, ca are already part of the front and cross nothing: only the new
@@ -780,7 +794,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
       {
         bool apart = false;
         for (int k = 0; k < 3 && !apart; ++k) {
-          const double flo = std::min({P[t[0]][k], P[t[1]][k], P[t[2]][k]}), fhi = std::max({P[t[0]][k], P[t[1]][k], P[t[2]][k]});
+          const double flo = std::min({P[t[0]][k], P[t[1]][k], P[t[2]][k]}),
+                       fhi = std::max({P[t[0]][k], P[t[1]][k], P[t[2]][k]});
           apart = fhi < tlo[k] || flo > thi[k];
         }
         if (apart) continue;
@@ -813,8 +828,10 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
         if (x[0] < tlo[0] - pad[0] || x[0] > thi[0] + pad[0] || x[1] < tlo[1] - pad[1] || x[1] > thi[1] + pad[1] ||
             x[2] < tlo[2] - pad[2] || x[2] > thi[2] + pad[2])
           continue;
-        if (orient3d(P[a].data(), P[b].data(), P[c].data(), x) >= 0 && orient3d(P[a].data(), P[b].data(), x, P[p].data()) >= 0 &&
-            orient3d(P[b].data(), P[c].data(), x, P[p].data()) >= 0 && orient3d(P[c].data(), P[a].data(), x, P[p].data()) >= 0)
+        if (orient3d(P[a].data(), P[b].data(), P[c].data(), x) >= 0 &&
+            orient3d(P[a].data(), P[b].data(), x, P[p].data()) >= 0 &&
+            orient3d(P[b].data(), P[c].data(), x, P[p].data()) >= 0 &&
+            orient3d(P[c].data(), P[a].data(), x, P[p].data()) >= 0)
           return false;  // a front node inside (or on) the new tet
       }
     }
@@ -847,8 +864,7 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
               if (!in_region[x]) in_region[x] = 1, region.push_back(x);
       }
       std::vector<int> doomed;
-      for (int v : region)
-        doomed.insert(doomed.end(), stars.begin(v), stars.end(v));
+      for (int v : region) doomed.insert(doomed.end(), stars.begin(v), stars.end(v));
       std::sort(doomed.begin(), doomed.end());
       doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
       for (int t : doomed) {
@@ -856,7 +872,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
         for (const auto& o : kFace) front.add_face(tv[o[0]], tv[o[2]], tv[o[1]]);
         tets[t][0] = -1;
       }
-      progress.info("advancing front: re-meshing around a stuck region (" + std::to_string(doomed.size()) + " tets removed)");
+      progress.info("advancing front: re-meshing around a stuck region (" + std::to_string(doomed.size()) +
+                    " tets removed)");
       for (size_t id = 0; id < front.capacity(); ++id)
         if (front.alive(static_cast<int>(id))) queue.push({face_size(static_cast<int>(id)), static_cast<int>(id)});
     }
@@ -909,7 +926,8 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
         }
         constexpr size_t kMaxNodeCandidates = 40;
         if (near_by_distance.size() > kMaxNodeCandidates) {
-          std::nth_element(near_by_distance.begin(), near_by_distance.begin() + kMaxNodeCandidates, near_by_distance.end());
+          std::nth_element(near_by_distance.begin(), near_by_distance.begin() + kMaxNodeCandidates,
+                           near_by_distance.end());
           near_by_distance.resize(kMaxNodeCandidates);
         }
         for (const auto& [d, q] : near_by_distance) {
@@ -996,185 +1014,187 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
           }
         const size_t first_piece_face = front.capacity();
         for (int grow = 0; grow < 4; ++grow) {
-        if (grow > 0) {
-          // no point saw the whole cavity: it takes in the new tets behind its faces (a
-          // twisted prism between the two sides of a thin wall has no such point; the larger
-          // cavity usually has), then the front faces around its nodes are its faces again
-          std::unordered_map<TriKey, int, TriKeyHash> owner;
-          for (size_t t = 0; t < tets.size(); ++t)
-            if (tets[t][0] >= 0)
-              for (const auto& o : kFace) owner[key_of(tets[t][o[0]], tets[t][o[1]], tets[t][o[2]])] = static_cast<int>(t);
-          int absorbed = 0;
-          for (int f : cf) {
-            if (!front.alive(f)) continue;
-            const Tri& t = front.face(f);
-            auto it = owner.find(key_of(t[0], t[1], t[2]));
-            if (it == owner.end() || tets[it->second][0] < 0) continue;
-            const auto tv = tets[it->second];
-            for (const auto& o : kFace) front.add_face(tv[o[0]], tv[o[2]], tv[o[1]]);
-            tets[it->second][0] = -1;
-            ++absorbed;
-          }
-          if (!absorbed) break;
-          std::vector<char> near(P.size(), 0);
-          for (int v : cn) near[v] = 1;
-          for (bool more = true; more;) {  // close under shared nodes
-            more = false;
+          if (grow > 0) {
+            // no point saw the whole cavity: it takes in the new tets behind its faces (a
+            // twisted prism between the two sides of a thin wall has no such point; the larger
+            // cavity usually has), then the front faces around its nodes are its faces again
+            std::unordered_map<TriKey, int, TriKeyHash> owner;
+            for (size_t t = 0; t < tets.size(); ++t)
+              if (tets[t][0] >= 0)
+                for (const auto& o : kFace)
+                  owner[key_of(tets[t][o[0]], tets[t][o[1]], tets[t][o[2]])] = static_cast<int>(t);
+            int absorbed = 0;
+            for (int f : cf) {
+              if (!front.alive(f)) continue;
+              const Tri& t = front.face(f);
+              auto it = owner.find(key_of(t[0], t[1], t[2]));
+              if (it == owner.end() || tets[it->second][0] < 0) continue;
+              const auto tv = tets[it->second];
+              for (const auto& o : kFace) front.add_face(tv[o[0]], tv[o[2]], tv[o[1]]);
+              tets[it->second][0] = -1;
+              ++absorbed;
+            }
+            if (!absorbed) break;
+            std::vector<char> near(P.size(), 0);
+            for (int v : cn) near[v] = 1;
+            for (bool more = true; more;) {  // close under shared nodes
+              more = false;
+              for (size_t id = 0; id < front.capacity(); ++id) {
+                if (!front.alive(static_cast<int>(id))) continue;
+                const Tri& t = front.face(static_cast<int>(id));
+                if (!(near[t[0]] || near[t[1]] || near[t[2]])) continue;
+                for (int v : t)
+                  if (!near[v]) near[v] = 1, more = true;
+              }
+            }
+            cf.clear(), cn.clear();
             for (size_t id = 0; id < front.capacity(); ++id) {
               if (!front.alive(static_cast<int>(id))) continue;
               const Tri& t = front.face(static_cast<int>(id));
-              if (!(near[t[0]] || near[t[1]] || near[t[2]])) continue;
-              for (int v : t)
-                if (!near[v]) near[v] = 1, more = true;
+              if (near[t[0]] || near[t[1]] || near[t[2]]) {
+                cf.push_back(static_cast<int>(id));
+                for (int v : t) cn.push_back(v);
+              }
             }
+            if (cf.empty()) break;
           }
-          cf.clear(), cn.clear();
-          for (size_t id = 0; id < front.capacity(); ++id) {
-            if (!front.alive(static_cast<int>(id))) continue;
-            const Tri& t = front.face(static_cast<int>(id));
-            if (near[t[0]] || near[t[1]] || near[t[2]]) {
-              cf.push_back(static_cast<int>(id));
-              for (int v : t) cn.push_back(v);
+          std::sort(cn.begin(), cn.end());
+          cn.erase(std::unique(cn.begin(), cn.end()), cn.end());
+          auto sees_all = [&](int apex) {
+            for (int f : cf) {
+              const Tri& t = front.face(f);
+              if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
+              if (orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[apex].data()) <= 0) return false;
             }
-          }
-          if (cf.empty()) break;
-        }
-        std::sort(cn.begin(), cn.end());
-        cn.erase(std::unique(cn.begin(), cn.end()), cn.end());
-        auto sees_all = [&](int apex) {
-          for (int f : cf) {
-            const Tri& t = front.face(f);
-            if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
-            if (orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[apex].data()) <= 0) return false;
-          }
-          return true;
-        };
-        // the apex: among the cavity's nodes, its centroid and points spread over its box, the
-        // one that sees every face with the best worst tet
-        auto worst_quality = [&](int apex) {
-          double w = 1;
-          for (int f : cf) {
-            const Tri& t = front.face(f);
-            if (t[0] != apex && t[1] != apex && t[2] != apex) w = std::min(w, tet_rho(P, t[0], t[1], t[2], apex));
-          }
-          return w;
-        };
-        int apex = -1;
-        double best = -1;
-        for (int v : cn)
-          if (sees_all(v) && worst_quality(v) > best) best = worst_quality(v), apex = v;
-        Vec3 clo = P[cn[0]], chi = P[cn[0]], centre = Vec3::Zero();
-        for (int v : cn) clo = clo.cwiseMin(P[v]), chi = chi.cwiseMax(P[v]), centre += P[v];
-        centre /= cn.size();
-        Vec3 best_point;
-        unsigned seed = 12345;
-        for (int trial = 0; trial < 400; ++trial) {
-          Vec3 x = centre;
-          if (trial > 0)
-            for (int d = 0; d < 3; ++d) {
-              seed = seed * 1664525u + 1013904223u;
-              x[d] = clo[d] + (chi[d] - clo[d]) * ((seed >> 8) & 0xFFFF) / 65535.0;
+            return true;
+          };
+          // the apex: among the cavity's nodes, its centroid and points spread over its box, the
+          // one that sees every face with the best worst tet
+          auto worst_quality = [&](int apex) {
+            double w = 1;
+            for (int f : cf) {
+              const Tri& t = front.face(f);
+              if (t[0] != apex && t[1] != apex && t[2] != apex) w = std::min(w, tet_rho(P, t[0], t[1], t[2], apex));
             }
-          P.push_back(x);
-          int id = static_cast<int>(P.size()) - 1;
-          if (sees_all(id)) {
-            double w = worst_quality(id);
-            if (w > best) best = w, apex = -2, best_point = x;
-          }
-          P.pop_back();
-        }
-        if (apex == -2) {
-          P.push_back(best_point);
-          apex = static_cast<int>(P.size()) - 1;
-        }
-        if (apex < 0) {
-          progress.info("advancing front: no point sees all " + std::to_string(cf.size()) + " faces of a cavity");
-          if (grow < 3) continue;
-          // last: fill the cavity in pieces, each from the point (a cavity node, its centroid
-          // or a sample of its box) with which the most faces make valid tets, every tet
-          // checked against the whole front as in the advancing loop
-          for (int piece = 0; piece < 10; ++piece) {
-            std::vector<int> live;
-            for (int f : cf)
-              if (front.alive(f)) live.push_back(f);
-            // faces born in this cavity join it
-            for (size_t id = first_piece_face; id < front.capacity(); ++id)
-              if (front.alive(static_cast<int>(id))) live.push_back(static_cast<int>(id));
-            std::sort(live.begin(), live.end());
-            live.erase(std::unique(live.begin(), live.end()), live.end());
-            if (live.empty()) break;
-            std::vector<int> nodes;
-            Vec3 lo3 = P[front.face(live[0])[0]], hi3 = lo3, mid3 = Vec3::Zero();
-            for (int f : live)
-              for (int v : front.face(f)) nodes.push_back(v), lo3 = lo3.cwiseMin(P[v]), hi3 = hi3.cwiseMax(P[v]), mid3 += P[v];
-            mid3 /= static_cast<double>(3 * live.size());
-            std::sort(nodes.begin(), nodes.end());
-            nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-            std::vector<Vec3> trial{mid3};
-            unsigned sd = 777u + static_cast<unsigned>(piece);
-            for (int q = 0; q < 30; ++q) {
-              Vec3 x;
+            return w;
+          };
+          int apex = -1;
+          double best = -1;
+          for (int v : cn)
+            if (sees_all(v) && worst_quality(v) > best) best = worst_quality(v), apex = v;
+          Vec3 clo = P[cn[0]], chi = P[cn[0]], centre = Vec3::Zero();
+          for (int v : cn) clo = clo.cwiseMin(P[v]), chi = chi.cwiseMax(P[v]), centre += P[v];
+          centre /= cn.size();
+          Vec3 best_point;
+          unsigned seed = 12345;
+          for (int trial = 0; trial < 400; ++trial) {
+            Vec3 x = centre;
+            if (trial > 0)
               for (int d = 0; d < 3; ++d) {
-                sd = sd * 1664525u + 1013904223u;
-                x[d] = lo3[d] + (hi3[d] - lo3[d]) * ((sd >> 8) & 0xFFFF) / 65535.0;
+                seed = seed * 1664525u + 1013904223u;
+                x[d] = clo[d] + (chi[d] - clo[d]) * ((seed >> 8) & 0xFFFF) / 65535.0;
               }
-              trial.push_back(x);
+            P.push_back(x);
+            int id = static_cast<int>(P.size()) - 1;
+            if (sees_all(id)) {
+              double w = worst_quality(id);
+              if (w > best) best = w, apex = -2, best_point = x;
             }
-            int best_count = 0, best_node = -1;
-            Vec3 best_x;
-            auto count_valid = [&](int p) {
-              int c = 0;
+            P.pop_back();
+          }
+          if (apex == -2) {
+            P.push_back(best_point);
+            apex = static_cast<int>(P.size()) - 1;
+          }
+          if (apex < 0) {
+            progress.info("advancing front: no point sees all " + std::to_string(cf.size()) + " faces of a cavity");
+            if (grow < 3) continue;
+            // last: fill the cavity in pieces, each from the point (a cavity node, its centroid
+            // or a sample of its box) with which the most faces make valid tets, every tet
+            // checked against the whole front as in the advancing loop
+            for (int piece = 0; piece < 10; ++piece) {
+              std::vector<int> live;
+              for (int f : cf)
+                if (front.alive(f)) live.push_back(f);
+              // faces born in this cavity join it
+              for (size_t id = first_piece_face; id < front.capacity(); ++id)
+                if (front.alive(static_cast<int>(id))) live.push_back(static_cast<int>(id));
+              std::sort(live.begin(), live.end());
+              live.erase(std::unique(live.begin(), live.end()), live.end());
+              if (live.empty()) break;
+              std::vector<int> nodes;
+              Vec3 lo3 = P[front.face(live[0])[0]], hi3 = lo3, mid3 = Vec3::Zero();
+              for (int f : live)
+                for (int v : front.face(f))
+                  nodes.push_back(v), lo3 = lo3.cwiseMin(P[v]), hi3 = hi3.cwiseMax(P[v]), mid3 += P[v];
+              mid3 /= static_cast<double>(3 * live.size());
+              std::sort(nodes.begin(), nodes.end());
+              nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+              std::vector<Vec3> trial{mid3};
+              unsigned sd = 777u + static_cast<unsigned>(piece);
+              for (int q = 0; q < 30; ++q) {
+                Vec3 x;
+                for (int d = 0; d < 3; ++d) {
+                  sd = sd * 1664525u + 1013904223u;
+                  x[d] = lo3[d] + (hi3[d] - lo3[d]) * ((sd >> 8) & 0xFFFF) / 65535.0;
+                }
+                trial.push_back(x);
+              }
+              int best_count = 0, best_node = -1;
+              Vec3 best_x;
+              auto count_valid = [&](int p) {
+                int c = 0;
+                for (int f : live) {
+                  const Tri& t = front.face(f);
+                  if (t[0] != p && t[1] != p && t[2] != p && valid(t[0], t[1], t[2], p, 0.0, f)) ++c;
+                }
+                return c;
+              };
+              for (int v : nodes) {
+                const int c = count_valid(v);
+                if (c > best_count) best_count = c, best_node = v;
+              }
+              for (const Vec3& x : trial) {
+                P.push_back(x);
+                const int c = count_valid(static_cast<int>(P.size()) - 1);
+                P.pop_back();
+                if (c > best_count) best_count = c, best_node = -2, best_x = x;
+              }
+              if (best_count == 0) break;
+              int p = best_node;
+              if (p == -2) P.push_back(best_x), p = static_cast<int>(P.size()) - 1;
               for (int f : live) {
-                const Tri& t = front.face(f);
-                if (t[0] != p && t[1] != p && t[2] != p && valid(t[0], t[1], t[2], p, 0.0, f)) ++c;
+                if (!front.alive(f)) continue;
+                const Tri t = front.face(f);
+                if (t[0] == p || t[1] == p || t[2] == p || !valid(t[0], t[1], t[2], p, 0.0, f)) continue;
+                tets.push_back({t[0], t[1], t[2], p});
+                front.kill(f);
+                const int tv[4] = {t[0], t[1], t[2], p};
+                for (int kf = 0; kf < 3; ++kf) front.add_face(tv[kFace[kf][0]], tv[kFace[kf][1]], tv[kFace[kf][2]]);
               }
-              return c;
-            };
-            for (int v : nodes) {
-              const int c = count_valid(v);
-              if (c > best_count) best_count = c, best_node = v;
             }
-            for (const Vec3& x : trial) {
-              P.push_back(x);
-              const int c = count_valid(static_cast<int>(P.size()) - 1);
-              P.pop_back();
-              if (c > best_count) best_count = c, best_node = -2, best_x = x;
-            }
-            if (best_count == 0) break;
-            int p = best_node;
-            if (p == -2) P.push_back(best_x), p = static_cast<int>(P.size()) - 1;
-            for (int f : live) {
+            break;
+          }
+          // every tet checked against the whole front as it is made (the faces gathered for a
+          // grown cavity are not always one closed cavity); what is left goes to the next round
+          long made = 0;
+          for (bool more = true; more;) {
+            more = false;
+            for (int f : cf) {
               if (!front.alive(f)) continue;
               const Tri t = front.face(f);
-              if (t[0] == p || t[1] == p || t[2] == p || !valid(t[0], t[1], t[2], p, 0.0, f)) continue;
-              tets.push_back({t[0], t[1], t[2], p});
+              if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
+              if (!valid(t[0], t[1], t[2], apex, 0.0, f)) continue;
+              tets.push_back({t[0], t[1], t[2], apex});
               front.kill(f);
-              const int tv[4] = {t[0], t[1], t[2], p};
+              const int tv[4] = {t[0], t[1], t[2], apex};
               for (int kf = 0; kf < 3; ++kf) front.add_face(tv[kFace[kf][0]], tv[kFace[kf][1]], tv[kFace[kf][2]]);
+              ++made, more = true;
             }
           }
+          progress.info("advancing front: filled " + std::to_string(made) + " of a cavity's " +
+                        std::to_string(cf.size()) + " faces from one point");
           break;
-        }
-        // every tet checked against the whole front as it is made (the faces gathered for a
-        // grown cavity are not always one closed cavity); what is left goes to the next round
-        long made = 0;
-        for (bool more = true; more;) {
-          more = false;
-          for (int f : cf) {
-            if (!front.alive(f)) continue;
-            const Tri t = front.face(f);
-            if (t[0] == apex || t[1] == apex || t[2] == apex) continue;
-            if (!valid(t[0], t[1], t[2], apex, 0.0, f)) continue;
-            tets.push_back({t[0], t[1], t[2], apex});
-            front.kill(f);
-            const int tv[4] = {t[0], t[1], t[2], apex};
-            for (int kf = 0; kf < 3; ++kf) front.add_face(tv[kFace[kf][0]], tv[kFace[kf][1]], tv[kFace[kf][2]]);
-            ++made, more = true;
-          }
-        }
-        progress.info("advancing front: filled " + std::to_string(made) + " of a cavity's " + std::to_string(cf.size()) +
-                      " faces from one point");
-        break;
         }
       }
     }
@@ -1189,43 +1209,44 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     throw Error(ErrorCode::MeshingFailed, s.str());
   }
 
-  tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }), tets.end());
+  tets.erase(std::remove_if(tets.begin(), tets.end(), [](const std::array<int, 4>& t) { return t[0] < 0; }),
+             tets.end());
   // ---- quality: flips of the bad tets, then node smoothing, twice
   const int first_new = static_cast<int>(V.rows());
   for (int round = 0; round < params.quality_rounds; ++round) {
-  if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
-  // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
-  // worst radius ratio around the node and keeps every tet positive
-  if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
-    const NodeStars stars(P.size(), tets);
-    for (int it = 0; it < params.smoothing_iterations; ++it)
-      for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
-        const NodeStars::Range ts = stars.of(v);
-        Vec3 sum = Vec3::Zero();
-        int n = 0;
-        double worst = 1;
-        for (int t : ts) {
-          worst = std::min(worst, tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]));
-          for (int w : tets[t])
-            if (w != v) sum += P[w], ++n;
-        }
-        if (!n) continue;
-        Vec3 old = P[v];
-        P[v] = sum / n;
-        bool ok = true;
-        double now = 1;
-        for (int t : ts) {
-          const auto& q = tets[t];
-          if (orient3d(P[q[0]].data(), P[q[1]].data(), P[q[2]].data(), P[q[3]].data()) <= 0) {
-            ok = false;
-            break;
+    if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
+    // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
+    // worst radius ratio around the node and keeps every tet positive
+    if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
+      const NodeStars stars(P.size(), tets);
+      for (int it = 0; it < params.smoothing_iterations; ++it)
+        for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
+          const NodeStars::Range ts = stars.of(v);
+          Vec3 sum = Vec3::Zero();
+          int n = 0;
+          double worst = 1;
+          for (int t : ts) {
+            worst = std::min(worst, tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]));
+            for (int w : tets[t])
+              if (w != v) sum += P[w], ++n;
           }
-          now = std::min(now, tet_rho(P, q[0], q[1], q[2], q[3]));
+          if (!n) continue;
+          Vec3 old = P[v];
+          P[v] = sum / n;
+          bool ok = true;
+          double now = 1;
+          for (int t : ts) {
+            const auto& q = tets[t];
+            if (orient3d(P[q[0]].data(), P[q[1]].data(), P[q[2]].data(), P[q[3]].data()) <= 0) {
+              ok = false;
+              break;
+            }
+            now = std::min(now, tet_rho(P, q[0], q[1], q[2], q[3]));
+          }
+          if (!ok || now < worst) P[v] = old;
         }
-        if (!ok || now < worst) P[v] = old;
-      }
-    compass_search_at_bad_tets(P, tets, stars, first_new, params.sliver_below);
-  }
+      compass_search_at_bad_tets(P, tets, stars, first_new, params.sliver_below);
+    }
   }
   // ---- slivers the flips and moves left (e.g. with two faces on the boundary): re-filled
   // from a new point, then one more round of flips
@@ -1265,7 +1286,8 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     MatX3i faces(F.rows() + 4 * T0.rows(), 3);
     faces.topRows(F.rows()) = F;
     for (long t = 0; t < T0.rows(); ++t)
-      for (int k = 0; k < 4; ++k) faces.row(F.rows() + 4 * t + k) << T0(t, kFace[k][0]), T0(t, kFace[k][1]), T0(t, kFace[k][2]);
+      for (int k = 0; k < 4; ++k)
+        faces.row(F.rows() + 4 * t + k) << T0(t, kFace[k][0]), T0(t, kFace[k][1]), T0(t, kFace[k][2]);
     const std::vector<double> spacing = node_spacing(V, faces);
     const double h = *std::max_element(spacing.begin(), spacing.end());
     auto background = std::make_shared<BackgroundSize>(V, faces, h, kDefaultGrowth);

@@ -27,19 +27,20 @@ struct VolumeFillParams {
   /// Target edge length at a point; empty: graded from the boundary's (and T0's) edge lengths
   /// by 0.3 per unit distance up to the longest of them (BackgroundSize, background_size.h).
   std::function<double(const double*)> size;
-  double min_quality = 0.25;    ///< radius ratio a new tet must reach on the first pass
-  int passes = 4;               ///< widening passes over faces that failed
-  long max_tets = 20'000'000;   ///< refuse to go beyond (memory)
-  int smoothing_iterations = 1; ///< node smoothing sweeps per round (the worst tet at a node never drops)
-  double flip_below = 0.55;     ///< new tets below this radius ratio get edge removal and 2-3 flips (0: none)
-  int quality_rounds = 3;       ///< rounds of flips, smoothing and compass search
-  bool delaunay_bulk = true;    ///< fill the bulk by Delaunay refinement first (delaunay_bulk.h), the front the rest
-  double sliver_below = 0.4;    ///< new tets below this get a compass search on their nodes each round, then sliver removal by point insertion, worst first, up to 3 times (0: none)
+  double min_quality = 0.25;     ///< radius ratio a new tet must reach on the first pass
+  int passes = 4;                ///< widening passes over faces that failed
+  long max_tets = 20'000'000;    ///< refuse to go beyond (memory)
+  int smoothing_iterations = 1;  ///< node smoothing sweeps per round (the worst tet at a node never drops)
+  double flip_below = 0.55;      ///< new tets below this radius ratio get edge removal and 2-3 flips (0: none)
+  int quality_rounds = 3;        ///< rounds of flips, smoothing and compass search
+  bool delaunay_bulk = true;     ///< fill the bulk by Delaunay refinement first (delaunay_bulk.h), the front the rest
+  double sliver_below = 0.4;     ///< new tets below this get a compass search on their nodes each round, then sliver
+                                 ///< removal by point insertion, worst first, up to 3 times (0: none)
 };
 
 struct VolumeFillResult {
-  MatX3d V;   ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones the tets use
-  MatX4i T;   ///< #T' by 4: the new tets only, positively oriented
+  MatX3d V;  ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones the tets use
+  MatX4i T;  ///< #T' by 4: the new tets only, positively oriented
 };
 
 /// Fills the region bounded by F (#F by 3, oriented with normals pointing OUT of the region)

@@ -1,16 +1,16 @@
 // Tests of src/brep: reading, checking, indexing and classifying the two models.
 #include "brep/classify.h"
 
+#include <gtest/gtest.h>
 #include <BRepAlgoAPI_Cut.hxx>
-#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRep_Builder.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <gp_Ax2.hxx>
-#include <gtest/gtest.h>
 
 #include <filesystem>
 
@@ -74,7 +74,9 @@ TEST(TopologyIndex, BoxCountsAndAdjacency) {
     EXPECT_EQ(t.face_surface[f], "Plane");
     EXPECT_EQ(t.face_solid[f], 0);
   }
-  for (int e = 0; e < 12; ++e) EXPECT_NEAR(t.edge_length[e], (t.vertex_point.row(t.edge_vertices(e, 0)) - t.vertex_point.row(t.edge_vertices(e, 1))).norm(), 1e-12);
+  for (int e = 0; e < 12; ++e)
+    EXPECT_NEAR(t.edge_length[e],
+                (t.vertex_point.row(t.edge_vertices(e, 0)) - t.vertex_point.row(t.edge_vertices(e, 1))).norm(), 1e-12);
   EXPECT_NEAR(t.diagonal(), std::sqrt(100 + 400 + 900), 1e-5);  // boxes carry the tolerance
 }
 
@@ -97,9 +99,9 @@ TEST(Classify, BoxOnFloorOfBox) {
     on_face_vertices += v.on == On::Face;
     interior_vertices += v.on == On::Interior;
   }
-  EXPECT_EQ(on_edge_vertices, 2);     // (2,0,0), (5,0,0)
-  EXPECT_EQ(on_face_vertices, 4);     // on y=0 or z=0 but not both
-  EXPECT_EQ(interior_vertices, 2);    // (2,3,3), (5,3,3)
+  EXPECT_EQ(on_edge_vertices, 2);   // (2,0,0), (5,0,0)
+  EXPECT_EQ(on_face_vertices, 4);   // on y=0 or z=0 but not both
+  EXPECT_EQ(interior_vertices, 2);  // (2,3,3), (5,3,3)
   int edge_on_edge = 0;
   for (const Location& e : c.edge)
     if (e.on == On::Edge) {
@@ -182,7 +184,9 @@ TEST(SolidCheck, NotASolidAndOpenShell) {
   for (int f = 1; f < 6; ++f) builder.Add(shell, t.faces(f));
   EXPECT_EQ(code_of([&] { load_two_breps(box(-1, -1, -1, 3, 3, 3), shell); }), ErrorCode::InvalidShape);
   // Two solids as the part.
-  EXPECT_EQ(code_of([&] { load_two_breps(compound({box(0, 0, 0, 1, 1, 1), box(2, 0, 0, 1, 1, 1)}), TopoDS_Shape()); }),
+  EXPECT_EQ(code_of([&] {
+              load_two_breps(compound({box(0, 0, 0, 1, 1, 1), box(2, 0, 0, 1, 1, 1)}), TopoDS_Shape());
+            }),
             ErrorCode::InvalidShape);
 }
 

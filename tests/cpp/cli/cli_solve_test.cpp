@@ -37,7 +37,8 @@ TEST(CliSolve, SolvesAJobWithAMeshFile) {
   using namespace topopt::fem;
   Material mat{200000, 0.3};
   Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
-  Eigen::MatrixXd F = make_loads(m, mat, {LoadCase{"tip", {LoadSpec{LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}}}, 1}});
+  Eigen::MatrixXd F =
+      make_loads(m, mat, {LoadCase{"tip", {LoadSpec{LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}}}, 1}});
   Elasticity fe(m, mat, s);
   double compliance = F.col(0).dot(fe.solve(F).col(0));
   EXPECT_NEAR(printed, compliance, 1e-5 * compliance);

@@ -41,7 +41,11 @@ TEST(Isolate, CarriesTheChildsErrorWithItsCode) {
 }
 
 TEST(Isolate, ASegfaultAnAbortOrASilentExitIsNamedCrashed) {
-  EXPECT_EQ(code_of([]() -> std::string { std::raise(SIGSEGV); return ""; }), ErrorCode::Crashed);
+  EXPECT_EQ(code_of([]() -> std::string {
+              std::raise(SIGSEGV);
+              return "";
+            }),
+            ErrorCode::Crashed);
   EXPECT_EQ(code_of([]() -> std::string { std::abort(); }), ErrorCode::Crashed);
   EXPECT_EQ(code_of([]() -> std::string { std::_Exit(0); }), ErrorCode::Crashed);
   EXPECT_EQ(code_of([]() -> std::string { throw std::string("thrown like Gmsh does"); }), ErrorCode::Internal);
@@ -49,7 +53,11 @@ TEST(Isolate, ASegfaultAnAbortOrASilentExitIsNamedCrashed) {
 
 TEST(Isolate, AHangIsStoppedAtTheDeadline) {
   auto t0 = std::chrono::steady_clock::now();
-  EXPECT_EQ(code_of([]() -> std::string { for (;;) std::this_thread::sleep_for(std::chrono::seconds(1)); }, 0.5),
+  EXPECT_EQ(code_of(
+                []() -> std::string {
+                  for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+                },
+                0.5),
             ErrorCode::Timeout);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
 }
@@ -58,7 +66,11 @@ TEST(Isolate, ACancelEndsTheChildAtOnce) {
   Progress p;
   auto t0 = std::chrono::steady_clock::now();
   p.cancelled = [&] { return std::chrono::steady_clock::now() - t0 > std::chrono::milliseconds(300); };
-  EXPECT_EQ(code_of([]() -> std::string { for (;;) std::this_thread::sleep_for(std::chrono::seconds(1)); }, 60, p),
+  EXPECT_EQ(code_of(
+                []() -> std::string {
+                  for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+                },
+                60, p),
             ErrorCode::Cancelled);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
 }

@@ -28,8 +28,7 @@ void distort(TetMesh& m, double h, double amount, unsigned seed) {
   Eigen::RowVector3d lo = m.V.colwise().minCoeff(), hi = m.V.colwise().maxCoeff();
   for (long i = 0; i < m.V.rows(); ++i) {
     bool boundary = false;
-    for (int c = 0; c < 3; ++c)
-      boundary |= std::abs(m.V(i, c) - lo[c]) < 1e-12 || std::abs(m.V(i, c) - hi[c]) < 1e-12;
+    for (int c = 0; c < 3; ++c) boundary |= std::abs(m.V(i, c) - lo[c]) < 1e-12 || std::abs(m.V(i, c) - hi[c]) < 1e-12;
     if (!boundary)
       for (int c = 0; c < 3; ++c) m.V(i, c) += u(rng);
   }
@@ -61,7 +60,8 @@ TEST(Elasticity, PatchTestReproducesLinearFieldOnDistortedMesh) {
   double err = 0, ref = 0;
   for (long i = 0; i < m.V.rows(); ++i) {
     Eigen::Vector3d u = A * m.V.row(i).transpose() + b;
-    for (int c = 0; c < 3; ++c) err = std::max(err, std::abs(U(3 * i + c, 0) - u[c])), ref = std::max(ref, std::abs(u[c]));
+    for (int c = 0; c < 3; ++c)
+      err = std::max(err, std::abs(U(3 * i + c, 0) - u[c])), ref = std::max(ref, std::abs(u[c]));
   }
   EXPECT_LT(err / ref, 1e-10);
   // Constant strain: every element carries the same von Mises stress.
@@ -223,9 +223,9 @@ TEST(Elasticity, SymmetricHalfEqualsFullModel) {
   Eigen::MatrixXd Ff = make_loads(full, mat, {LoadCase{"f", {load}, 1}});
   Eigen::MatrixXd Fh = make_loads(half, mat, {LoadCase{"h", {half_load}, 1}});
   Elasticity ff(full, mat, make_supports(full, {SupportSpec{SupportSpec::Kind::Fixed, {1}}}));
-  Elasticity fh(half, mat,
-                make_supports(half, {SupportSpec{SupportSpec::Kind::Fixed, {1}},
-                                     SupportSpec{SupportSpec::Kind::Symmetry, {4}}}));
+  Elasticity fh(
+      half, mat,
+      make_supports(half, {SupportSpec{SupportSpec::Kind::Fixed, {1}}, SupportSpec{SupportSpec::Kind::Symmetry, {4}}}));
   Eigen::MatrixXd Uf = ff.solve(Ff), Uh = fh.solve(Fh);
   double err = (Uf.topRows(3 * nv) - Uh).cwiseAbs().maxCoeff();
   EXPECT_LT(err, 1e-9 * Uh.cwiseAbs().maxCoeff());
@@ -276,8 +276,8 @@ TEST(BoundaryConditions, LoadTotalsAndFaceErrors) {
   LoadSpec force{LoadSpec::Kind::Force, {2, 4}, {3, -7, 11}, 0, {}};
   LoadSpec pressure{LoadSpec::Kind::Pressure, {6}, {0, 0, 0}, 2.5, {}};
   LoadSpec gravity{LoadSpec::Kind::Gravity, {}, {0, 0, -9810}, 0, {}};
-  Eigen::MatrixXd F = make_loads(m, mat, {LoadCase{"f", {force}, 1}, LoadCase{"p", {pressure}, 1},
-                                          LoadCase{"g", {gravity}, 1}});
+  Eigen::MatrixXd F =
+      make_loads(m, mat, {LoadCase{"f", {force}, 1}, LoadCase{"p", {pressure}, 1}, LoadCase{"g", {gravity}, 1}});
   auto total = [&](int c) {
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
     for (long i = 0; i < m.V.rows(); ++i) s += F.block<3, 1>(3 * i, c);

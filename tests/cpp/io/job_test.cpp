@@ -27,7 +27,8 @@ TEST(Job, ParsesTheDocumentedFormat) {
         {"type": "force", "faces": ["Face7"], "vector": [0, -1000, 0]},
         {"type": "pressure", "faces": ["Face8"], "value": 1.5},
         {"type": "gravity", "vector": [0, 0, -9810]}]}],
-    "optimization": {"volume_fraction": 0.3}})", "/data/jobs");
+    "optimization": {"volume_fraction": 0.3}})",
+                    "/data/jobs");
   EXPECT_EQ(j.part, "/data/jobs/p.step");
   EXPECT_EQ(j.nondesign, "/abs/nd.step");
   EXPECT_EQ(j.mesh_size, 2.5);

@@ -67,7 +67,8 @@ TEST(Msh, GmshReadsOurFile) {
       "k=sum(len(x) for x in gmsh.model.mesh.getElements(2)[1])\n"
       "g=gmsh.model.getPhysicalGroups()\n"
       "d1=len(gmsh.model.mesh.getNodesForPhysicalGroup(3,1)[0])\n"
-      "open(sys.argv[2],'w').write('%d %d %d %d %s' % (n,k,len([x for x in g if x[0]==3]),d1,gmsh.model.getPhysicalName(2,100001)))\n";
+      "open(sys.argv[2],'w').write('%d %d %d %d %s' % (n,k,len([x for x in g if "
+      "x[0]==3]),d1,gmsh.model.getPhysicalName(2,100001)))\n";
   fs::path py = temp("check.py");
   std::ofstream(py) << script;
   std::string cmd = "/usr/bin/python3 " + py.string() + " " + p.string() + " " + out.string();
@@ -109,10 +110,11 @@ TEST(Vtu, IsWellFormedXmlWithTheFields) {
   VtuField u{"displacement", 3, std::vector<double>(3 * m.V.rows(), 0.5)};
   VtuField d{"density", 1, std::vector<double>(m.T.rows(), 1.0)};
   write_vtu(p.string(), m, {u}, {d});
-  std::string cmd = "/usr/bin/python3 -c \"import xml.etree.ElementTree as E,sys; r=E.parse(sys.argv[1]).getroot(); "
-                    "pc=r.find('UnstructuredGrid/Piece'); names=[a.get('Name') for a in r.iter('DataArray')]; "
-                    "sys.exit(0 if pc.get('NumberOfCells')=='" + std::to_string(m.T.rows()) +
-                    "' and 'density' in names and 'displacement' in names else 1)\" " + p.string();
+  std::string cmd =
+      "/usr/bin/python3 -c \"import xml.etree.ElementTree as E,sys; r=E.parse(sys.argv[1]).getroot(); "
+      "pc=r.find('UnstructuredGrid/Piece'); names=[a.get('Name') for a in r.iter('DataArray')]; "
+      "sys.exit(0 if pc.get('NumberOfCells')=='" +
+      std::to_string(m.T.rows()) + "' and 'density' in names and 'displacement' in names else 1)\" " + p.string();
   EXPECT_EQ(std::system(cmd.c_str()), 0);
   fs::remove(p);
 }

@@ -8,8 +8,8 @@
 
 #include "common/error.h"
 #include "mesh/core/structured_box.h"
-#include "simp/density_filter.h"
 #include "result/smoothing.h"
+#include "simp/density_filter.h"
 
 namespace topopt::result {
 namespace {

@@ -124,8 +124,8 @@ TEST(Simp, OcUnderSelfWeightAloneMeetsTheVolumeAndLowersTheCompliance) {
   SimpParams p;
   p.volume_fraction = 0.4;
   p.max_iterations = 40;
-  const SimpResult r = optimize(c.mesh, c.mat, c.supports, fem::make_loads(c.mesh, c.mat, cases), {}, p, {}, {},
-                                fem::gravity_of(cases));
+  const SimpResult r =
+      optimize(c.mesh, c.mat, c.supports, fem::make_loads(c.mesh, c.mat, cases), {}, p, {}, {}, fem::gravity_of(cases));
   ASSERT_GE(r.history.size(), 5u);
   EXPECT_NEAR(r.history.back().volume_fraction, 0.4, 0.005);
   EXPECT_LT(r.history.back().compliance, 0.8 * r.history.front().compliance);
@@ -147,7 +147,8 @@ TEST(Simp, OcMeetsTheVolumeAndKeepsNonDesignSolid) {
   p.filter.radius = 5;
   p.max_iterations = 40;
   std::vector<IterationRecord> seen;
-  SimpResult r = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p, {}, [&](const IterationRecord& rec) { seen.push_back(rec); });
+  SimpResult r =
+      optimize(c.mesh, c.mat, c.supports, c.loads, {}, p, {}, [&](const IterationRecord& rec) { seen.push_back(rec); });
   ASSERT_FALSE(r.history.empty());
   EXPECT_EQ(seen.size(), r.history.size());
   // volume of the design domain at the end, from the returned densities

@@ -20,9 +20,9 @@ TetMesh cantilever_mesh() {
 }
 
 const brep::TwoBReps& cantilever_geometry() {
-  static const brep::TwoBReps g = brep::load_two_breps(
-      brep::read_shape_file(TOPOPT_SHARED_DATA "/examples/cantilever.step"),
-      brep::read_shape_file(TOPOPT_SHARED_DATA "/examples/cantilever_nondesign.step"));
+  static const brep::TwoBReps g =
+      brep::load_two_breps(brep::read_shape_file(TOPOPT_SHARED_DATA "/examples/cantilever.step"),
+                           brep::read_shape_file(TOPOPT_SHARED_DATA "/examples/cantilever_nondesign.step"));
   return g;
 }
 

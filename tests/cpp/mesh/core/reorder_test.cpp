@@ -30,8 +30,9 @@ std::multiset<std::pair<Tuple, int>> tets_by_coordinates(const TetMesh& m) {
     std::array<int, 4> v{m.T(t, 0), m.T(t, 1), m.T(t, 2), m.T(t, 3)};
     Tuple best;
     best.fill(1e300);
-    static const int kEven[12][4] = {{0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2}, {1, 0, 3, 2}, {1, 2, 0, 3}, {1, 3, 2, 0},
-                                     {2, 0, 1, 3}, {2, 1, 3, 0}, {2, 3, 0, 1}, {3, 0, 2, 1}, {3, 1, 0, 2}, {3, 2, 1, 0}};
+    static const int kEven[12][4] = {{0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2}, {1, 0, 3, 2},
+                                     {1, 2, 0, 3}, {1, 3, 2, 0}, {2, 0, 1, 3}, {2, 1, 3, 0},
+                                     {2, 3, 0, 1}, {3, 0, 2, 1}, {3, 1, 0, 2}, {3, 2, 1, 0}};
     for (const auto& p : kEven) {
       Tuple c;
       for (int a = 0; a < 4; ++a)

@@ -93,8 +93,10 @@ double check(const FaceFrontInput& in, const FaceFrontResult& out, double region
   for (const auto& [e, n] : used) {
     EXPECT_EQ(n, 1) << "directed edge " << e.first << "->" << e.second << " used " << n << " times";
     const bool reverse = used.count({e.second, e.first}) > 0;
-    if (bnd.count(e)) EXPECT_FALSE(reverse) << "a boundary edge is used from outside";
-    else EXPECT_TRUE(reverse) << "edge " << e.first << "->" << e.second << " is unmatched";
+    if (bnd.count(e))
+      EXPECT_FALSE(reverse) << "a boundary edge is used from outside";
+    else
+      EXPECT_TRUE(reverse) << "edge " << e.first << "->" << e.second << " is unmatched";
   }
   for (const auto& [e, n] : bnd) EXPECT_TRUE(used.count(e)) << "boundary edge missing";
   for (long k = 0; k < in.segments.rows(); ++k) {
@@ -148,7 +150,8 @@ TEST(FaceFront, PrePlacedTrianglesAreKept) {
   for (int i = 0; i < 20; ++i)
     for (int j = 0; j < 3; ++j) {
       const double x0 = 0.1 * i, y0 = 0.1 * j;
-      int p00 = b.node(x0, y0), p10 = b.node(x0 + 0.1, y0), p01 = b.node(x0, y0 + 0.1), p11 = b.node(x0 + 0.1, y0 + 0.1);
+      int p00 = b.node(x0, y0), p10 = b.node(x0 + 0.1, y0), p01 = b.node(x0, y0 + 0.1),
+          p11 = b.node(x0 + 0.1, y0 + 0.1);
       b.tris.push_back({p00, p10, p11});
       b.tris.push_back({p00, p11, p01});
     }

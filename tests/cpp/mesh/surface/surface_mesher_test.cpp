@@ -4,10 +4,10 @@
 // face (the tagged areas equal the faces' areas).
 #include "mesh/surface/surface_mesher.h"
 
+#include <gtest/gtest.h>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -71,7 +71,8 @@ TEST(SurfaceMesher, EverySharedPartIsClosedAndOriented) {
 }
 
 SurfaceMesh mesh_at(const std::string& name, double factor) {
-  const brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/" + name));
+  const brep::TopologyIndex topo =
+      brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/" + name));
   SurfaceMeshParams p;
   p.size = factor * topo.diagonal() / 50;
   return mesh_surface(topo, p);
@@ -90,7 +91,8 @@ CornerAngles corner_angles(const SurfaceMesh& m) {
   for (long t = 0; t < m.F.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d a = m.V.row(m.F(t, k)), b = m.V.row(m.F(t, (k + 1) % 3)), c = m.V.row(m.F(t, (k + 2) % 3));
-      const double angle = std::acos(std::clamp((b - a).normalized().dot((c - a).normalized()), -1.0, 1.0)) * 180 / M_PI;
+      const double angle =
+          std::acos(std::clamp((b - a).normalized().dot((c - a).normalized()), -1.0, 1.0)) * 180 / M_PI;
       auto& [sum, count] = out.corner[{m.face[t], m.F(t, k)}];
       sum += angle, ++count;
       out.smallest[t] = std::min(out.smallest[t], angle);
@@ -119,7 +121,8 @@ TEST(SurfaceMesher, TheSameInputGivesTheSameMesh) {
   // node. (The face front once read its node array through pointers that a tentative new node
   // could invalidate; NIST 1 at this size came out with 40 824 or 40 826 triangles from one
   // process to the next. Valgrind found it; within one process this test rarely sees it.)
-  const brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/nist/NIST_MBE_PMI_1.stp"));
+  const brep::TopologyIndex topo =
+      brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/nist/NIST_MBE_PMI_1.stp"));
   SurfaceMeshParams p;
   p.size = 9.578292502195493;  // bench/surface's half size (Gmsh's bounding box)
   const SurfaceMesh first = mesh_surface(topo, p);
@@ -252,7 +255,8 @@ TEST(SurfaceMesher, FansAtPolesAndApexesFollowTheAngleTheFaceSweeps) {
   // point by point from the parameter bounds and flipped at some points, which counted
   // half-turns: 8 triangles of 19° there
   const TopoDS_Shape nist1 = brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/nist/NIST_MBE_PMI_1.stp");
-  const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep::write_brep_string(nist1), "NIST 1"));
+  const brep::TopologyIndex topo =
+      brep::index_topology(brep::read_brep_string(brep::write_brep_string(nist1), "NIST 1"));
   SurfaceMeshParams p;
   p.size = topo.diagonal() / 100;
   const SurfaceMesh m = mesh_surface(topo, p);

@@ -33,7 +33,8 @@ double smallest_angle(const MatX3d& X, const MatX3i& T) {
 void expect_valid(const MatX2d& P0, const MatX2d& P, const MatX3i& T, int fixed, double area) {
   double sum = 0;
   for (long t = 0; t < T.rows(); ++t) {
-    EXPECT_GT(predicates::orient2d(P.row(T(t, 0)).data(), P.row(T(t, 1)).data(), P.row(T(t, 2)).data()), 0) << "triangle " << t;
+    EXPECT_GT(predicates::orient2d(P.row(T(t, 0)).data(), P.row(T(t, 1)).data(), P.row(T(t, 2)).data()), 0)
+        << "triangle " << t;
     const Eigen::Vector2d a = P.row(T(t, 0)), b = P.row(T(t, 1)), c = P.row(T(t, 2));
     sum += 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
   }

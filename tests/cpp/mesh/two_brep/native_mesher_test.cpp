@@ -6,10 +6,10 @@
 // shared face, a load pad's face tagged on the part's boundary.
 #include "mesh/two_brep/native_mesher.h"
 
+#include <gtest/gtest.h>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
 #include <TopoDS_Compound.hxx>
-#include <gtest/gtest.h>
 
 #include <functional>
 #include <map>
@@ -52,7 +52,8 @@ double triangle_area(const TetMesh& m, int a, int b, int c) {
 }
 
 TEST(NativeMesher, PartsAloneAreConformalWithTheBRepVolume) {
-  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0}, {"bracket", 1.0}}) {
+  for (auto [name, factor] :
+       {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0}, {"bracket", 1.0}}) {
     SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
     const brep::TwoBReps model = load(name);
     const TetMesh m = mesh_at(model, factor);
@@ -92,7 +93,8 @@ TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
         const double z = m.V(m.T(t, c), 2);
         bottom |= std::abs(z) < 1e-9, top |= std::abs(z - 1) < 1e-9;
       }
-      const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)), d = m.V.row(m.T(t, 3));
+      const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                            d = m.V.row(m.T(t, 3));
       const double v = std::abs((b - a).dot((c - a).cross(d - a))) / 6;
       total += v, span += bottom && top ? v : 0;
     }
@@ -107,8 +109,12 @@ TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
 }
 
 TEST(TwoBRepSteps, ExamplesMeshIntoOneConformalTaggedMesh) {
-  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0}, {"rocker", 0.5}, {"cantilever", 1.0},
-                              {"cantilever", 0.6}, {"bracket", 1.0}, {"bracket", 0.75}}) {
+  for (auto [name, factor] : {std::pair<const char*, double>{"rocker", 1.0},
+                              {"rocker", 0.5},
+                              {"cantilever", 1.0},
+                              {"cantilever", 0.6},
+                              {"bracket", 1.0},
+                              {"bracket", 0.75}}) {
     SCOPED_TRACE(std::string(name) + " at " + std::to_string(factor) + " x the default size");
     const brep::TwoBReps model = load(name, true);
     const TetMesh m = mesh_at(model, factor);

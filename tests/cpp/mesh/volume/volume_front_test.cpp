@@ -4,10 +4,10 @@
 // lie inside and leave holes only at boundary triangles its tetrahedralisation lacks.
 #include "mesh/volume/volume_front.h"
 
-#include "mesh/volume/delaunay_bulk.h"
+#include "brep/shape_io.h"
 #include "mesh/core/predicates.h"
 #include "mesh/surface/surface_mesher.h"
-#include "brep/shape_io.h"
+#include "mesh/volume/delaunay_bulk.h"
 
 #include <gtest/gtest.h>
 
@@ -43,7 +43,8 @@ void surface_of(const TetMesh& m, const std::vector<int>& keep, MatX3d& V, MatX3
 }
 
 /// Checks the filled mesh (T0 ∪ new tets) against the surface and returns its volume.
-double check_fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillResult& r, double expected_volume) {
+double check_fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillResult& r,
+                  double expected_volume) {
   TetMesh m;
   m.V = r.V;
   m.T.resize(T0.rows() + r.T.rows(), 4);
@@ -112,8 +113,8 @@ double l_shape_surface(MatX3d& V, MatX3i& F, double jitter = 0) {
   double removed = 0;
   VecXd vol = simp::tet_volumes(box);
   for (long t = 0; t < box.T.rows(); ++t) {
-    bool notch = c(t, 0) > 3 && c(t, 1) > 3;                                     // L-shape
-    bool hole = c(t, 0) > 1 && c(t, 0) < 2 && c(t, 1) > 1 && c(t, 1) < 2;        // a through hole
+    bool notch = c(t, 0) > 3 && c(t, 1) > 3;                               // L-shape
+    bool hole = c(t, 0) > 1 && c(t, 0) < 2 && c(t, 1) > 1 && c(t, 1) < 2;  // a through hole
     if (notch || hole)
       removed += vol[t];
     else
@@ -154,9 +155,9 @@ TEST_P(VolumeFill, FillsAPrismOverAPolygon) {
   MatX3i F(4 * n, 3);
   for (int i = 0; i < n; ++i) {
     int j = (i + 1) % n;
-    F.row(4 * i) << 2 * n, j, i;              // bottom, outward −z
+    F.row(4 * i) << 2 * n, j, i;                  // bottom, outward −z
     F.row(4 * i + 1) << 2 * n + 1, n + i, n + j;  // top, outward +z
-    F.row(4 * i + 2) << i, j, n + j;          // side
+    F.row(4 * i + 2) << i, j, n + j;              // side
     F.row(4 * i + 3) << i, n + j, n + i;
   }
   double area = 0.5 * n * 9 * std::sin(2 * M_PI / n);
@@ -272,7 +273,8 @@ double winding_number(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& x
 /// Our surface mesh of a part of ../shared/data at its default size (diagonal / 50, also
 /// returned in `size`).
 SurfaceMesh default_surface(const std::string& file, double* size = nullptr) {
-  const brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/" + file));
+  const brep::TopologyIndex topo =
+      brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/" + file));
   SurfaceMeshParams sp;
   sp.size = topo.diagonal() / 50;
   if (size) *size = sp.size;
@@ -407,7 +409,8 @@ TEST(VolumeFill, RockerAtOneMillimetreMeetsIssueFoursQualityBounds) {
   // The shape goes through a BREP string, as from FreeCAD and in the bench (its surface then
   // differs slightly from the STEP file's)
   const TopoDS_Shape rocker = brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/examples/rocker.step");
-  const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep::write_brep_string(rocker), "rocker"));
+  const brep::TopologyIndex topo =
+      brep::index_topology(brep::read_brep_string(brep::write_brep_string(rocker), "rocker"));
   SurfaceMeshParams sp;
   sp.size = 1.0;
   const SurfaceMesh s = mesh_surface(topo, sp);
@@ -444,7 +447,9 @@ TEST(VolumeFill, GradesFromAFineBoundaryWithoutASize) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BulkThenFrontAndFrontAlone, VolumeFill, ::testing::Values(true, false),
-                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "DelaunayBulk" : "FrontAlone"; });
+                         [](const ::testing::TestParamInfo<bool>& i) {
+                           return i.param ? "DelaunayBulk" : "FrontAlone";
+                         });
 
 }  // namespace
 }  // namespace topopt::mesh
