@@ -13,6 +13,7 @@ int cmd_mesh(const Args& args);
 int cmd_solve(const Args& args);
 int cmd_optimize(const Args& args);
 int cmd_surface(const Args& args);
+int cmd_worker(const Args& args);
 
 /// Small argument reader shared by the sub-commands: `--name value` options, `--flag`
 /// switches and positionals. Unknown options are an error with the usage text.
