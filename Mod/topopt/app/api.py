@@ -29,19 +29,19 @@ def _brep(shape):
     return shape.exportBrepToString()
 
 
-def info(part, nondesign=None, tolerance=-1.0):
+def info(part, nondesign=None, tolerance=-1.0, cancel=None):
     """Check the part and the non-design solids and classify one against the other (in the
     worker process).
 
     part: a Part.Shape holding one solid (Ω). nondesign: a solid, a compound of solids or a
     list of solids (Ω̄, in order), or None. tolerance: coincidence tolerance in mm (< 0: from
-    the part's size). Returns a dict (see `topopt info --json`): counts, volumes, where each
-    non-design face lies on the part, contacts. Raises TopOptError with a message saying what
-    to fix.
+    the part's size). cancel(): polled, True cancels. Returns a dict (see `topopt info --json`):
+    counts, volumes, where each non-design face lies on the part, contacts. Raises TopOptError
+    with a message saying what to fix.
     """
     tolerance = checks.number(tolerance, "tolerance")
     result = worker.run("info", part=_brep(part), nondesign=_brep(nondesign), params={"tolerance": tolerance},
-                        timeout=INFO_TIMEOUT)
+                        cancel=cancel, timeout=INFO_TIMEOUT)
     return result["report"]
 
 

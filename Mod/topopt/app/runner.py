@@ -102,9 +102,10 @@ def run(study, on_progress=None, cancel=None):
     return apply(study, execute(prepare(study), on_progress, cancel))
 
 
-def reextract(study, threshold):
+def reextract(study, threshold, cancel=None):
     """Re-extracts the result shape from the stored densities at another threshold (no
-    re-run), in the worker process. threshold: in (0, 1). Returns the result Mesh feature.
+    re-run), in the worker process. threshold: in (0, 1); cancel(): polled, True cancels.
+    Stopped after REEXTRACT_TIMEOUT seconds. Returns the result Mesh feature.
     Raises TopOptError if the study has no result, if what it stored is damaged, or if the
     worker fails (the document is then unchanged)."""
     if not study.Densities:
@@ -113,7 +114,7 @@ def reextract(study, threshold):
     nodes, tets, domain, densities = checks.stored_mesh(study)
     result = worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
                                                    "densities": densities},
-                        params={"threshold": threshold}, timeout=REEXTRACT_TIMEOUT)
+                        params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
     shape = result_mesh(result["surface_points"], result["surface_triangles"])
     study.Threshold = threshold
     feature = study.Result or study.Document.addObject("Mesh::Feature", study.Name + "_Result")

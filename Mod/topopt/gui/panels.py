@@ -79,6 +79,7 @@ class StudyPanel:
         self.progress.setRange(0, 100)
         layout.addWidget(self.progress)
         self.status = QtWidgets.QLabel(study.Status or "")
+        self.status.setWordWrap(True)  # an error says what to try: all of it must show
         layout.addWidget(self.status)
         self.plot = HistoryPlot()
         self.plot.set_history(study.ComplianceHistory, study.VolumeHistory)
@@ -190,8 +191,10 @@ class StudyPanel:
             self.poll()
 
     def reextract(self):
+        from topopt.gui.waiting import WaitDialog
         try:
-            runner.reextract(self.study, self.threshold.value() / 100.0)
+            with WaitDialog("Extracting the result shape") as wait:
+                runner.reextract(self.study, self.threshold.value() / 100.0, wait.cancel)
         except TopOptError as e:
             report_error(e)
 
