@@ -119,6 +119,13 @@ void put_tet_mesh(json& result, const fs::path& dir, const TetMesh& mesh) {
   put_array(result, dir, "boundary_nondesign_faces", mesh.nd_face);
 }
 
+/// The result shape's arrays: surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q.
+void put_result_surface(json& result, const fs::path& dir, const result::TriSurface& s) {
+  put_array(result, dir, "surface_points", s.V);
+  put_array(result, dir, "surface_triangles", s.F);
+  put_array(result, dir, "surface_tags", s.tag);
+}
+
 /// The request's part and non-design shapes (null shapes where none is given).
 std::pair<TopoDS_Shape, TopoDS_Shape> read_shapes(const Request& r, WorkerChannel& ch) {
   std::pair<TopoDS_Shape, TopoDS_Shape> shapes;
@@ -235,9 +242,7 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
   ch.progress("write", -1, "writing the results");
   put_tet_mesh(result, r.output, o.mesh);
   put_array(result, r.output, "densities", o.result.simp.density);
-  put_array(result, r.output, "surface_points", o.result.surface.V);
-  put_array(result, r.output, "surface_triangles", o.result.surface.F);
-  put_array(result, r.output, "surface_tags", o.result.surface.tag);
+  put_result_surface(result, r.output, o.result.surface);
   return result;
 }
 
@@ -293,9 +298,7 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
                                                         volume_fraction, smooth, &used);
   json result = {{"threshold", used}};
   ch.progress("write", -1, "writing the results");
-  put_array(result, r.output, "surface_points", s.V);
-  put_array(result, r.output, "surface_triangles", s.F);
-  put_array(result, r.output, "surface_tags", s.tag);
+  put_result_surface(result, r.output, s);
   return result;
 }
 
