@@ -56,6 +56,8 @@ struct Request {
   fs::path output;
 };
 
+/// Reads REQUEST.json; relative paths are taken from its folder, the output folder is created.
+/// Throws Error(Io) for a missing file, Error(InvalidParameter) naming a malformed key.
 Request read_request(const std::string& path) {
   std::ifstream f(path);
   if (!f) throw Error(ErrorCode::Io, "worker request not found: " + path);
@@ -90,6 +92,7 @@ Request read_request(const std::string& path) {
   return r;
 }
 
+/// params.KEY as a number (`fallback` when absent); Error(InvalidParameter) if not a number.
 double param(const Request& r, const std::string& key, double fallback) {
   if (!r.params.contains(key) || r.params[key].is_null()) return fallback;
   if (!r.params[key].is_number())
@@ -97,6 +100,7 @@ double param(const Request& r, const std::string& key, double fallback) {
   return r.params[key].get<double>();
 }
 
+/// The NPY file the request gives for array `name`, read.
 io::NpyArray array_of(const Request& r, const std::string& name) {
   auto it = r.arrays.find(name);
   if (it == r.arrays.end()) throw Error(ErrorCode::InvalidParameter, "worker request: array \"" + name + "\" missing");
@@ -110,6 +114,7 @@ void put_array(json& result, const fs::path& dir, const std::string& name, const
   result["arrays"].push_back(name);
 }
 
+/// The tet mesh's arrays under the names the workbench reads (as the Python module's dicts).
 void put_tet_mesh(json& result, const fs::path& dir, const TetMesh& mesh) {
   put_array(result, dir, "nodes", mesh.V);
   put_array(result, dir, "tets", mesh.T);
@@ -140,11 +145,13 @@ std::pair<TopoDS_Shape, TopoDS_Shape> read_shapes(const Request& r, WorkerChanne
   return shapes;
 }
 
+/// The request's inline job, parsed and checked as a job file is.
 io::Job job_of(const Request& r) {
   if (!r.job.is_object()) throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object");
   return io::parse_job(r.job.dump(), r.base.string());
 }
 
+/// info: the shapes checked and classified; result.json holds {"report"} (topopt info --json).
 json op_info(const Request& r, WorkerChannel& ch) {
   auto [part, nd] = read_shapes(r, ch);
   if (part.IsNull()) throw Error(ErrorCode::InvalidParameter, "no part given");
@@ -155,6 +162,7 @@ json op_info(const Request& r, WorkerChannel& ch) {
   return {{"report", brep::two_breps_report(two)}, {"warnings", warnings}};
 }
 
+/// surface_mesh: the native surface mesh of the part (nodes, triangles, faces) and its checks.
 json op_surface_mesh(const Request& r, WorkerChannel& ch) {
   mesh::SurfaceMeshParams p;
   p.size = param(r, "size", 0);
@@ -186,6 +194,7 @@ json op_surface_mesh(const Request& r, WorkerChannel& ch) {
   return result;
 }
 
+/// mesh: the job's conformal tagged tet mesh and its quality figures.
 json op_mesh(const Request& r, WorkerChannel& ch) {
   const io::Job job = job_of(r);
   auto [part, nd] = read_shapes(r, ch);
@@ -221,6 +230,7 @@ OptimizeOutcome optimize_shapes(const io::Job& job, const TopoDS_Shape& part, co
   return out;
 }
 
+/// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
   const io::Job job = job_of(r);
   auto [part, nd] = read_shapes(r, ch);
@@ -282,6 +292,7 @@ std::pair<TetMesh, VecXd> checked_densities(const Request& r) {
   return {mesh, density};
 }
 
+/// extract_surface: the result shape of given densities at a threshold (or volume fraction).
 json op_extract_surface(const Request& r, WorkerChannel& ch) {
   const double threshold = param(r, "threshold", -1), volume_fraction = param(r, "volume_fraction", -1);
   if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
@@ -302,6 +313,7 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   return result;
 }
 
+/// Runs the request's operation; returns what goes into result.json.
 json run_operation(const Request& r, WorkerChannel& ch) {
   const std::map<std::string, json (*)(const Request&, WorkerChannel&)> ops{{"info", op_info},
                                                                             {"surface_mesh", op_surface_mesh},
@@ -324,6 +336,7 @@ void end_with_parent() {
   if (::getppid() != parent) ::_exit(1);
 }
 
+/// Writes DIR/result.json.
 void write_result(const fs::path& dir, const json& result) {
   const std::string path = (dir / "result.json").string();
   std::ofstream f(path);
