@@ -13,6 +13,9 @@ int cmd_mesh(const Args& args);
 int cmd_solve(const Args& args);
 int cmd_optimize(const Args& args);
 int cmd_surface(const Args& args);
+/// topopt worker REQUEST.json: one request of the FreeCAD workbench, run out of FreeCAD's process
+/// (JSON lines on stdout, results in files; see cmd_worker.cpp and worker_channel.h).
+int cmd_worker(const Args& args);
 
 /// Small argument reader shared by the sub-commands: `--name value` options, `--flag`
 /// switches and positionals. Unknown options are an error with the usage text.

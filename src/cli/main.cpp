@@ -78,6 +78,7 @@ const char* kUsage =
     "  surface   native surface mesh of one model, with its checks (closed, oriented, no self-intersection)\n"
     "  solve     linear elastic analysis of a job file\n"
     "  optimize  topology optimisation of a job file: mesh, SIMP, result surface\n"
+    "  worker    one request of the FreeCAD workbench, run out of FreeCAD's process\n"
     "Run 'topopt <command> --help' for a command's options.\n";
 
 /// Exit codes: 0 success, 1 user error (message printed), 2 usage, 3 internal error.
@@ -100,11 +101,9 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
   }
-  const std::map<std::string, int (*)(const Args&)> commands{{"info", cmd_info},
-                                                             {"mesh", cmd_mesh},
-                                                             {"solve", cmd_solve},
-                                                             {"optimize", cmd_optimize},
-                                                             {"surface", cmd_surface}};
+  const std::map<std::string, int (*)(const Args&)> commands{{"info", cmd_info},       {"mesh", cmd_mesh},
+                                                             {"solve", cmd_solve},     {"optimize", cmd_optimize},
+                                                             {"surface", cmd_surface}, {"worker", cmd_worker}};
   auto it = commands.find(argv[1]);
   if (it == commands.end()) {
     std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;

@@ -1,14 +1,20 @@
 """Plain scripting API for FreeCADCmd and the Python console.
 
-Shapes go to the native core as BREP strings (Shape.exportBrepToString()), so the core links
-only OCCT, the same OCCT FreeCAD loads.
+Shapes go to the native core as BREP text (Shape.exportBrepToString()), so the core links
+only OCCT, the same OCCT FreeCAD loads. Every call that meshes, runs or checks shapes runs in
+the worker process (topopt.app.worker): a failure of the core ends that process, never
+FreeCAD, and comes back as a TopOptError. Arguments are checked here before anything starts.
 """
+import os
+
 import Part
 
-from .. import native
-
-
+from . import checks
+from . import worker
 from .errors import TopOptError  # noqa: F401  (part of the API)
+
+#: seconds a shape check (info) may take before the worker is stopped
+INFO_TIMEOUT = 600.0
 
 
 def _brep(shape):
@@ -23,33 +29,35 @@ def _brep(shape):
     return shape.exportBrepToString()
 
 
-def info(part, nondesign=None, tolerance=-1.0):
-    """Check the part and the non-design solids and classify one against the other.
+def info(part, nondesign=None, tolerance=-1.0, cancel=None):
+    """Check the part and the non-design solids and classify one against the other (in the
+    worker process).
 
     part: a Part.Shape holding one solid (Ω). nondesign: a solid, a compound of solids or a
-    list of solids (Ω̄, in order), or None. Returns a dict (see `topopt info --json`):
-    counts, volumes, where each non-design face lies on the part, contacts.
-    Raises TopOptError with a message saying what to fix.
+    list of solids (Ω̄, in order), or None. tolerance: coincidence tolerance in mm (< 0: from
+    the part's size). cancel(): polled, True cancels. Returns a dict (see `topopt info --json`):
+    counts, volumes, where each non-design face lies on the part, contacts. Raises TopOptError
+    with a message saying what to fix.
     """
-    try:
-        return native().info(_brep(part), _brep(nondesign), tolerance)
-    except native().TopOptError as e:
-        raise TopOptError(str(e), getattr(e, "code", "Internal")) from None
+    tolerance = checks.number(tolerance, "tolerance")
+    result = worker.run("info", part=_brep(part), nondesign=_brep(nondesign), params={"tolerance": tolerance},
+                        cancel=cancel, timeout=INFO_TIMEOUT)
+    return result["report"]
 
 
-def surface_mesh(shape, size=0.0, doc=None, name="SurfaceMesh"):
+def surface_mesh(shape, size=0.0, doc=None, name="SurfaceMesh", wall_layers=0):
     """The native surface mesh of one shape (every solid closed and outward, each triangle
-    tagged with its FreeCAD face number) and its checks.
+    tagged with its FreeCAD face number) and its checks, made in the worker process.
 
-    size: target edge length in mm (0: the shape's diagonal / 50). Returns the dict of the
-    native `surface_mesh` (nodes, triangles, faces, failed_faces, open_edges_per_solid,
-    self_intersecting_pairs, min_angle, share_below_20deg); with `doc`, also adds a Mesh
-    feature `name` to it and returns (dict, feature).
+    size: target edge length in mm (0: the shape's diagonal / 50). wall_layers: 0 (off) to 4,
+    element layers across walls thinner than two sizes. Returns a dict (nodes, triangles,
+    faces, failed_faces, failure_reasons, open_edges_per_solid, self_intersecting_pairs,
+    min_angle, share_below_20deg, warnings); with `doc`, also adds a Mesh feature `name` to it
+    and returns (dict, feature).
     """
-    try:
-        result = native().surface_mesh(_brep(shape), float(size))
-    except native().TopOptError as e:
-        raise TopOptError(str(e), getattr(e, "code", "Internal")) from None
+    size = checks.in_range(size, "size (mm, 0 for the default)", 0.0)
+    wall_layers = int(checks.in_range(wall_layers, "wall_layers", 0, 4))
+    result = worker.run("surface_mesh", part=_brep(shape), params={"size": size, "wall_layers": wall_layers})
     if doc is None:
         return result
     import FreeCAD
@@ -66,82 +74,133 @@ def surface_mesh(shape, size=0.0, doc=None, name="SurfaceMesh"):
 
 def new_study(doc, part, nondesign=(), volume_fraction=0.3, mesh_size=0.0, name="TopOptStudy"):
     """Adds a study to `doc`: `part` is the document object of the whole part (one solid),
-    `nondesign` the document objects of the solids to keep. Returns the study object."""
+    `nondesign` the document objects of the solids to keep, volume_fraction in (0, 1),
+    mesh_size in mm (0: automatic). Returns the study object. Everything is checked before
+    the study is added."""
     from .study import make_study
-    if not 0.0 < volume_fraction < 1.0:
-        raise TopOptError("volume fraction %g is out of range: give a value between 0 and 1"
-                          % volume_fraction, "InvalidParameter")
+    volume_fraction = checks.in_range(volume_fraction, "volume_fraction", 0.0, 1.0, True, True)
+    mesh_size = checks.in_range(mesh_size, "mesh_size (mm, 0 for automatic)", 0.0)
+    for obj in [part] + list(nondesign):
+        if getattr(obj, "Shape", None) is None:
+            raise TopOptError("%r is not a document object with a shape: pick a solid" % (obj,), "InvalidShape")
     study = make_study(doc, part, nondesign, name)
     study.VolumeFraction = volume_fraction
     study.MeshSize = mesh_size
     return study
 
 
-def _faces(obj, faces):
-    faces = [faces] if isinstance(faces, str) else list(faces)
-    shape = obj.Shape
+def _faces(study, faces, obj):
+    """The References entry [(obj, ("Face3", ...))] for faces of `obj` (default: the study's
+    part), every name checked. Raises TopOptError naming the face or what is missing."""
+    from .study import is_study
+    if not is_study(study):
+        raise TopOptError("%r is not a TopOpt study: pass the object api.new_study returned" % (study,),
+                          "InvalidParameter")
+    obj = obj or study.Part
+    if obj is None or getattr(obj, "Shape", None) is None:
+        raise TopOptError("the faces must belong to a document object with a shape (the study's part "
+                          "or a non-design solid)", "FaceNotFound")
+    if isinstance(faces, str):
+        faces = [faces]
+    try:
+        faces = list(faces)
+    except TypeError:
+        raise TopOptError("faces must be a face name like 'Face3' or a list of them, not %r" % (faces,),
+                          "FaceNotFound") from None
+    if not faces:
+        raise TopOptError("no faces given: name at least one face of %s, like 'Face3'" % obj.Label, "FaceNotFound")
+    count = len(obj.Shape.Faces)
     for f in faces:
-        if not f.startswith("Face") or not f[4:].isdigit() or not 1 <= int(f[4:]) <= len(shape.Faces):
-            raise TopOptError("%s has no face '%s': it has Face1 to Face%d"
-                              % (obj.Label, f, len(shape.Faces)), "FaceNotFound")
+        if not isinstance(f, str) or not f.startswith("Face") or not f[4:].isdigit() or not 1 <= int(f[4:]) <= count:
+            raise TopOptError("%s has no face %r: it has Face1 to Face%d" % (obj.Label, f, count), "FaceNotFound")
     return [(obj, tuple(faces))]
 
 
-def _attach(study, constraint):
-    study.Constraints = list(study.Constraints) + [constraint]
-    return constraint
+def _add_constraint(study, make, configure):
+    """Makes a constraint with make(doc), sets it up with configure(c) and attaches it to the
+    study; if anything fails on the way the constraint is removed again, so that no orphan is
+    left in the document."""
+    doc = study.Document
+    c = make(doc)
+    try:
+        configure(c)
+        study.Constraints = list(study.Constraints) + [c]
+    except BaseException:
+        doc.removeObject(c.Name)
+        raise
+    return c
+
+
+def _fem(maker, name):
+    def make(doc):
+        import ObjectsFem
+        return getattr(ObjectsFem, maker)(doc, name)
+    return make
 
 
 def add_fixed(study, faces, obj=None):
     """Fixes the given faces ("Face3" or ["Face3", "Face4"]) of the part (or of `obj`)."""
-    import ObjectsFem
-    c = ObjectsFem.makeConstraintFixed(study.Document, "Fixed")
-    c.References = _faces(obj or study.Part, faces)
-    return _attach(study, c)
+    refs = _faces(study, faces, obj)
+    return _add_constraint(study, _fem("makeConstraintFixed", "Fixed"), lambda c: setattr(c, "References", refs))
 
 
 def add_fixed_components(study, faces, x=False, y=False, z=False, obj=None):
     """Fixes only some displacement components on the faces (a roller support)."""
-    import ObjectsFem
-    c = ObjectsFem.makeConstraintDisplacement(study.Document, "Displacement")
-    c.References = _faces(obj or study.Part, faces)
-    for axis, fixed in zip("xyz", (x, y, z)):
-        setattr(c, axis + "Fix", bool(fixed))
-        setattr(c, axis + "Free", not fixed)
-    return _attach(study, c)
+    refs = _faces(study, faces, obj)
+    if not (x or y or z):
+        raise TopOptError("fix at least one component: pass x=True, y=True or z=True", "InvalidParameter")
+
+    def configure(c):
+        c.References = refs
+        for axis, fixed in zip("xyz", (x, y, z)):
+            setattr(c, axis + "Fix", bool(fixed))
+            setattr(c, axis + "Free", not fixed)
+    return _add_constraint(study, _fem("makeConstraintDisplacement", "Displacement"), configure)
 
 
 def add_symmetry(study, faces, obj=None):
     """A symmetry plane on planar faces of the part: their normal displacement is fixed."""
     from .symmetry import make_symmetry_plane
-    return _attach(study, make_symmetry_plane(study.Document, _faces(obj or study.Part, faces)))
+    refs = _faces(study, faces, obj)
+    return _add_constraint(study, make_symmetry_plane, lambda c: setattr(c, "References", refs))
 
 
 def add_force(study, faces, vector, obj=None):
     """A total force (N, a 3-vector) spread over the faces by area."""
     import FreeCAD
-    import ObjectsFem
-    v = FreeCAD.Vector(*vector)
+    refs = _faces(study, faces, obj)
+    try:
+        components = list(vector)
+    except TypeError:
+        components = []
+    if len(components) != 3:
+        raise TopOptError("the force must be a vector of three numbers (x, y, z in N), not %r" % (vector,),
+                          "InvalidParameter")
+    components = [checks.number(x, "the force's %s component" % axis) for axis, x in zip("xyz", components)]
+    v = FreeCAD.Vector(*components)
     if v.Length == 0:
         raise TopOptError("the force is zero: give a non-zero vector", "InvalidParameter")
-    c = ObjectsFem.makeConstraintForce(study.Document, "Force")
-    c.References = _faces(obj or study.Part, faces)
-    c.Force = v.Length
-    # FreeCAD's force takes its direction from a reference edge or face; scripted forces get
-    # their direction stored directly in DirectionVector's place through a hidden property.
-    c.addProperty("App::PropertyVector", "TopOptDirection", "TopOpt", "Force direction (script)")
-    c.TopOptDirection = v.normalize()
-    return _attach(study, c)
+
+    def configure(c):
+        c.References = refs
+        c.Force = v.Length
+        # FreeCAD's force takes its direction from a reference edge or face; scripted forces get
+        # their direction stored directly in DirectionVector's place through a hidden property.
+        c.addProperty("App::PropertyVector", "TopOptDirection", "TopOpt", "Force direction (script)")
+        c.TopOptDirection = FreeCAD.Vector(v).normalize()
+    return _add_constraint(study, _fem("makeConstraintForce", "Force"), configure)
 
 
 def add_pressure(study, faces, value, obj=None):
     """A pressure (MPa) on the faces; positive pushes into the part."""
-    import ObjectsFem
-    c = ObjectsFem.makeConstraintPressure(study.Document, "Pressure")
-    c.References = _faces(obj or study.Part, faces)
-    c.Pressure = abs(value)
-    c.Reversed = value < 0
-    return _attach(study, c)
+    refs = _faces(study, faces, obj)
+    value = checks.number(value, "the pressure")
+
+    def configure(c):
+        c.References = refs
+        c.Pressure = abs(value)
+        c.Reversed = value < 0
+    return _add_constraint(study, _fem("makeConstraintPressure", "Pressure"), configure)
 
 
 def job_of(study):
@@ -150,16 +209,32 @@ def job_of(study):
     return study_to_job(study)
 
 
-def run(study, on_progress=None):
-    """Runs the study (mesh → SIMP → result surface) and returns the result Mesh feature.
-    on_progress(record) is called per stage and iteration; returning True cancels."""
+def run(study, on_progress=None, cancel=None):
+    """Runs the study (mesh → SIMP → result surface) in the worker process and returns the
+    result Mesh feature. on_progress(record) is called per stage and iteration and returns
+    True to cancel (False or None to go on); cancel(), if given, is polled several times a
+    second and cancels on True. The document is only changed when the run succeeds."""
     from . import runner
-    return runner.run(study, on_progress)
+    return runner.run(study, on_progress, cancel)
 
 
 def export_stl(study, path):
-    """Writes the study's result shape to an STL file."""
+    """Writes the study's result shape to an STL file at `path`. Raises TopOptError if the
+    study has no result, if the folder does not exist, or if the file cannot be written."""
     if study.Result is None:
         raise TopOptError("the study has no result yet: run it first", "InvalidParameter")
-    study.Result.Mesh.write(path)
+    path = os.path.abspath(os.path.expanduser(str(path)))
+    folder = os.path.dirname(path)
+    if not os.path.isdir(folder):
+        raise TopOptError("the folder %s does not exist: create it or pick another folder for %s"
+                          % (folder, os.path.basename(path)), "Io")
+    if os.path.isdir(path):
+        raise TopOptError("%s is a folder: give a file name ending in .stl" % path, "Io")
+    try:
+        study.Result.Mesh.write(path)
+    except Exception as e:  # OSError, or FreeCAD's own exception types
+        raise TopOptError("cannot write %s (%s): check that the folder is writable"
+                          % (path, getattr(e, "strerror", None) or e), "Io") from None
+    if not os.path.isfile(path):
+        raise TopOptError("cannot write %s: check that the folder is writable" % path, "Io")
     return path

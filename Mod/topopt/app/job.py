@@ -7,6 +7,7 @@ loads on load pads whose faces lie on the part's boundary.
 """
 import Part
 
+from . import checks
 from . import errors
 from .study import is_study
 
@@ -81,20 +82,23 @@ def constraint_to_job(study, c):
     if proxy_type == "TopOpt::SymmetryPlane":
         return "support", {"type": "symmetry", "faces": face_names(study, c.References, label)}
     if t == "Fem::ConstraintForce":
-        force = float(c.Force)
+        force = checks.number(c.Force, "%s: Force" % label)
         d = c.TopOptDirection if "TopOptDirection" in c.PropertiesList else c.DirectionVector
+        for axis in "xyz":
+            checks.number(getattr(d, axis), "%s: the direction's %s" % (label, axis))
         if d.Length == 0:
             raise errors.TopOptError("%s has no direction: pick an edge or face for it" % label, "InvalidParameter")
         d = d.normalize() if hasattr(d, "normalize") else d
         return "load", {"type": "force", "faces": face_names(study, c.References, label),
                         "vector": [force * x for x in _vec(d)]}
     if t == "Fem::ConstraintPressure":
-        p = float(c.Pressure)
+        p = checks.number(c.Pressure, "%s: Pressure" % label)
         return "load", {"type": "pressure", "faces": face_names(study, c.References, label),
                         "value": -p if c.Reversed else p}
     if t == "Fem::ConstraintSelfWeight":
         g = 9806.65  # mm/s², FreeCAD's self weight is in multiples of g
-        return "load", {"type": "gravity", "vector": [c.Gravity_x * g, c.Gravity_y * g, c.Gravity_z * g]}
+        return "load", {"type": "gravity", "vector": [checks.number(getattr(c, "Gravity_" + axis), "%s: Gravity_%s"
+                                                                    % (label, axis)) * g for axis in "xyz"]}
     raise errors.TopOptError("%s (%s) is not a support or load TopOpt knows: use fixed, displacement, "
                              "force, pressure, self weight or a TopOpt symmetry plane" % (label, t),
                              "InvalidParameter")
@@ -106,6 +110,7 @@ def study_to_job(study):
         raise errors.TopOptError("not a TopOpt study", "InvalidParameter")
     if study.Part is None:
         raise errors.TopOptError("the study has no part: set its Part to a solid", "InvalidShape")
+    n = study_numbers(study)
     supports, loads = [], []
     for c in study.Constraints:
         kind, item = constraint_to_job(study, c)
@@ -115,25 +120,49 @@ def study_to_job(study):
                                  "on a face of the part", "NoSupport")
     if not loads:
         raise errors.TopOptError("the study has no load: add a force, pressure or self weight", "InvalidParameter")
-    vf = float(study.VolumeFraction)
-    if not 0.0 < vf < 1.0:
-        raise errors.TopOptError("volume fraction %g is out of range: give a value between 0 and 1" % vf,
-                                 "InvalidParameter")
-    layers = int(getattr(study, "WallLayers", 0))
-    if not 0 <= layers <= 4:
-        raise errors.TopOptError("wall layers %d is out of range: give 0 (off) to 4" % layers, "InvalidParameter")
     job = {
         "mesh": dict({"mesher": str(getattr(study, "Mesher", "auto"))},
-                     **({"size": float(study.MeshSize)} if float(study.MeshSize) > 0 else {}),
-                     **({"wall_layers": layers} if layers > 0 else {})),
-        "material": {"E": study.YoungsModulus, "nu": study.PoissonRatio, "density": study.Density},
+                     **({"size": n["MeshSize"]} if n["MeshSize"] > 0 else {}),
+                     **({"wall_layers": n["WallLayers"]} if n["WallLayers"] > 0 else {})),
+        "material": {"E": n["YoungsModulus"], "nu": n["PoissonRatio"], "density": n["Density"]},
         "supports": supports,
         "load_cases": [{"name": "loads", "weight": 1.0, "loads": loads}],
-        "optimization": {"volume_fraction": vf, "penalty": study.Penalty, "filter": study.Filter,
-                         "update": study.Update, "max_iterations": study.MaxIterations},
+        "optimization": {"volume_fraction": n["VolumeFraction"], "penalty": n["Penalty"], "filter": study.Filter,
+                         "update": study.Update, "max_iterations": n["MaxIterations"]},
     }
-    if float(study.FilterRadius) > 0:
-        job["optimization"]["filter_radius"] = float(study.FilterRadius)
-    if study.Threshold >= 0:
-        job["optimization"]["threshold"] = study.Threshold
+    if n["FilterRadius"] > 0:
+        job["optimization"]["filter_radius"] = n["FilterRadius"]
+    if n["Threshold"] >= 0:
+        job["optimization"]["threshold"] = n["Threshold"]
     return job
+
+
+#: the study's numeric properties: (name, low, high, open low, open high); None = no bound
+_NUMBERS = [
+    ("VolumeFraction", 0.0, 1.0, True, True),
+    ("YoungsModulus", 0.0, None, True, False),
+    ("PoissonRatio", -1.0, 0.5, True, True),
+    ("Density", 0.0, None, False, False),
+    ("MeshSize", 0.0, None, False, False),
+    ("WallLayers", 0, 4, False, False),
+    ("Penalty", 1.0, 10.0, False, False),
+    ("FilterRadius", 0.0, None, False, False),
+    ("MaxIterations", 1, 10000, False, False),
+]
+
+
+def study_numbers(study):
+    """The study's numeric properties as plain numbers, each checked: finite, in its range,
+    the threshold -1 (automatic) or in (0, 1). Raises TopOptError naming the property."""
+    out = {}
+    for name, low, high, open_low, open_high in _NUMBERS:
+        if name in study.PropertiesList:
+            out[name] = checks.in_range(getattr(study, name), name, low, high, open_low, open_high)
+    out.setdefault("WallLayers", 0)
+    for name in ("WallLayers", "MaxIterations"):
+        out[name] = int(out[name])
+    threshold = checks.number(study.Threshold, "Threshold")
+    if threshold >= 0:
+        threshold = checks.in_range(threshold, "Threshold (-1 for automatic)", 0.0, 1.0, True, True)
+    out["Threshold"] = threshold
+    return out

@@ -1,13 +1,18 @@
-"""Running a study: prepare (document → strings, GUI thread), execute (native, any thread,
-touches no document), apply (results → document, GUI thread). Headless scripts call run().
+"""Running a study: prepare (document → strings, GUI thread), execute (the worker process,
+any thread, touches no document), apply (results → document, GUI thread). Headless scripts
+call run(). Meshing, runs and re-extraction run in the worker process (topopt.app.worker):
+whatever fails there, the document is only touched after success.
 """
-import json
-
 import FreeCAD
 
-from .. import native
+from . import checks
 from . import job as jobmod
+from . import worker
 from .errors import TopOptError
+
+#: seconds the threshold slider's re-extraction may take before it is stopped (it runs while
+#: FreeCAD waits)
+REEXTRACT_TIMEOUT = 300.0
 
 
 class PreparedRun:
@@ -26,34 +31,26 @@ def prepare(study):
     return PreparedRun(job, part.exportBrepToString(), nd.exportBrepToString() if nd else "")
 
 
-def _native_error(e):
-    return TopOptError(str(e), getattr(e, "code", "Internal"))
+def execute(prepared, on_progress=None, cancel=None):
+    """Runs mesh → SIMP → surface in the worker process. on_progress(record) gets a dict per
+    stage ({"stage", "fraction", "message"}) and iteration ({"iteration", "compliance",
+    "volume", "change", "seconds"}) in the calling thread; it returns True to cancel, False or
+    None to go on. cancel(), if given, is polled several times a second and cancels on True
+    (this is how a Cancel button stops a worker that has gone silent). Returns the result
+    dict: nodes, tets, domain, boundary_triangles, boundary_faces, boundary_nondesign_faces,
+    densities, history, threshold, surface_points, surface_triangles, surface_tags, status,
+    seconds, warnings. Raises TopOptError (see worker.run)."""
+    return worker.run("optimize", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
+                      on_progress=on_progress, cancel=cancel)
 
 
-def execute(prepared, on_progress=None):
-    """Runs mesh → SIMP → surface natively. on_progress(record) gets a dict per iteration
-    ({"iteration", "compliance", "volume", "change"}) or stage ({"stage", "fraction",
-    "message"}); returning True cancels. Returns the result dict of the native run_job."""
-    core = native()
-    if not hasattr(core, "run_job"):
-        raise TopOptError("this build of TopOpt cannot run optimisations yet (the native run_job is "
-                          "missing): rebuild with scripts/build", "Internal")
-    try:
-        return core.run_job(json.dumps(prepared.job), prepared.part_brep, prepared.nondesign_brep,
-                            on_progress)
-    except core.TopOptError as e:
-        raise _native_error(e) from None
-
-
-def mesh_only(study):
-    """Meshes the study's shapes (no optimisation) and stores the tagged mesh in the study.
-    Returns the native result dict (nodes, tets, domain, boundary triangles, quality)."""
+def mesh_only(study, on_progress=None, cancel=None):
+    """Meshes the study's shapes (no optimisation) in the worker process and stores the tagged
+    mesh in the study. Returns the result dict (nodes, tets, domain, boundary triangles and
+    faces, min_radius_ratio, mean_radius_ratio, warnings)."""
     prepared = prepare(study)
-    core = native()
-    try:
-        result = core.mesh_shapes(json.dumps(prepared.job), prepared.part_brep, prepared.nondesign_brep)
-    except core.TopOptError as e:
-        raise _native_error(e) from None
+    result = worker.run("mesh", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
+                        on_progress=on_progress, cancel=cancel)
     study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]
     study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
     study.MeshDomains = [int(i) for i in result["domain"]]
@@ -79,8 +76,10 @@ def _report_warnings(result):
 
 def apply(study, result):
     """Stores the run's mesh, densities and history in the study and shows the result shape as
-    a Mesh feature (created once, updated on later runs). Returns that feature."""
+    a Mesh feature (created once, updated on later runs). Returns that feature. Everything is
+    converted before the first property is set, so that a bad result leaves the study as it was."""
     doc = study.Document
+    shape = result_mesh(result["surface_points"], result["surface_triangles"])
     study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]
     study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
     study.MeshDomains = [int(i) for i in result["domain"]]
@@ -93,34 +92,33 @@ def apply(study, result):
     if feature is None:
         feature = doc.addObject("Mesh::Feature", study.Name + "_Result")
         study.Result = feature
-    feature.Mesh = result_mesh(result["surface_points"], result["surface_triangles"])
+    feature.Mesh = shape
     doc.recompute()
     return feature
 
 
-def run(study, on_progress=None):
+def run(study, on_progress=None, cancel=None):
     """prepare → execute → apply in the calling thread; returns the result Mesh feature."""
-    return apply(study, execute(prepare(study), on_progress))
+    return apply(study, execute(prepare(study), on_progress, cancel))
 
 
-def reextract(study, threshold):
+def reextract(study, threshold, cancel=None):
     """Re-extracts the result shape from the stored densities at another threshold (no
-    re-run). Returns the result Mesh feature."""
-    core = native()
+    re-run), in the worker process. threshold: in (0, 1); cancel(): polled, True cancels.
+    Stopped after REEXTRACT_TIMEOUT seconds. Returns the result Mesh feature.
+    Raises TopOptError if the study has no result, if what it stored is damaged, or if the
+    worker fails (the document is then unchanged)."""
     if not study.Densities:
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
-    import numpy as np
-    nodes = np.array([[v.x, v.y, v.z] for v in study.MeshNodes])
-    tets = np.array(study.MeshTets, dtype=np.int32).reshape(-1, 4)
-    domain = np.array(study.MeshDomains, dtype=np.int32)
-    dens = np.array(study.Densities)
-    try:
-        points, triangles = core.extract_surface(nodes, tets, domain, dens, float(threshold))
-    except core.TopOptError as e:
-        raise _native_error(e) from None
-    study.Threshold = float(threshold)
+    threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
+    nodes, tets, domain, densities = checks.stored_mesh(study)
+    result = worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
+                                                   "densities": densities},
+                        params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
+    shape = result_mesh(result["surface_points"], result["surface_triangles"])
+    study.Threshold = threshold
     feature = study.Result or study.Document.addObject("Mesh::Feature", study.Name + "_Result")
     study.Result = feature
-    feature.Mesh = result_mesh(points, triangles)
+    feature.Mesh = shape
     study.Document.recompute()
     return feature

@@ -43,10 +43,11 @@ class Study:
         _add(obj, "App::PropertyInteger", "WallLayers", "Mesh",
              "Element layers across walls thinner than two mesh sizes (native mesher; 0 = off, "
              "2 = two layers, more elements)", 0)
-        if "VolumeFraction" not in obj.PropertiesList:
-            obj.addProperty("App::PropertyFloatConstraint", "VolumeFraction", "Optimization",
-                            "Share of the design domain's volume to keep, in (0, 1)")
-            obj.VolumeFraction = (0.3, 0.01, 0.99, 0.01)
+        # a plain float, checked when the study is run (job.study_numbers): a constrained float
+        # would silently clamp 0 to its lower bound and run (documents saved with the older
+        # PropertyFloatConstraint load without its bounds, so they behave the same)
+        _add(obj, "App::PropertyFloat", "VolumeFraction", "Optimization",
+             "Share of the design domain's volume to keep, strictly between 0 and 1", 0.3)
         _add(obj, "App::PropertyFloat", "Penalty", "Optimization", "SIMP penalty p", 3.0)
         _add(obj, "App::PropertyLength", "FilterRadius", "Optimization",
              "Density filter radius; 0 = 1.5 × mesh size", 0.0)

@@ -50,7 +50,9 @@ class NewStudy:
         sel = [o for o in FreeCADGui.Selection.getSelection() if hasattr(o, "Shape")]
         if not sel:
             raise TopOptError("select the part (a solid) first, then any non-design solids")
-        api.info(sel[0].Shape, [o.Shape for o in sel[1:]] or None)  # checks, with clear errors
+        from topopt.gui.waiting import WaitDialog
+        with WaitDialog("Checking the shapes") as wait:  # checks, with clear errors
+            api.info(sel[0].Shape, [o.Shape for o in sel[1:]] or None, cancel=wait.cancel)
         FreeCAD.ActiveDocument.openTransaction("New TopOpt study")
         study = api.new_study(FreeCAD.ActiveDocument, sel[0], sel[1:])
         FreeCAD.ActiveDocument.commitTransaction()
@@ -164,8 +166,10 @@ class MeshStudy:
         from topopt.app import runner
         from topopt.gui import display
         study = active_study()
+        from topopt.gui.waiting import WaitDialog
         FreeCAD.Console.PrintMessage("TopOpt: meshing %s…\n" % study.Label)
-        result = runner.mesh_only(study)
+        with WaitDialog("Meshing %s" % study.Label) as wait:
+            result = runner.mesh_only(study, wait.on_progress, wait.cancel)
         display.show_domains(study)
         FreeCAD.Console.PrintMessage("TopOpt: %d nodes, %d tets (mean radius ratio %.2f)\n" % (
             len(result["nodes"]), len(result["tets"]), result["mean_radius_ratio"]))

@@ -3,7 +3,7 @@ density) as Mesh features in the document, grouped under the study's result grou
 import FreeCAD
 import numpy as np
 
-from topopt.app import display
+from topopt.app import checks, display
 
 _DOMAIN_COLOURS = [(0.75, 0.75, 0.78), (0.90, 0.35, 0.20), (0.20, 0.55, 0.90), (0.30, 0.75, 0.35),
                    (0.85, 0.70, 0.20), (0.60, 0.35, 0.80), (0.20, 0.75, 0.75), (0.85, 0.45, 0.65)]
@@ -23,10 +23,8 @@ def _feature(doc, name, label):
 
 
 def _arrays(study):
-    nodes = np.array([[v.x, v.y, v.z] for v in study.MeshNodes])
-    tets = np.array(study.MeshTets, dtype=np.int64).reshape(-1, 4)
-    domain = np.array(study.MeshDomains, dtype=np.int64)
-    return nodes, tets, domain
+    """The study's stored mesh, checked (a damaged document gives a TopOptError, not a crash)."""
+    return checks.stored_tets(study)
 
 
 def show_domains(study):

@@ -14,14 +14,17 @@ from topopt.gui.plot import HistoryPlot
 def report_error(e):
     """Shows a TopOpt error in the report view (and a message box when the GUI is visible)."""
     FreeCAD.Console.PrintError("TopOpt: %s\n" % e)
+    if getattr(e, "details", ""):  # the worker's last words, for a bug report
+        FreeCAD.Console.PrintLog("TopOpt worker output:\n%s\n" % e.details)
     mw = FreeCADGui.getMainWindow()
     if mw is not None and mw.isVisible() and not FreeCAD.ConfigGet("TopOptNoDialogs"):
         QtWidgets.QMessageBox.warning(mw, "TopOpt", str(e))
 
 
 class StudyPanel:
-    """Task panel of a study. Runs on a worker thread; the document is only touched here, in
-    the GUI thread, when the run ends."""
+    """Task panel of a study. A run is the worker process (topopt.app.worker), followed from a
+    thread of this panel; the document is only touched here, in the GUI thread, when the run
+    has succeeded. Cancel kills the worker at once, even one that has gone silent."""
 
     def __init__(self, study):
         self.study = study
@@ -76,6 +79,7 @@ class StudyPanel:
         self.progress.setRange(0, 100)
         layout.addWidget(self.progress)
         self.status = QtWidgets.QLabel(study.Status or "")
+        self.status.setWordWrap(True)  # an error says what to try: all of it must show
         layout.addWidget(self.status)
         self.plot = HistoryPlot()
         self.plot.set_history(study.ComplianceHistory, study.VolumeHistory)
@@ -137,7 +141,7 @@ class StudyPanel:
             self.messages.put(("progress", record))
             return self.cancel_requested
         try:
-            self.messages.put(("done", runner.execute(prepared, on_progress)))
+            self.messages.put(("done", runner.execute(prepared, on_progress, lambda: self.cancel_requested)))
         except TopOptError as e:
             self.messages.put(("error", e))
         except Exception as e:  # never let a worker exception vanish
@@ -187,8 +191,10 @@ class StudyPanel:
             self.poll()
 
     def reextract(self):
+        from topopt.gui.waiting import WaitDialog
         try:
-            runner.reextract(self.study, self.threshold.value() / 100.0)
+            with WaitDialog("Extracting the result shape") as wait:
+                runner.reextract(self.study, self.threshold.value() / 100.0, wait.cancel)
         except TopOptError as e:
             report_error(e)
 

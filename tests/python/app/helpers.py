@@ -11,3 +11,72 @@ def example(name):
 def bundled(name):
     """A file of the project's bundled examples (examples/)."""
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "examples", name)
+
+
+def box_study(name="Box", iterations=6, mesh_size=4.0):
+    """A document with a 60 x 10 x 10 mm box fixed at x = 0 (Face1) and pulled down at x = 60
+    (Face2), and a study on it that runs in a few seconds. Returns (doc, study)."""
+    import FreeCAD
+    import Part
+    from topopt.app import api
+    doc = FreeCAD.newDocument(name)
+    part = doc.addObject("Part::Feature", "Beam")
+    part.Shape = Part.makeBox(60, 10, 10)
+    doc.recompute()
+    study = api.new_study(doc, part, (), volume_fraction=0.4, mesh_size=mesh_size)
+    study.MaxIterations = iterations
+    api.add_fixed(study, "Face1")
+    api.add_force(study, "Face2", (0, 0, -100))
+    doc.recompute()
+    return doc, study
+
+
+def _describe(value):
+    """A comparable stand-in for a property value (objects by name, shapes and meshes by
+    their counts and volume)."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_describe(v) for v in value)
+    if hasattr(value, "TypeId") and hasattr(value, "Document") and hasattr(value, "Name"):
+        return ("object", value.Name)
+    if hasattr(value, "CountFacets"):
+        return ("mesh", value.CountPoints, value.CountFacets, round(value.Volume, 6))
+    if hasattr(value, "ShapeType"):
+        return ("shape", value.ShapeType, len(value.Faces), round(value.Volume, 6))
+    if type(value).__name__ in ("Vector", "Placement", "Rotation", "Quantity"):
+        return str(value)
+    text = repr(value)
+    if " at 0x" in text:  # a Python object (a proxy): its class, not its address
+        return ("instance", type(value).__module__, type(value).__name__)
+    return text
+
+
+def snapshot(doc):
+    """{object name: (type, {property: value})} of every object of `doc`, to tell whether a
+    failed call left the document exactly as it was."""
+    out = {}
+    for o in doc.Objects:
+        props = {}
+        for p in o.PropertiesList:
+            try:
+                props[p] = _describe(o.getPropertyByName(p))
+            except Exception as e:  # a property that cannot be read is recorded as such
+                props[p] = "unreadable: %s" % type(e).__name__
+        out[o.Name] = (o.TypeId, props)
+    return out
+
+
+def worker_children():
+    """The worker processes (comm 'topopt') that this process started and that still exist."""
+    import os
+    mine = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open("/proc/%s/stat" % pid) as f:
+                stat = f.read()
+        except OSError:
+            continue
+        comm = stat[stat.index("(") + 1:stat.rindex(")")]
+        ppid = int(stat[stat.rindex(")") + 2:].split()[1])
+        if comm == "topopt" and ppid == os.getpid():
+            mine.append(int(pid))
+    return mine

@@ -68,7 +68,7 @@ class StudyFromScript(unittest.TestCase):
         study.WallLayers = 7
         with self.assertRaises(api.TopOptError) as ctx:
             api.job_of(study)
-        self.assertIn("wall layers", str(ctx.exception))
+        self.assertIn("WallLayers is 7, outside [0, 4]", str(ctx.exception))
 
     def test_native_mesh_is_tagged_with_the_brep_volumes(self):
         # the 14-step mesher through the study: every domain's tet volume is its solid's

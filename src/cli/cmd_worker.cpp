@@ -1,0 +1,374 @@
+// topopt worker REQUEST.json: runs one request of the FreeCAD workbench in its own process, so
+// that a crash, abort or hang of OCCT, Gmsh or our code ends this process and never FreeCAD.
+// Progress streams as JSON lines on stdout (cli/worker_channel.h); results go to files.
+#include <sys/prctl.h>
+#include <unistd.h>
+#include <Standard_Failure.hxx>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "brep/report.h"
+#include "brep/shape_io.h"
+#include "brep/topology_index.h"
+#include "brep/two_breps.h"
+#include "cli/commands.h"
+#include "cli/worker_channel.h"
+#include "common/error.h"
+#include "io/job.h"
+#include "io/npy.h"
+#include "mesh/core/tet_quality.h"
+#include "mesh/surface/surface_check.h"
+#include "mesh/surface/surface_mesher.h"
+#include "pipeline/optimize_job.h"
+#include "pipeline/solve_job.h"
+
+namespace topopt::cli {
+namespace {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+const char* kUsage =
+    "usage: topopt worker REQUEST.json\n"
+    "  Runs one request of the FreeCAD workbench out of FreeCAD's process. REQUEST.json:\n"
+    "    {\"operation\": \"optimize\" | \"mesh\" | \"info\" | \"surface_mesh\" | \"extract_surface\",\n"
+    "     \"job\": {...} (the job, inline: optimize, mesh), \"part\", \"nondesign\": shape files\n"
+    "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
+    "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
+    "     extract_surface: threshold, volume_fraction, smoothing_iterations), \"output\": DIR}\n"
+    "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
+    "  progress {\"stage\", \"fraction\", \"message\"}, iterations {\"iteration\", \"compliance\",\n"
+    "  \"volume\", \"change\", \"seconds\"}, {\"warning\"}, and last {\"done\": true} or {\"error\":\n"
+    "  {\"code\", \"message\", \"stage\"}}. Writes DIR/result.json (scalars, history, warnings, and\n"
+    "  \"arrays\": the names of the DIR/NAME.npy files written).\n"
+    "  TOPOPT_FAULT=STAGE[/WORD]:abort|segv|hang (tests only) makes the worker fail at that stage.";
+
+/// A request as the workbench writes it (see kUsage), with its paths made absolute.
+struct Request {
+  std::string operation;
+  json job;
+  std::string part, nondesign;
+  std::map<std::string, std::string> arrays;
+  json params = json::object();
+  fs::path base;  ///< the request file's folder
+  fs::path output;
+};
+
+/// Reads REQUEST.json; relative paths are taken from its folder, the output folder is created.
+/// Throws Error(Io) for a missing file, Error(InvalidParameter) naming a malformed key.
+Request read_request(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw Error(ErrorCode::Io, "worker request not found: " + path);
+  json j = json::parse(f, nullptr, false);
+  if (!j.is_object()) throw Error(ErrorCode::InvalidParameter, "worker request " + path + " is not a JSON object");
+  const fs::path base = fs::absolute(path).parent_path();
+  auto file = [&](const std::string& key) -> std::string {
+    if (!j.contains(key) || j[key].is_null() || j[key] == "") return "";
+    if (!j[key].is_string()) throw Error(ErrorCode::InvalidParameter, "worker request: \"" + key + "\" is not a path");
+    return (base / j[key].get<std::string>()).string();
+  };
+  Request r;
+  r.base = base;
+  r.operation = j.value("operation", "");
+  r.job = j.value("job", json());
+  r.part = file("part");
+  r.nondesign = file("nondesign");
+  if (j.contains("arrays") && !j["arrays"].is_object())
+    throw Error(ErrorCode::InvalidParameter, "worker request: \"arrays\" must map names to NPY files");
+  const json arrays = j.value("arrays", json::object());
+  for (const auto& [name, value] : arrays.items()) {
+    if (!value.is_string())
+      throw Error(ErrorCode::InvalidParameter, "worker request: array \"" + name + "\" is not a path");
+    r.arrays[name] = (base / value.get<std::string>()).string();
+  }
+  r.params = j.value("params", json::object());
+  r.output = file("output");
+  if (r.output.empty()) throw Error(ErrorCode::InvalidParameter, "worker request: \"output\" folder missing");
+  std::error_code ec;
+  fs::create_directories(r.output, ec);
+  if (ec) throw Error(ErrorCode::Io, "cannot create the output folder " + r.output.string() + ": " + ec.message());
+  return r;
+}
+
+/// params.KEY as a number (`fallback` when absent); Error(InvalidParameter) if not a number.
+double param(const Request& r, const std::string& key, double fallback) {
+  if (!r.params.contains(key) || r.params[key].is_null()) return fallback;
+  if (!r.params[key].is_number())
+    throw Error(ErrorCode::InvalidParameter, "worker request: params." + key + " must be a number");
+  return r.params[key].get<double>();
+}
+
+/// The NPY file the request gives for array `name`, read.
+io::NpyArray array_of(const Request& r, const std::string& name) {
+  auto it = r.arrays.find(name);
+  if (it == r.arrays.end()) throw Error(ErrorCode::InvalidParameter, "worker request: array \"" + name + "\" missing");
+  return io::read_npy(it->second);
+}
+
+/// Writes `array` to DIR/NAME.npy and lists NAME in result["arrays"].
+template <typename Array>
+void put_array(json& result, const fs::path& dir, const std::string& name, const Array& array) {
+  io::write_npy((dir / (name + ".npy")).string(), array);
+  result["arrays"].push_back(name);
+}
+
+/// The tet mesh's arrays under the names the workbench reads (as the Python module's dicts).
+void put_tet_mesh(json& result, const fs::path& dir, const TetMesh& mesh) {
+  put_array(result, dir, "nodes", mesh.V);
+  put_array(result, dir, "tets", mesh.T);
+  put_array(result, dir, "domain", mesh.domain);
+  put_array(result, dir, "boundary_triangles", mesh.F);
+  put_array(result, dir, "boundary_faces", mesh.face);
+  put_array(result, dir, "boundary_nondesign_faces", mesh.nd_face);
+}
+
+/// The result shape's arrays: surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q.
+void put_result_surface(json& result, const fs::path& dir, const result::TriSurface& s) {
+  put_array(result, dir, "surface_points", s.V);
+  put_array(result, dir, "surface_triangles", s.F);
+  put_array(result, dir, "surface_tags", s.tag);
+}
+
+/// The request's part and non-design shapes (null shapes where none is given).
+std::pair<TopoDS_Shape, TopoDS_Shape> read_shapes(const Request& r, WorkerChannel& ch) {
+  std::pair<TopoDS_Shape, TopoDS_Shape> shapes;
+  if (!r.part.empty()) {
+    ch.progress("read", 0, "reading the part");
+    shapes.first = brep::read_shape_file(r.part);
+  }
+  if (!r.nondesign.empty()) {
+    ch.progress("read", 0.5, "reading the non-design solids");
+    shapes.second = brep::read_shape_file(r.nondesign);
+  }
+  return shapes;
+}
+
+/// The request's inline job, parsed and checked as a job file is.
+io::Job job_of(const Request& r) {
+  if (!r.job.is_object()) throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object");
+  return io::parse_job(r.job.dump(), r.base.string());
+}
+
+/// info: the shapes checked and classified; result.json holds {"report"} (topopt info --json).
+json op_info(const Request& r, WorkerChannel& ch) {
+  auto [part, nd] = read_shapes(r, ch);
+  if (part.IsNull()) throw Error(ErrorCode::InvalidParameter, "no part given");
+  brep::ClassifyParams params;
+  params.tolerance = param(r, "tolerance", -1);
+  std::vector<std::string> warnings;
+  const brep::TwoBReps two = brep::load_two_breps(part, nd, params, ch.make_progress(warnings));
+  return {{"report", brep::two_breps_report(two)}, {"warnings", warnings}};
+}
+
+/// surface_mesh: the native surface mesh of the part (nodes, triangles, faces) and its checks.
+json op_surface_mesh(const Request& r, WorkerChannel& ch) {
+  mesh::SurfaceMeshParams p;
+  p.size = param(r, "size", 0);
+  if (!(p.size >= 0))
+    throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
+  p.wall_layers = mesh::wall_layers_option(param(r, "wall_layers", 0));
+  auto shapes = read_shapes(r, ch);
+  if (shapes.first.IsNull()) throw Error(ErrorCode::InvalidParameter, "no shape given");
+  const brep::TopologyIndex topo = brep::index_topology(shapes.first);
+  ch.progress("mesh", 0, "meshing the faces");
+  std::vector<std::string> warnings;
+  const mesh::SurfaceMesh sm = mesh::mesh_surface(topo, p, ch.make_progress(warnings));
+  ch.progress("mesh", 0.9, "checking the surface");
+  long crossings = 0;
+  for (int s = 0; s < topo.num_solids(); ++s)
+    crossings += static_cast<long>(mesh::self_intersections(sm.V, mesh::solid_triangles(topo, sm, s)).size());
+  const mesh::SurfaceQuality q = mesh::surface_quality(sm.V, sm.F);
+  json result = {{"failed_faces", sm.failed_faces},
+                 {"failure_reasons", sm.reasons},
+                 {"open_edges_per_solid", mesh::open_edges_per_solid(topo, sm)},
+                 {"self_intersecting_pairs", crossings},
+                 {"min_angle", q.min_angle},
+                 {"share_below_20deg", q.share_below_20},
+                 {"warnings", warnings}};
+  ch.progress("write", -1, "writing the results");
+  put_array(result, r.output, "nodes", sm.V);
+  put_array(result, r.output, "triangles", sm.F);
+  put_array(result, r.output, "faces", sm.face);
+  return result;
+}
+
+/// mesh: the job's conformal tagged tet mesh and its quality figures.
+json op_mesh(const Request& r, WorkerChannel& ch) {
+  const io::Job job = job_of(r);
+  auto [part, nd] = read_shapes(r, ch);
+  std::vector<std::string> warnings;
+  const Progress progress = ch.make_progress(warnings);
+  const TetMesh mesh =
+      job.mesh_file.empty() ? pipeline::mesh_job_shapes(job, part, nd, progress) : pipeline::job_mesh(job, progress);
+  const mesh::QualityReport q = mesh::tet_quality(mesh);
+  json result = {
+      {"min_radius_ratio", q.min_radius_ratio}, {"mean_radius_ratio", q.mean_radius_ratio}, {"warnings", warnings}};
+  ch.progress("write", -1, "writing the results");
+  put_tet_mesh(result, r.output, mesh);
+  return result;
+}
+
+/// What one optimisation produced: the analysis mesh and the SIMP result with its surface.
+struct OptimizeOutcome {
+  TetMesh mesh;
+  pipeline::OptimizeResult result;
+};
+
+/// mesh → SIMP → result surface for a job and its shapes (or the job's mesh file): the same
+/// sequence as the Python module's run_job, the one pipeline::run_job is to own.
+OptimizeOutcome optimize_shapes(const io::Job& job, const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
+                                const Progress& progress,
+                                const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+  pipeline::optimize_settings(job);  // a bad setting is reported before meshing
+  OptimizeOutcome out;
+  if (job.mesh_file.empty() && part.IsNull()) throw Error(ErrorCode::InvalidParameter, "no part given");
+  out.mesh = job.mesh_file.empty() ? pipeline::mesh_job_shapes(job, part, nondesign, progress)
+                                   : pipeline::job_mesh(job, progress);
+  out.result = pipeline::optimize_job(job, out.mesh, progress, on_iteration);
+  return out;
+}
+
+/// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
+json op_optimize(const Request& r, WorkerChannel& ch) {
+  const io::Job job = job_of(r);
+  auto [part, nd] = read_shapes(r, ch);
+  std::vector<std::string> warnings;
+  const OptimizeOutcome o = optimize_shapes(job, part, nd, ch.make_progress(warnings),
+                                            [&ch](const simp::IterationRecord& rec) { ch.iteration(rec); });
+  json history = json::array();
+  for (const auto& h : o.result.simp.history)
+    history.push_back({{"iteration", h.iteration},
+                       {"compliance", h.compliance},
+                       {"volume", h.volume_fraction},
+                       {"change", h.change},
+                       {"seconds", h.seconds}});
+  json result = {{"history", history},
+                 {"threshold", o.result.threshold},
+                 {"status", o.result.simp.status},
+                 {"seconds", {o.result.seconds_simp, o.result.seconds_surface}},
+                 {"warnings", warnings}};
+  ch.progress("write", -1, "writing the results");
+  put_tet_mesh(result, r.output, o.mesh);
+  put_array(result, r.output, "densities", o.result.simp.density);
+  put_result_surface(result, r.output, o.result.surface);
+  return result;
+}
+
+/// Index array `a` (#rows by cols) as ints, each in [0, limit). Throws InvalidParameter
+/// naming the array, the row and the value.
+template <typename Out>
+Out indices(const io::NpyArray& a, long cols, const std::string& what, long long limit, const std::string& range) {
+  const io::RowMatXl m = io::npy_integer(a, cols, what);
+  for (long i = 0; i < m.rows(); ++i)
+    for (long k = 0; k < m.cols(); ++k)
+      if (m(i, k) < 0 || m(i, k) >= limit)
+        throw Error(ErrorCode::InvalidParameter,
+                    what + ": row " + std::to_string(i) + " holds " + std::to_string(m(i, k)) + ", outside " + range);
+  return m.cast<int>();
+}
+
+/// The tet mesh and densities of an extract_surface request, every index and length checked.
+std::pair<TetMesh, VecXd> checked_densities(const Request& r) {
+  TetMesh mesh;
+  mesh.V = io::npy_real(array_of(r, "nodes"), 3, "nodes");
+  const long nv = mesh.V.rows();
+  mesh.T = indices<MatX4i>(array_of(r, "tets"), 4, "tets", nv, "the node numbers 0.." + std::to_string(nv - 1));
+  const long nt = mesh.T.rows();
+  if (nt == 0) throw Error(ErrorCode::InvalidParameter, "tets: the mesh has no tets");
+  if (r.arrays.count("domain")) {
+    mesh.domain = indices<VecXi>(array_of(r, "domain"), 1, "domain", 1LL << 30, "0 and above");
+    if (mesh.domain.size() != nt)
+      throw Error(ErrorCode::InvalidParameter, "domain: " + std::to_string(mesh.domain.size()) + " tags for " +
+                                                   std::to_string(nt) + " tets; one per tet expected");
+  } else {
+    mesh.domain = VecXi::Zero(nt);
+  }
+  VecXd density = io::npy_real(array_of(r, "densities"), 1, "densities");
+  if (density.size() != nt)
+    throw Error(ErrorCode::InvalidParameter, "densities: " + std::to_string(density.size()) + " values for " +
+                                                 std::to_string(nt) + " tets; one per tet expected");
+  return {mesh, density};
+}
+
+/// extract_surface: the result shape of given densities at a threshold (or volume fraction).
+json op_extract_surface(const Request& r, WorkerChannel& ch) {
+  const double threshold = param(r, "threshold", -1), volume_fraction = param(r, "volume_fraction", -1);
+  if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
+    throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
+  result::SmoothParams smooth;
+  smooth.iterations = static_cast<int>(param(r, "smoothing_iterations", 20));
+  if (smooth.iterations < 0 || smooth.iterations > 1000)
+    throw Error(ErrorCode::InvalidParameter, "smoothing_iterations must lie in [0, 1000]");
+  ch.progress("read", 0, "reading the densities");
+  const auto [mesh, density] = checked_densities(r);
+  ch.progress("surface", -1, "extracting the result shape");
+  double used = 0;
+  const result::TriSurface s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
+                                                        volume_fraction, smooth, &used);
+  json result = {{"threshold", used}};
+  ch.progress("write", -1, "writing the results");
+  put_result_surface(result, r.output, s);
+  return result;
+}
+
+/// Runs the request's operation; returns what goes into result.json.
+json run_operation(const Request& r, WorkerChannel& ch) {
+  const std::map<std::string, json (*)(const Request&, WorkerChannel&)> ops{{"info", op_info},
+                                                                            {"surface_mesh", op_surface_mesh},
+                                                                            {"mesh", op_mesh},
+                                                                            {"optimize", op_optimize},
+                                                                            {"extract_surface", op_extract_surface}};
+  auto it = ops.find(r.operation);
+  if (it == ops.end())
+    throw Error(ErrorCode::InvalidParameter, "worker request: unknown operation '" + r.operation +
+                                                 "' (optimize, mesh, info, surface_mesh, extract_surface)");
+  json result = it->second(r, ch);
+  if (!result.contains("arrays")) result["arrays"] = json::array();
+  return result;
+}
+
+/// The worker ends with the process that started it (FreeCAD), even if that one is killed.
+void end_with_parent() {
+  const pid_t parent = ::getppid();
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(1);
+}
+
+/// Writes DIR/result.json.
+void write_result(const fs::path& dir, const json& result) {
+  const std::string path = (dir / "result.json").string();
+  std::ofstream f(path);
+  f << result.dump(-1, ' ', false, json::error_handler_t::replace) << "\n";
+  if (!f) throw Error(ErrorCode::Io, "cannot write " + path);
+}
+
+}  // namespace
+
+int cmd_worker(const Args& args) {
+  ArgReader a(args, kUsage);
+  if (a.print_help()) return 0;
+  const std::vector<std::string> pos = a.positionals();
+  if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one request file\n" + a.usage());
+  end_with_parent();
+  WorkerChannel ch;
+  try {
+    ch.inject_at(fault_from_environment());
+    const Request r = read_request(pos[0]);
+    write_result(r.output, run_operation(r, ch));
+    ch.done();
+    return 0;
+  } catch (const Error& e) {
+    ch.error(error_code_name(e.code()), e.what());
+  } catch (const Standard_Failure& e) {
+    ch.error("Internal", std::string("geometry kernel error: ") + (e.GetMessageString() ? e.GetMessageString() : "?"));
+  } catch (const std::bad_alloc&) {
+    ch.error("TooLarge", "out of memory: use a coarser mesh size");
+  } catch (const std::exception& e) {
+    ch.error("Internal", std::string("internal error: ") + e.what());
+  }
+  return 1;
+}
+
+}  // namespace topopt::cli

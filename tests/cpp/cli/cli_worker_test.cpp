@@ -1,0 +1,203 @@
+// topopt worker as the FreeCAD workbench drives it: JSON lines on stdout (and nothing else
+// there), results in result.json and NPY files, the core's errors as a last error line naming
+// the stage, and the test-only TOPOPT_FAULT ending or stalling the worker at a chosen stage.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <BRepPrimAPI_MakeBox.hxx>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "brep/shape_io.h"
+#include "io/npy.h"
+
+namespace {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+/// What one worker run printed: its exit status as the shell reports it (128 + N when signal
+/// N ended it) and its stdout lines, each parsed as JSON.
+struct WorkerRun {
+  int status = -1;
+  std::vector<json> lines;
+  bool all_json = true;
+  const json& last() const { return lines.back(); }
+};
+
+WorkerRun run_worker(const fs::path& request, const std::string& env = "", const std::string& wrapper = "") {
+  const std::string cmd =
+      env + " " + wrapper + " " + TOPOPT_CLI + " worker " + request.string() + " 2>/dev/null; echo \"status=$?\"";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  size_t n;
+  while (pipe && (n = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
+  if (pipe) pclose(pipe);
+  WorkerRun r;
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("status=", 0) == 0) {
+      r.status = std::stoi(line.substr(7));
+      continue;
+    }
+    json j = json::parse(line, nullptr, false);
+    r.all_json = r.all_json && j.is_object();
+    r.lines.push_back(j);
+  }
+  return r;
+}
+
+class CliWorker : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("topopt_cli_worker_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path request(const json& r) {
+    const fs::path p = dir_ / "request.json";
+    std::ofstream(p) << r.dump();
+    return p;
+  }
+
+  /// A unit cube split into 6 positive tets, its arrays written as NPY files; densities all `rho`.
+  json cube_arrays(int bad_node = -1) {
+    topopt::MatX3d V(8, 3);
+    for (int i = 0; i < 8; ++i) V.row(i) << (i & 1), (i >> 1) & 1, (i >> 2) & 1;
+    topopt::MatX4i T(6, 4);
+    T << 0, 1, 3, 7, 0, 1, 7, 5, 0, 5, 7, 4, 0, 3, 2, 7, 0, 2, 6, 7, 0, 6, 4, 7;
+    if (bad_node >= 0) T(2, 1) = bad_node;
+    topopt::io::write_npy((dir_ / "nodes.npy").string(), V);
+    topopt::io::write_npy((dir_ / "tets.npy").string(), T);
+    topopt::io::write_npy((dir_ / "densities.npy").string(), topopt::VecXd(topopt::VecXd::Ones(6)));
+    return {{"nodes", "nodes.npy"}, {"tets", "tets.npy"}, {"densities", "densities.npy"}};
+  }
+
+  json extract_request(int bad_node = -1) {
+    return {{"operation", "extract_surface"},
+            {"arrays", cube_arrays(bad_node)},
+            {"params", {{"threshold", 0.5}, {"smoothing_iterations", 0}}},
+            {"output", "out"}};
+  }
+
+  fs::path dir_;
+};
+
+/// The volume enclosed by a closed, outward triangle surface (divergence theorem).
+double enclosed_volume(const topopt::io::RowMatXd& P, const topopt::io::RowMatXl& F) {
+  double v = 0;
+  for (long t = 0; t < F.rows(); ++t) {
+    Eigen::Vector3d a = P.row(F(t, 0)), b = P.row(F(t, 1)), c = P.row(F(t, 2));
+    v += a.dot(b.cross(c)) / 6.0;
+  }
+  return v;
+}
+
+TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
+  std::ofstream(dir_ / "beam.brep") << topopt::brep::write_brep_string(BRepPrimAPI_MakeBox(60, 10, 10).Shape());
+  const json job = {
+      {"mesh", {{"size", 4.0}}},
+      {"material", {{"E", 210000}, {"nu", 0.3}}},
+      {"supports", {{{"type", "fixed"}, {"faces", {"Face1"}}}}},
+      {"load_cases",
+       {{{"name", "tip"}, {"loads", {{{"type", "force"}, {"faces", {"Face2"}}, {"vector", {0, 0, -100}}}}}}}},
+      {"optimization", {{"volume_fraction", 0.4}, {"max_iterations", 3}}}};
+  const WorkerRun r =
+      run_worker(request({{"operation", "optimize"}, {"job", job}, {"part", "beam.brep"}, {"output", "out"}}));
+  ASSERT_EQ(r.status, 0);
+  ASSERT_TRUE(r.all_json) << "stdout holds only protocol lines";
+  EXPECT_EQ(r.last(), json({{"done", true}}));
+  int iterations = 0;
+  bool meshed = false;
+  for (const auto& l : r.lines) {
+    iterations += l.contains("iteration");
+    meshed = meshed || l.value("stage", "") == "mesh";
+  }
+  EXPECT_TRUE(meshed);
+  json result;
+  std::ifstream(dir_ / "out" / "result.json") >> result;
+  EXPECT_EQ(static_cast<int>(result["history"].size()), iterations);
+  EXPECT_GE(iterations, 1);
+  using namespace topopt::io;
+  const RowMatXd V = npy_real(read_npy((dir_ / "out" / "nodes.npy").string()), 3, "nodes");
+  const RowMatXl T = npy_integer(read_npy((dir_ / "out" / "tets.npy").string()), 4, "tets");
+  EXPECT_LT(T.maxCoeff(), V.rows());
+  EXPECT_EQ(read_npy((dir_ / "out" / "densities.npy").string()).rows(), T.rows());
+  EXPECT_EQ(read_npy((dir_ / "out" / "domain.npy").string()).rows(), T.rows());
+  const RowMatXd P = npy_real(read_npy((dir_ / "out" / "surface_points.npy").string()), 3, "points");
+  const RowMatXl F = npy_integer(read_npy((dir_ / "out" / "surface_triangles.npy").string()), 3, "triangles");
+  EXPECT_LT(F.maxCoeff(), P.rows());
+  const double kept = enclosed_volume(P, F) / 6000.0;
+  EXPECT_NEAR(kept, 0.4, 0.05);  // the result shape keeps the volume fraction
+  for (const char* name :
+       {"nodes", "tets", "domain", "boundary_triangles", "boundary_faces", "boundary_nondesign_faces", "densities",
+        "surface_points", "surface_triangles", "surface_tags"})
+    EXPECT_NE(std::find(result["arrays"].begin(), result["arrays"].end(), name), result["arrays"].end()) << name;
+}
+
+TEST_F(CliWorker, ExtractSurfaceOfAFullCubeIsTheCube) {
+  const WorkerRun r = run_worker(request(extract_request()));
+  ASSERT_EQ(r.status, 0);
+  EXPECT_EQ(r.last(), json({{"done", true}}));
+  using namespace topopt::io;
+  const RowMatXd P = npy_real(read_npy((dir_ / "out" / "surface_points.npy").string()), 3, "points");
+  const RowMatXl F = npy_integer(read_npy((dir_ / "out" / "surface_triangles.npy").string()), 3, "triangles");
+  EXPECT_EQ(F.rows(), 12);
+  EXPECT_NEAR(enclosed_volume(P, F), 1.0, 1e-12);
+}
+
+TEST_F(CliWorker, ErrorsAreALastLineNamingCodeAndStage) {
+  WorkerRun r = run_worker(request(extract_request(8)));  // a tet naming node 8 of 8
+  EXPECT_EQ(r.status, 1);
+  ASSERT_TRUE(r.last().contains("error"));
+  EXPECT_EQ(r.last()["error"]["code"], "InvalidParameter");
+  EXPECT_EQ(r.last()["error"]["stage"], "read");
+  EXPECT_EQ(r.last()["error"]["message"], "tets: row 2 holds 8, outside the node numbers 0..7");
+  r = run_worker(request({{"operation", "frobnicate"}, {"output", "out"}}));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.last()["error"]["message"].get<std::string>().find("unknown operation 'frobnicate'"), std::string::npos);
+  r = run_worker(dir_ / "missing.json");
+  EXPECT_EQ(r.last()["error"]["code"], "Io");
+  r = run_worker(request(extract_request()), "TOPOPT_FAULT=surface:explode");
+  EXPECT_NE(r.last()["error"]["message"].get<std::string>().find("expected STAGE[/WORD]:abort|segv|hang"),
+            std::string::npos);
+}
+
+TEST_F(CliWorker, FaultInjectionEndsOrStallsTheWorkerAtTheStage) {
+  // abort and access violation: the worker dies by the signal right after reporting the stage
+  for (const auto& [kind, signal] : {std::pair<std::string, int>{"abort", 6}, {"segv", 11}}) {
+    const WorkerRun r = run_worker(request(extract_request()), "TOPOPT_FAULT=surface:" + kind);
+    EXPECT_EQ(r.status, 128 + signal) << kind;
+    ASSERT_FALSE(r.lines.empty());
+    EXPECT_EQ(r.last().value("stage", ""), "surface") << kind << ": the stage's line comes out before the fault";
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "result.json"));
+  }
+  // a word narrows the stage to one message: "read/reading the densities" fires, "read/x" never does
+  EXPECT_EQ(run_worker(request(extract_request()), "TOPOPT_FAULT='read/reading the:abort'").status, 134);
+  EXPECT_EQ(run_worker(request(extract_request()), "TOPOPT_FAULT=read/x:abort").status, 0);
+  // hang: alive and silent until killed (here by timeout after 2 s)
+  const WorkerRun r = run_worker(request(extract_request()), "TOPOPT_FAULT=surface:hang", "timeout -s KILL 2");
+  EXPECT_EQ(r.status, 128 + 9);
+  EXPECT_EQ(r.last().value("stage", ""), "surface");
+}
+
+TEST_F(CliWorker, InfoReportsTheRocker) {
+  const std::string ex = std::string(TOPOPT_SHARED_DATA) + "/examples/";
+  const WorkerRun r = run_worker(request({{"operation", "info"},
+                                          {"part", ex + "rocker.step"},
+                                          {"nondesign", ex + "rocker_nondesign.step"},
+                                          {"output", "out"}}));
+  ASSERT_EQ(r.status, 0);
+  json result;
+  std::ifstream(dir_ / "out" / "result.json") >> result;
+  EXPECT_EQ(result["report"]["nondesign"]["solids"].size(), 3u);
+  EXPECT_EQ(result["arrays"], json::array());
+}
+
+}  // namespace
