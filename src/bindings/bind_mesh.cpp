@@ -6,15 +6,16 @@
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
 #include "common/error.h"
-#include "io/job.h"
 #include "mesh/core/conformity.h"
 #include "mesh/surface/surface_check.h"
 #include "mesh/surface/surface_mesher.h"
 #include "mesh/volume/volume_front.h"
 
 #include <chrono>
+#include <cmath>
 #include "mesh/core/tet_quality.h"
-#include "pipeline/solve_job.h"
+#include "pipeline/job_mesh.h"
+#include "pipeline/mesh_settings.h"
 
 namespace topopt::py {
 
@@ -22,7 +23,7 @@ void bind_mesh(pybind11::module_& m) {
   m.def(
       "mesh_shapes",
       [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep) {
-        io::Job job = io::parse_job(job_json, "");
+        const pipeline::Job job = pipeline::parse_job(job_json, "");
         TetMesh mesh;
         mesh::QualityReport q;
         std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
@@ -30,9 +31,10 @@ void bind_mesh(pybind11::module_& m) {
         keep_warnings(progress, warnings);
         {
           pybind11::gil_scoped_release release;
-          TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
-          TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
-          mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
+          pipeline::JobShapes shapes;
+          shapes.part = brep::read_brep_string(part_brep, "part");
+          if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids");
+          mesh = pipeline::job_mesh(job, shapes, progress);
           q = mesh::tet_quality(mesh);
         }
         pybind11::dict out;
@@ -62,8 +64,13 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
         {
           pybind11::gil_scoped_release release;
           const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep, "shape"));
+          pipeline::MeshSettings settings;  // the sizes, clamp and element budget of every mesher
+          settings.size = size;
+          const pipeline::MeshSizes sizes =
+              pipeline::resolve_mesh_sizes(settings, topo.diagonal(), std::abs(topo.solid_volume.sum()));
           mesh::SurfaceMeshParams p;
-          p.size = size;
+          p.size = sizes.size;
+          p.min_size = sizes.min_size;
           p.wall_layers = wall_layers;
           sm = mesh::mesh_surface(topo, p);
           open = mesh::open_edges_per_solid(topo, sm);
