@@ -134,7 +134,7 @@ void write_stats(const std::string& stats, const TetMesh& m, const mesh::Quality
 int cmd_mesh(const Args& args) {
   ArgReader a(args, kUsage);
   if (a.print_help()) return 0;
-  const std::string part = a.option("part"), nd = a.option("non-design"), out = a.option("out"),
+  const std::string part = a.option("part"), nondesign = a.option("non-design"), out = a.option("out"),
                     stats = a.option("stats");
   const pipeline::MeshSettings settings = settings_from(a);
   if (!a.positionals().empty() || part.empty() || out.empty())
@@ -146,8 +146,8 @@ int cmd_mesh(const Args& args) {
     if (!file.empty()) pipeline::prepare_output_folder(std::filesystem::absolute(file).parent_path().string(), option);
   Times t;
   t.start = clock::now();
-  const brep::TwoBReps model =
-      brep::load_two_breps(brep::read_shape_file(part), nd.empty() ? TopoDS_Shape() : brep::read_shape_file(nd));
+  const brep::TwoBReps model = brep::load_two_breps(
+      brep::read_shape_file(part), nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(nondesign));
   t.read = clock::now();
   mesh::MeshRun run;
   TetMesh m = pipeline::mesh_model(model, settings, stderr_progress(), &run);

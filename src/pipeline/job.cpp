@@ -57,7 +57,8 @@ fem::Material parse_material(const json& section) {
   m.young = f.number("E", m.young);
   m.poisson = f.number("nu", m.poisson);
   m.density = f.number("density", m.density);
-  if (!(m.young > 0 && m.young <= 1e9)) f.bad("E", "must be a Young's modulus in MPa, above 0 (steel: 210000)");
+  if (!(m.young > 0 && m.young <= 1e9))
+    f.bad("E", "must be a Young's modulus in MPa, above 0 and at most 1e9 (steel: 210000)");
   if (!(m.poisson > -1 && m.poisson < 0.5)) f.bad("nu", "must lie in (-1, 0.5) (steel: 0.3)");
   if (!(m.density >= 0 && m.density <= 1e-3)) f.bad("density", "must be a density in t/mm³ (steel: 7.85e-9)");
   return m;

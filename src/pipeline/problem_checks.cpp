@@ -48,23 +48,30 @@ void check_loads_reach_the_part(const Eigen::MatrixXd& loads, const fem::Support
   }
 }
 
-double estimated_filter_pairs(const TetMesh& mesh, double radius) {
+std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int bins) {
   std::vector<Eigen::RowVector3d> centre;
   for (long t = 0; t < mesh.T.rows(); ++t)
     if (mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0)
       centre.push_back(0.25 * (mesh.V.row(mesh.T(t, 0)) + mesh.V.row(mesh.T(t, 1)) + mesh.V.row(mesh.T(t, 2)) +
                                mesh.V.row(mesh.T(t, 3))));
+  std::vector<double> pairs(static_cast<size_t>(bins), 0.0);
   const size_t n = centre.size();
-  if (n == 0) return 0;
+  if (n == 0 || !(radius > 0)) return pairs;
   const size_t samples = std::min<size_t>(64, n);
-  const double r2 = radius * radius;
-  double neighbours = 0;
   for (size_t k = 0; k < samples; ++k) {
     const Eigen::RowVector3d& p = centre[(n * (2 * k + 1)) / (2 * samples)];
-    for (const auto& q : centre) neighbours += (q - p).squaredNorm() < r2;
+    for (const auto& q : centre) {
+      const double d = (q - p).norm();
+      if (d < radius) pairs[std::min(static_cast<size_t>(d / radius * bins), static_cast<size_t>(bins - 1))] += 1;
+    }
   }
-  return neighbours / static_cast<double>(samples) * static_cast<double>(n);
+  const double scale = static_cast<double>(n) / static_cast<double>(samples);
+  double sum = 0;
+  for (double& p : pairs) p = (sum += p) * scale;
+  return pairs;
 }
+
+double estimated_filter_pairs(const TetMesh& mesh, double radius) { return filter_pairs_within(mesh, radius, 1)[0]; }
 
 void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes) {
   const Eigen::RowVector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
@@ -75,15 +82,19 @@ void check_filter_radius(const TetMesh& mesh, double radius, bool given, double 
                     "diagonal is " + number(diagonal) + " mm), so the filter would blur the whole design into one " +
                     "grey: give about twice the mesh size, or the thinnest member you want");
   if (!(memory_bytes > 0)) return;
-  const double pairs = estimated_filter_pairs(mesh, radius);
+  const int bins = 200;
+  const std::vector<double> within = filter_pairs_within(mesh, radius, bins);
+  const double pairs = within.back();
   const double budget = 0.5 * memory_bytes / kBytesPerPair;
   if (pairs <= budget) return;
+  int fits = 0;  // the largest radius k/bins * radius whose pairs fit
+  while (fits < bins && within[fits] <= budget) ++fits;
   const std::string need = "the density filter of radius " + number(radius) + " mm would hold about " + number(pairs) +
                            " neighbour pairs (" + number(pairs * kBytesPerPair / 1e9) +
                            " GB), more than this machine's memory allows: ";
   if (given)
-    throw Error(ErrorCode::TooLarge, need + "give 'optimization.filter_radius' at most " +
-                                         number(radius * std::cbrt(budget / pairs)) + " mm");
+    throw Error(ErrorCode::TooLarge,
+                need + "give 'optimization.filter_radius' at most " + number(radius * fits / bins) + " mm");
   throw Error(ErrorCode::TooLarge, need + "use a coarser mesh size (the automatic radius is 1.5 mean edges)");
 }
 

@@ -22,6 +22,9 @@ void check_loads_reach_the_part(const Eigen::MatrixXd& loads, const fem::Support
 /// counted exactly, times the number of design tets.
 double estimated_filter_pairs(const TetMesh& mesh, double radius);
 
+/// The same estimate for the radii (k + 1) / bins × radius, k = 0 .. bins - 1 (one pass).
+std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int bins);
+
 /// Throws Error(InvalidParameter) when `radius` (mm; given = the user set
 /// 'optimization.filter_radius') exceeds the part's diagonal, and Error(TooLarge) when the
 /// filter's estimated pairs need more than half of `memory_bytes` (each pair ~90 bytes
