@@ -16,6 +16,8 @@
 
 #include "brep/shape_io.h"
 #include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "fem/elasticity.h"
 #include "mesh/core/conformity.h"
 #include "mesh/two_brep/native_mesher.h"
 #include "testing/expect_error.h"
@@ -97,6 +99,25 @@ TEST(MeshModel, GmshPastItsTimeBudgetIsANamedError) {
   expect_error([&] { mesh_model(partial_contact(), s); }, ErrorCode::Timeout,
                {"the native mesher could not mesh this part", "identical touching faces",
                 "the Gmsh fallback failed too", "did not finish"});
+}
+
+TEST(MeshModel, GmshInItsChildAfterParallelWorkInTheParent) {
+  // the workbench's process solves (CHOLMOD, BLAS and OpenMP threads) before a later run falls
+  // back to Gmsh: the forked child, which has one thread, must still mesh (not hang)
+  const brep::TwoBReps model = example("cantilever");
+  const TetMesh native = mesh_model(model, with(Mesher::Native, 2));
+  const fem::Supports s =
+      fem::make_supports(native, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}, {true, true, true}, {}}});
+  const Eigen::MatrixXd F = fem::make_loads(
+      native, {}, {fem::LoadCase{"tip", {fem::LoadSpec{fem::LoadSpec::Kind::Gravity, {}, {0, 0, -9810}, 0, {}}}, 1}});
+  fem::Elasticity fe(native, {}, s, {});
+  EXPECT_GT(F.col(0).dot(fe.solve(F).col(0)), 0);
+  MeshSettings g = with(Mesher::Gmsh, 4);
+  g.gmsh_seconds = 120;
+  mesh::MeshRun run;
+  const TetMesh m = mesh_model(model, g, {}, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_TRUE(mesh::check_conformity(m, &model).ok());
 }
 
 TEST(MeshModel, GmshWritesNoFileOfItsOwn) {
