@@ -4,7 +4,7 @@
 
 #include "bindings/bindings.h"
 #include "common/error.h"
-#include "io/job.h"
+#include "pipeline/job.h"
 #include "pipeline/solve_job.h"
 
 namespace topopt::py {
@@ -27,7 +27,7 @@ void bind_fem(pybind11::module_& m) {
         pipeline::SolveResult r;
         {
           pybind11::gil_scoped_release release;
-          io::Job job = io::parse_job(job_json, "");
+          const pipeline::Job job = pipeline::parse_job(job_json, "");
           r = pipeline::solve_job(job, mesh);
         }
         pybind11::dict out;

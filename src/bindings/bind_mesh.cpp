@@ -6,15 +6,17 @@
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
 #include "common/error.h"
-#include "io/job.h"
 #include "mesh/core/conformity.h"
 #include "mesh/surface/surface_check.h"
 #include "mesh/surface/surface_mesher.h"
 #include "mesh/volume/volume_front.h"
 
 #include <chrono>
+#include <cmath>
 #include "mesh/core/tet_quality.h"
-#include "pipeline/solve_job.h"
+#include "pipeline/job_mesh.h"
+#include "pipeline/mesh_settings.h"
+#include "pipeline/surface_job.h"
 
 namespace topopt::py {
 
@@ -22,7 +24,7 @@ void bind_mesh(pybind11::module_& m) {
   m.def(
       "mesh_shapes",
       [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep) {
-        io::Job job = io::parse_job(job_json, "");
+        const pipeline::Job job = pipeline::parse_job(job_json, "");
         TetMesh mesh;
         mesh::QualityReport q;
         std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
@@ -30,9 +32,10 @@ void bind_mesh(pybind11::module_& m) {
         keep_warnings(progress, warnings);
         {
           pybind11::gil_scoped_release release;
-          TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
-          TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
-          mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
+          pipeline::JobShapes shapes;
+          shapes.part = brep::read_brep_string(part_brep, "part");
+          if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids");
+          mesh = pipeline::job_mesh(job, shapes, progress);
           q = mesh::tet_quality(mesh);
         }
         pybind11::dict out;
@@ -55,32 +58,26 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
         if (size < 0)
           throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
         wall_layers = mesh::wall_layers_option(wall_layers);
-        mesh::SurfaceMesh sm;
-        std::vector<long> open;
-        long crossings = 0;
-        mesh::SurfaceQuality q;
+        pipeline::SurfaceJobResult r;
         {
           pybind11::gil_scoped_release release;
           const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep, "shape"));
-          mesh::SurfaceMeshParams p;
-          p.size = size;
-          p.wall_layers = wall_layers;
-          sm = mesh::mesh_surface(topo, p);
-          open = mesh::open_edges_per_solid(topo, sm);
-          for (int s = 0; s < topo.num_solids(); ++s)
-            crossings += static_cast<long>(mesh::self_intersections(sm.V, mesh::solid_triangles(topo, sm, s)).size());
-          q = mesh::surface_quality(sm.V, sm.F);
+          pipeline::MeshSettings settings;  // the sizes, clamp and element budget of every mesher
+          settings.size = size;
+          settings.wall_layers = wall_layers;
+          r = pipeline::surface_job(topo, settings);
         }
+        const mesh::SurfaceMesh& sm = r.mesh;
         pybind11::dict out;
         out["nodes"] = sm.V;
         out["triangles"] = sm.F;
         out["faces"] = sm.face;
         out["failed_faces"] = sm.failed_faces;
         out["failure_reasons"] = sm.reasons;
-        out["open_edges_per_solid"] = open;
-        out["self_intersecting_pairs"] = crossings;
-        out["min_angle"] = q.min_angle;
-        out["share_below_20deg"] = q.share_below_20;
+        out["open_edges_per_solid"] = r.open_edges_per_solid;
+        out["self_intersecting_pairs"] = r.crossings.size();
+        out["min_angle"] = r.quality.min_angle;
+        out["share_below_20deg"] = r.quality.share_below_20;
         return out;
       },
       pybind11::arg("brep"), pybind11::arg("size") = 0.0, pybind11::arg("wall_layers") = 0,

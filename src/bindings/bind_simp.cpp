@@ -8,9 +8,9 @@
 #include "bindings/bindings.h"
 #include "brep/shape_io.h"
 #include "common/error.h"
-#include "io/job.h"
+#include "pipeline/job.h"
 #include "pipeline/optimize_job.h"
-#include "pipeline/solve_job.h"
+#include "pipeline/run_job.h"
 
 namespace topopt::py {
 namespace pyb = pybind11;
@@ -19,7 +19,7 @@ void bind_simp(pyb::module_& m) {
   m.def(
       "run_job",
       [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep, pyb::object callback) {
-        io::Job job = io::parse_job(job_json, "");
+        const pipeline::Job job = pipeline::parse_job(job_json, "");
         // The callback runs with the GIL held; returning True (or raising) cancels.
         std::atomic<bool> stop{false};
         std::string callback_error;
@@ -36,8 +36,6 @@ void bind_simp(pyb::module_& m) {
         };
         Progress progress;
         progress.cancelled = [&] { return stop.load(); };
-        std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
-        keep_warnings(progress, warnings);
         progress.report = [&](const std::string& stage, double fraction, const std::string& message) {
           if (stage == "simp") return;  // iterations come as records below
           pyb::gil_scoped_acquire gil;
@@ -45,21 +43,16 @@ void bind_simp(pyb::module_& m) {
           d["stage"] = stage, d["fraction"] = fraction, d["message"] = message;
           call(d);
         };
-        TetMesh mesh;
-        pipeline::OptimizeResult r;
+        pipeline::RunResult run;
         {
           pyb::gil_scoped_release release;
-          pipeline::optimize_settings(job);  // a bad setting is reported before meshing
-          if (!job.mesh_file.empty()) {
-            mesh = pipeline::job_mesh(job, progress);
-          } else {
+          pipeline::JobShapes shapes;
+          if (job.mesh.file.empty()) {
             if (part_brep.empty()) throw Error(ErrorCode::InvalidParameter, "no part given");
-            TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
-            TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
-            mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
+            shapes.part = brep::read_brep_string(part_brep, "part");
+            if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids");
           }
-          progress.check_cancel("meshing");
-          r = pipeline::optimize_job(job, mesh, progress, [&](const simp::IterationRecord& rec) {
+          run = pipeline::run_job(job, shapes, progress, [&](const simp::IterationRecord& rec) {
             pyb::gil_scoped_acquire gil;
             pyb::dict d;
             d["iteration"] = rec.iteration, d["compliance"] = rec.compliance, d["volume"] = rec.volume_fraction,
@@ -69,10 +62,11 @@ void bind_simp(pyb::module_& m) {
         }
         if (!callback_error.empty())
           throw Error(ErrorCode::Cancelled, "the progress callback raised: " + callback_error);
+        const pipeline::OptimizeResult& r = run.optimization;
         pyb::dict out;
-        put_tet_mesh(out, mesh);
+        put_tet_mesh(out, run.mesh);
         out["densities"] = r.simp.density;
-        out["warnings"] = warnings;
+        out["warnings"] = run.warnings;
         pyb::list hist;
         for (const auto& h : r.simp.history) {
           pyb::dict d;

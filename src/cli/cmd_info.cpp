@@ -16,15 +16,15 @@ int cmd_info(const Args& args) {
               "  --json       print the full report as JSON\n"
               "  --tolerance  coincidence tolerance in mm (default 1e-6 x part size)");
   if (a.print_help()) return 0;
-  std::string part = a.option("part"), nd = a.option("non-design");
+  std::string part = a.option("part"), nondesign = a.option("non-design");
   bool json = a.flag("json");
   brep::ClassifyParams params;
   params.tolerance = a.number("tolerance", -1);
   if (!a.positionals().empty() || part.empty())
     throw Error(ErrorCode::InvalidParameter, "give the part with --part FILE\n" + a.usage());
   TopoDS_Shape part_shape = brep::read_shape_file(part);
-  TopoDS_Shape nd_shape = nd.empty() ? TopoDS_Shape() : brep::read_shape_file(nd);
-  brep::TwoBReps m = brep::load_two_breps(part_shape, nd_shape, params);
+  TopoDS_Shape nondesign_shape = nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(nondesign);
+  brep::TwoBReps m = brep::load_two_breps(part_shape, nondesign_shape, params);
   if (json)
     std::cout << brep::two_breps_report(m).dump(2) << "\n";
   else

@@ -14,51 +14,47 @@
 #include "mesh/core/conformity.h"
 #include "mesh/core/reorder.h"
 #include "mesh/core/tet_quality.h"
-#include "mesh/two_brep/gmsh_fragments.h"
-#include "mesh/two_brep/native_mesher.h"
+#include "mesh/surface/surface_mesher.h"
+#include "pipeline/mesh_model.h"
+#include "pipeline/output_files.h"
 
 namespace topopt::cli {
+namespace {
 
-int cmd_mesh(const Args& args) {
-  ArgReader a(
-      args,
-      "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] [--wall-layers N] --out FILE\n"
-      "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
-      "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
-      "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
-      "  part's face numbers (FreeCAD's FaceN).\n"
-      "  --out    FILE.msh (Gmsh MSH 4.1), FILE.vtu (ParaView) or FILE.inp (CalculiX mesh)\n"
-      "  --size   target element size in mm (default: part diagonal / 50)\n"
-      "  --wall-layers N  (native) walls thinner than two sizes get about N layers across\n"
-      "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
-      "  --mesher native: the two-B-Rep advancing front (the 14 steps: no boolean of the part\n"
-      "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh;\n"
-      "           auto (default): native, and gmsh with a warning where native fails\n"
-      "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
-      "           (a comparison aid)");
-  if (a.print_help()) return 0;
-  std::string part = a.option("part"), nd = a.option("non-design"), out = a.option("out"), stats = a.option("stats");
-  mesh::FragmentMeshParams mp;
-  mp.size = a.number("size", 0);
-  mp.min_size = a.number("min-size", 0);
-  const int wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
-  std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "auto");
-  if (mesher != "auto" && mesher != "gmsh" && mesher != "native")
-    throw Error(ErrorCode::InvalidParameter, "--mesher takes auto, native or gmsh");
+using clock = std::chrono::steady_clock;
+
+const char* kUsage =
+    "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] [--wall-layers N] --out FILE\n"
+    "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
+    "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
+    "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
+    "  part's face numbers (FreeCAD's FaceN).\n"
+    "  --out    FILE.msh (Gmsh MSH 4.1), FILE.vtu (ParaView) or FILE.inp (CalculiX mesh)\n"
+    "  --size   target element size in mm (default: part diagonal / 50; above the diagonal:\n"
+    "           the diagonal, with a warning; a size asking for too many elements is refused)\n"
+    "  --min-size  smallest element size in mm (default: size / 10)\n"
+    "  --wall-layers N  (native) walls thinner than two sizes get about N layers across\n"
+    "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
+    "  --mesher native: the two-B-Rep advancing front (the 14 steps: no boolean of the part\n"
+    "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh in a\n"
+    "           separate process; auto (default): native, and gmsh with a warning where native fails\n"
+    "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
+    "           (a comparison aid)";
+
+pipeline::MeshSettings settings_from(ArgReader& a) {
+  pipeline::MeshSettings s;
+  s.size = a.number("size", 0);
+  s.min_size = a.number("min-size", 0);
+  s.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
+  s.mesher = pipeline::mesher_from_name(a.option("mesher", "auto"));
+  const std::string volume = a.option("volume", "gmsh");
   if (volume != "gmsh" && volume != "native") throw Error(ErrorCode::InvalidParameter, "--volume takes gmsh or native");
-  mp.native_volume = volume == "native";
-  if (!a.positionals().empty() || part.empty() || out.empty())
-    throw Error(ErrorCode::InvalidParameter, "give --part and --out\n" + a.usage());
-  if (mp.size < 0 || mp.min_size < 0) throw Error(ErrorCode::InvalidParameter, "mesh sizes must be positive (mm)");
-  std::string ext = std::filesystem::path(out).extension().string();
-  if (ext != ".msh" && ext != ".vtu" && ext != ".inp")
-    throw Error(ErrorCode::InvalidParameter, "--out must end in .msh, .vtu or .inp");
-  using clock = std::chrono::steady_clock;
-  auto t0 = clock::now();
-  TopoDS_Shape p = brep::read_shape_file(part);
-  TopoDS_Shape n = nd.empty() ? TopoDS_Shape() : brep::read_shape_file(nd);
-  brep::TwoBReps model = brep::load_two_breps(p, n);
-  auto t1 = clock::now();
+  s.gmsh_volume_by_front = volume == "native";
+  pipeline::check_mesh_settings(s, "--size", "--min-size");
+  return s;
+}
+
+Progress stderr_progress() {
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) {
     std::cerr << "[" << stage << "] " << msg << "\n";
@@ -68,28 +64,30 @@ int cmd_mesh(const Args& args) {
     if (verbose || level == LogLevel::Warning)
       std::cerr << (level != LogLevel::Warning ? "  " : "warning: ") << msg << "\n";
   };
-  TetMesh m;
-  if (mesher != "gmsh" && mp.native_volume)
-    throw Error(ErrorCode::InvalidParameter,
-                "--volume native goes with --mesher gmsh (the native mesher fills its volumes itself)");
-  mesh::MeshRun run;
-  if (mp.native_volume)
-    m = mesh::mesh_with_gmsh_fragments(model, mp, progress), run.mesher = "gmsh surfaces + native volumes";
-  else
-    m = mesh::mesh_two_breps(model, mesher, mp.size, mp.min_size, progress, &run, wall_layers);
-  mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
-  auto t2 = clock::now();
-  if (ext == ".msh")
-    io::write_msh(out, m);
-  else if (ext == ".vtu")
-    io::write_vtu(out, m, {}, {});
-  else
-    io::write_inp(out, m, fem::Material{}, fem::Supports{}, Eigen::MatrixXd(), 0);
-  auto t3 = clock::now();
-  mesh::ConformityReport conf = mesh::check_conformity(m, &model);
-  mesh::QualityReport q = mesh::tet_quality(m);
+  return progress;
+}
+
+void write_mesh(const std::string& out, const TetMesh& m) {
+  const std::string ext = std::filesystem::path(out).extension().string();
+  pipeline::write_replacing(out, [&](const std::string& p) {
+    if (ext == ".msh")
+      io::write_msh(p, m);
+    else if (ext == ".vtu")
+      io::write_vtu(p, m, {}, {});
+    else
+      io::write_inp(p, m, fem::Material{}, fem::Supports{}, Eigen::MatrixXd(), 0);
+  });
+}
+
+std::vector<long> tets_per_domain(const TetMesh& m) {
   std::vector<long> per_domain(m.domain.size() ? m.domain.maxCoeff() + 1 : 1, 0);
   for (long t = 0; t < m.domain.size(); ++t) per_domain[m.domain[t]]++;
+  return per_domain;
+}
+
+void print_summary(const TetMesh& m, const mesh::QualityReport& q, const mesh::ConformityReport& conf,
+                   const std::string& out) {
+  const std::vector<long> per_domain = tets_per_domain(m);
   std::cout << "mesh: " << m.V.rows() << " nodes, " << m.T.rows() << " tets (";
   for (size_t d = 0; d < per_domain.size(); ++d)
     std::cout << (d ? ", " : "") << (d ? "non-design " + std::to_string(d) : std::string("design")) << " "
@@ -100,24 +98,67 @@ int cmd_mesh(const Args& args) {
             << "conformity: " << (conf.ok() ? "ok" : "DEFECTS (see --stats)") << ", largest volume error "
             << 100 * conf.max_volume_error << " %\n"
             << "wrote " << out << "\n";
-  if (!stats.empty()) {
-    auto sec = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
-    nlohmann::json j;
-    j["nodes"] = m.V.rows();
-    j["tets"] = m.T.rows();
-    j["tets_per_domain"] = per_domain;
-    j["boundary_triangles"] = m.F.rows();
-    j["quality"] = q.to_json();
-    j["conformity"] = conf.to_json();
-    j["seconds"] = {{"read_and_classify", sec(t0, t1)}, {"mesh", sec(t1, t2)}, {"write", sec(t2, t3)}};
-    j["mesher"] = run.mesher;
-    if (!run.fallback_reason.empty()) j["native_failed"] = run.fallback_reason;
-    for (const auto& [stage, t] : run.seconds) j["seconds_per_stage"][stage] = t;
-    std::ofstream f(stats);
+}
+
+/// Seconds between marks: read and classify, mesh, write.
+struct Times {
+  clock::time_point start, read, meshed, written;
+};
+
+void write_stats(const std::string& stats, const TetMesh& m, const mesh::QualityReport& q,
+                 const mesh::ConformityReport& conf, const Times& t, const mesh::MeshRun& run) {
+  auto sec = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  nlohmann::json j;
+  j["nodes"] = m.V.rows();
+  j["tets"] = m.T.rows();
+  j["tets_per_domain"] = tets_per_domain(m);
+  j["boundary_triangles"] = m.F.rows();
+  j["quality"] = q.to_json();
+  j["conformity"] = conf.to_json();
+  j["seconds"] = {{"read_and_classify", sec(t.start, t.read)},
+                  {"mesh", sec(t.read, t.meshed)},
+                  {"write", sec(t.meshed, t.written)}};
+  j["mesher"] = run.mesher;
+  if (!run.fallback_reason.empty()) j["native_failed"] = run.fallback_reason;
+  for (const auto& [stage, s] : run.seconds) j["seconds_per_stage"][stage] = s;
+  pipeline::write_replacing(stats, [&](const std::string& p) {
+    std::ofstream f(p);
     f << j.dump(2) << "\n";
     if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);
-    std::cout << "wrote " << stats << "\n";
-  }
+  });
+  std::cout << "wrote " << stats << "\n";
+}
+
+}  // namespace
+
+int cmd_mesh(const Args& args) {
+  ArgReader a(args, kUsage);
+  if (a.print_help()) return 0;
+  const std::string part = a.option("part"), nondesign = a.option("non-design"), out = a.option("out"),
+                    stats = a.option("stats");
+  const pipeline::MeshSettings settings = settings_from(a);
+  if (!a.positionals().empty() || part.empty() || out.empty())
+    throw Error(ErrorCode::InvalidParameter, "give --part and --out\n" + a.usage());
+  const std::string ext = std::filesystem::path(out).extension().string();
+  if (ext != ".msh" && ext != ".vtu" && ext != ".inp")
+    throw Error(ErrorCode::InvalidParameter, "--out must end in .msh, .vtu or .inp");
+  for (const auto& [file, option] : {std::pair{out, "--out"}, std::pair{stats, "--stats"}})
+    if (!file.empty()) pipeline::prepare_output_folder(std::filesystem::absolute(file).parent_path().string(), option);
+  Times t;
+  t.start = clock::now();
+  const brep::TwoBReps model = brep::load_two_breps(
+      brep::read_shape_file(part), nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(nondesign));
+  t.read = clock::now();
+  mesh::MeshRun run;
+  TetMesh m = pipeline::mesh_model(model, settings, stderr_progress(), &run);
+  mesh::reorder_for_locality(m);  // node numbers that follow space (faster solves downstream)
+  t.meshed = clock::now();
+  write_mesh(out, m);
+  t.written = clock::now();
+  const mesh::ConformityReport conf = mesh::check_conformity(m, &model);
+  const mesh::QualityReport q = mesh::tet_quality(m);
+  print_summary(m, q, conf, out);
+  if (!stats.empty()) write_stats(stats, m, q, conf, t, run);
   return conf.ok() ? 0 : 1;
 }
 

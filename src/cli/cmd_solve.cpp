@@ -5,7 +5,9 @@
 
 #include "cli/commands.h"
 #include "common/error.h"
-#include "io/job.h"
+#include "pipeline/job.h"
+#include "pipeline/job_mesh.h"
+#include "pipeline/output_files.h"
 #include "pipeline/solve_job.h"
 
 namespace topopt::cli {
@@ -15,7 +17,7 @@ int cmd_solve(const Args& args) {
               "usage: topopt solve JOB.json [--out-dir DIR] [--solver auto|direct|iterative] [--inp FILE]\n"
               "  Solves the job's load cases (linear elasticity on tets) and writes DIR/result.vtu\n"
               "  (displacements and von Mises stress per case) for ParaView. The job format is in\n"
-              "  docs/job-format.md.\n"
+              "  docs/job-format.md; the whole job is checked, and DIR made and tested, before any work.\n"
               "  --out-dir  output folder (default: the job's output.directory, or out/ beside it)\n"
               "  --solver   direct (CHOLMOD sparse Cholesky, auto below 40 000 unknowns) or iterative\n"
               "             (conjugate gradients with smoothed-aggregation multigrid, auto above)\n"
@@ -25,8 +27,8 @@ int cmd_solve(const Args& args) {
   std::string out = a.option("out-dir"), solver = a.option("solver", "auto"), inp = a.option("inp");
   std::vector<std::string> pos = a.positionals();
   if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one job file\n" + a.usage());
-  io::Job job = io::read_job(pos[0]);
-  if (!out.empty()) job.output_dir = std::filesystem::absolute(out).string();
+  pipeline::Job job = pipeline::read_job(pos[0]);
+  if (!out.empty()) job.output.directory = std::filesystem::absolute(out).lexically_normal().string();
   fem::SolverParams sp;
   if (solver == "direct")
     sp.kind = fem::SolverKind::Direct;
@@ -34,12 +36,15 @@ int cmd_solve(const Args& args) {
     sp.kind = fem::SolverKind::Iterative;
   else if (solver != "auto")
     throw Error(ErrorCode::InvalidParameter, "--solver takes auto, direct or iterative");
+  pipeline::require_supports_and_loads(job);
+  pipeline::prepare_output_folder(job.output.directory, "'output.directory' (or --out-dir)");
+  if (!inp.empty()) pipeline::prepare_output_folder(std::filesystem::absolute(inp).parent_path().string(), "--inp");
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) {
     std::cerr << "[" << stage << "] " << msg << "\n";
   };
   progress.log = [](LogLevel, const std::string& msg) { std::cerr << "  " << msg << "\n"; };
-  TetMesh mesh = pipeline::job_mesh(job, progress);
+  TetMesh mesh = pipeline::job_mesh(job, {}, progress);
   std::cout << "mesh: " << mesh.V.rows() << " nodes, " << mesh.T.rows() << " tets\n";
   pipeline::SolveResult r = pipeline::solve_job(job, mesh, sp, VecXd(), progress);
   std::cout << std::setprecision(6);
@@ -50,7 +55,7 @@ int cmd_solve(const Args& args) {
               << umax << " mm, max von Mises " << r.von_mises[c].maxCoeff() << " MPa\n";
   }
   std::cout << "time: setup " << r.seconds_setup << " s, solve " << r.seconds_solve << " s\n";
-  for (const auto& p : pipeline::write_solve_outputs(job, mesh, r, job.output_dir, inp))
+  for (const auto& p : pipeline::write_solve_outputs(job, mesh, r, job.output.directory, inp))
     std::cout << "wrote " << p << "\n";
   return 0;
 }

@@ -1,6 +1,7 @@
 // topopt surface: the native surface mesh of one model (steps 1, 5 and 9 for a single B-Rep),
 // with its checks: closed and oriented per solid, self-intersections, angles.
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,9 @@
 #include "io/stl.h"
 #include "mesh/surface/surface_check.h"
 #include "mesh/surface/surface_mesher.h"
+#include "pipeline/mesh_settings.h"
+#include "pipeline/surface_job.h"
+#include "pipeline/output_files.h"
 
 namespace topopt::cli {
 
@@ -22,7 +26,10 @@ int cmd_surface(const Args& args) {
               "                      [--stats STATS.json]\n"
               "  Meshes every face of PART (STEP or BREP) with the native surface mesher: a closed,\n"
               "  consistently oriented triangulation per solid, each triangle tagged with its face.\n"
-              "  --size   target edge length in mm (default: part diagonal / 50)\n"
+              "  --size   target edge length in mm (default: part diagonal / 50; above the diagonal:\n"
+              "           the diagonal, with a warning; a size asking for too many elements is refused,\n"
+              "           as by topopt mesh)\n"
+              "  --min-size  smallest edge length in mm (default: size / 10)\n"
               "  --wall-layers N  walls thinner than two sizes get about N element layers across\n"
               "           (sizes from the wall thickness, measured by rays; default 0: off)\n"
               "  --out    binary STL; each triangle's attribute bytes hold its face number (FaceN)\n"
@@ -30,30 +37,31 @@ int cmd_surface(const Args& args) {
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
   if (a.print_help()) return 0;
   const std::string part = a.option("part"), out = a.option("out"), stats = a.option("stats");
-  mesh::SurfaceMeshParams p;
-  p.size = a.number("size", 0);
-  p.min_size = a.number("min-size", 0);
-  p.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
+  pipeline::MeshSettings settings;
+  settings.size = a.number("size", 0);
+  settings.min_size = a.number("min-size", 0);
+  settings.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
   if (!a.positionals().empty() || part.empty()) throw Error(ErrorCode::InvalidParameter, "give --part\n" + a.usage());
-  if (p.size < 0 || p.min_size < 0) throw Error(ErrorCode::InvalidParameter, "mesh sizes must be positive (mm)");
+  pipeline::check_mesh_settings(settings, "--size", "--min-size");
   if (!out.empty() && std::filesystem::path(out).extension() != ".stl")
     throw Error(ErrorCode::InvalidParameter, "--out must end in .stl");
+  for (const auto& [file, option] : {std::pair{out, "--out"}, std::pair{stats, "--stats"}})
+    if (!file.empty()) pipeline::prepare_output_folder(std::filesystem::absolute(file).parent_path().string(), option);
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
   brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(part));
   auto t1 = clock::now();
-  mesh::SurfaceMesh m = mesh::mesh_surface(topo, p);
+  // the same sizes, clamp and element budget as topopt mesh (pipeline/mesh_settings.h)
+  Progress progress;
+  progress.log = [](LogLevel level, const std::string& msg) {
+    if (level == LogLevel::Warning) std::cerr << "warning: " << msg << "\n";
+  };
+  const pipeline::SurfaceJobResult r = pipeline::surface_job(topo, settings, progress);
   auto t2 = clock::now();
-  const std::vector<long> open = mesh::open_edges_per_solid(topo, m);
-  // self-intersection per solid: solids of one model may touch each other (the bracket's
-  // clamp pads), where their separate faces coincide by design
-  std::vector<std::pair<int, int>> crossings;
-  for (int s = 0; s < topo.num_solids() && crossings.size() < 100; ++s) {
-    const auto c =
-        mesh::self_intersections(m.V, mesh::solid_triangles(topo, m, s), 100 - static_cast<long>(crossings.size()));
-    crossings.insert(crossings.end(), c.begin(), c.end());
-  }
-  const mesh::SurfaceQuality q = mesh::surface_quality(m.V, m.F);
+  const mesh::SurfaceMesh& m = r.mesh;
+  const std::vector<long>& open = r.open_edges_per_solid;
+  const auto& crossings = r.crossings;
+  const mesh::SurfaceQuality& q = r.quality;
   long open_total = 0;
   for (long o : open) open_total += o;
   auto sec = [](clock::time_point x, clock::time_point y) { return std::chrono::duration<double>(y - x).count(); };
@@ -66,7 +74,8 @@ int cmd_surface(const Args& args) {
   for (size_t k = 0; k < m.failed_faces.size(); ++k)
     std::cout << "  Face" << m.failed_faces[k] << ": " << m.reasons[k] << "\n";
   if (!out.empty()) {
-    io::write_stl(out, m.V, m.F, "TopOpt surface mesh", &m.face);
+    pipeline::write_replacing(
+        out, [&](const std::string& path) { io::write_stl(path, m.V, m.F, "TopOpt surface mesh", &m.face); });
     std::cout << "wrote " << out << "\n";
   }
   if (!stats.empty()) {
@@ -82,11 +91,13 @@ int cmd_surface(const Args& args) {
                     {"share_below_20deg", q.share_below_20},
                     {"mean_shape", q.mean_quality}};
     j["seconds"] = {{"read", sec(t0, t1)}, {"mesh", sec(t1, t2)}};
-    std::ofstream f(stats);
-    f << j.dump(2) << "\n";
-    if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);
+    pipeline::write_replacing(stats, [&](const std::string& path) {
+      std::ofstream f(path);
+      f << j.dump(2) << "\n";
+      if (!f) throw Error(ErrorCode::Io, "cannot write " + stats);
+    });
   }
-  return m.failed_faces.empty() && open_total == 0 && crossings.empty() ? 0 : 1;
+  return r.ok() ? 0 : 1;
 }
 
 }  // namespace topopt::cli

@@ -17,13 +17,15 @@
 #include "cli/commands.h"
 #include "cli/worker_channel.h"
 #include "common/error.h"
-#include "io/job.h"
 #include "io/npy.h"
 #include "mesh/core/tet_quality.h"
 #include "mesh/surface/surface_check.h"
 #include "mesh/surface/surface_mesher.h"
+#include "pipeline/job.h"
+#include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
-#include "pipeline/solve_job.h"
+#include "pipeline/run_job.h"
+#include "pipeline/surface_job.h"
 
 namespace topopt::cli {
 namespace {
@@ -146,9 +148,9 @@ std::pair<TopoDS_Shape, TopoDS_Shape> read_shapes(const Request& r, WorkerChanne
 }
 
 /// The request's inline job, parsed and checked as a job file is.
-io::Job job_of(const Request& r) {
+pipeline::Job job_of(const Request& r) {
   if (!r.job.is_object()) throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object");
-  return io::parse_job(r.job.dump(), r.base.string());
+  return pipeline::parse_job(r.job.dump(), r.base.string());
 }
 
 /// info: the shapes checked and classified; result.json holds {"report"} (topopt info --json).
@@ -164,44 +166,36 @@ json op_info(const Request& r, WorkerChannel& ch) {
 
 /// surface_mesh: the native surface mesh of the part (nodes, triangles, faces) and its checks.
 json op_surface_mesh(const Request& r, WorkerChannel& ch) {
-  mesh::SurfaceMeshParams p;
-  p.size = param(r, "size", 0);
-  if (!(p.size >= 0))
+  pipeline::MeshSettings settings;
+  settings.size = param(r, "size", 0);
+  if (!(settings.size >= 0))
     throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
-  p.wall_layers = mesh::wall_layers_option(param(r, "wall_layers", 0));
+  settings.wall_layers = mesh::wall_layers_option(param(r, "wall_layers", 0));
   auto shapes = read_shapes(r, ch);
   if (shapes.first.IsNull()) throw Error(ErrorCode::InvalidParameter, "no shape given");
-  const brep::TopologyIndex topo = brep::index_topology(shapes.first);
-  ch.progress("mesh", 0, "meshing the faces");
   std::vector<std::string> warnings;
-  const mesh::SurfaceMesh sm = mesh::mesh_surface(topo, p, ch.make_progress(warnings));
-  ch.progress("mesh", 0.9, "checking the surface");
-  long crossings = 0;
-  for (int s = 0; s < topo.num_solids(); ++s)
-    crossings += static_cast<long>(mesh::self_intersections(sm.V, mesh::solid_triangles(topo, sm, s)).size());
-  const mesh::SurfaceQuality q = mesh::surface_quality(sm.V, sm.F);
-  json result = {{"failed_faces", sm.failed_faces},
-                 {"failure_reasons", sm.reasons},
-                 {"open_edges_per_solid", mesh::open_edges_per_solid(topo, sm)},
-                 {"self_intersecting_pairs", crossings},
-                 {"min_angle", q.min_angle},
-                 {"share_below_20deg", q.share_below_20},
+  const pipeline::SurfaceJobResult s =
+      pipeline::surface_job(brep::index_topology(shapes.first), settings, ch.make_progress(warnings));
+  json result = {{"failed_faces", s.mesh.failed_faces},
+                 {"failure_reasons", s.mesh.reasons},
+                 {"open_edges_per_solid", s.open_edges_per_solid},
+                 {"self_intersecting_pairs", s.crossings.size()},
+                 {"min_angle", s.quality.min_angle},
+                 {"share_below_20deg", s.quality.share_below_20},
                  {"warnings", warnings}};
   ch.progress("write", -1, "writing the results");
-  put_array(result, r.output, "nodes", sm.V);
-  put_array(result, r.output, "triangles", sm.F);
-  put_array(result, r.output, "faces", sm.face);
+  put_array(result, r.output, "nodes", s.mesh.V);
+  put_array(result, r.output, "triangles", s.mesh.F);
+  put_array(result, r.output, "faces", s.mesh.face);
   return result;
 }
 
 /// mesh: the job's conformal tagged tet mesh and its quality figures.
 json op_mesh(const Request& r, WorkerChannel& ch) {
-  const io::Job job = job_of(r);
+  const pipeline::Job job = job_of(r);
   auto [part, nd] = read_shapes(r, ch);
   std::vector<std::string> warnings;
-  const Progress progress = ch.make_progress(warnings);
-  const TetMesh mesh =
-      job.mesh_file.empty() ? pipeline::mesh_job_shapes(job, part, nd, progress) : pipeline::job_mesh(job, progress);
+  const TetMesh mesh = pipeline::job_mesh(job, {part, nd}, ch.make_progress(warnings));
   const mesh::QualityReport q = mesh::tet_quality(mesh);
   json result = {
       {"min_radius_ratio", q.min_radius_ratio}, {"mean_radius_ratio", q.mean_radius_ratio}, {"warnings", warnings}};
@@ -210,49 +204,30 @@ json op_mesh(const Request& r, WorkerChannel& ch) {
   return result;
 }
 
-/// What one optimisation produced: the analysis mesh and the SIMP result with its surface.
-struct OptimizeOutcome {
-  TetMesh mesh;
-  pipeline::OptimizeResult result;
-};
-
-/// mesh → SIMP → result surface for a job and its shapes (or the job's mesh file): the same
-/// sequence as the Python module's run_job, the one pipeline::run_job is to own.
-OptimizeOutcome optimize_shapes(const io::Job& job, const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
-                                const Progress& progress,
-                                const std::function<void(const simp::IterationRecord&)>& on_iteration) {
-  pipeline::optimize_settings(job);  // a bad setting is reported before meshing
-  OptimizeOutcome out;
-  if (job.mesh_file.empty() && part.IsNull()) throw Error(ErrorCode::InvalidParameter, "no part given");
-  out.mesh = job.mesh_file.empty() ? pipeline::mesh_job_shapes(job, part, nondesign, progress)
-                                   : pipeline::job_mesh(job, progress);
-  out.result = pipeline::optimize_job(job, out.mesh, progress, on_iteration);
-  return out;
-}
-
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
-  const io::Job job = job_of(r);
+  const pipeline::Job job = job_of(r);
   auto [part, nd] = read_shapes(r, ch);
   std::vector<std::string> warnings;
-  const OptimizeOutcome o = optimize_shapes(job, part, nd, ch.make_progress(warnings),
-                                            [&ch](const simp::IterationRecord& rec) { ch.iteration(rec); });
+  const pipeline::RunResult run = pipeline::run_job(job, {part, nd}, ch.make_progress(warnings),
+                                                    [&ch](const simp::IterationRecord& rec) { ch.iteration(rec); });
+  const pipeline::OptimizeResult& o = run.optimization;
   json history = json::array();
-  for (const auto& h : o.result.simp.history)
+  for (const auto& h : o.simp.history)
     history.push_back({{"iteration", h.iteration},
                        {"compliance", h.compliance},
                        {"volume", h.volume_fraction},
                        {"change", h.change},
                        {"seconds", h.seconds}});
   json result = {{"history", history},
-                 {"threshold", o.result.threshold},
-                 {"status", o.result.simp.status},
-                 {"seconds", {o.result.seconds_simp, o.result.seconds_surface}},
+                 {"threshold", o.threshold},
+                 {"status", o.simp.status},
+                 {"seconds", {o.seconds_simp, o.seconds_surface}},
                  {"warnings", warnings}};
   ch.progress("write", -1, "writing the results");
-  put_tet_mesh(result, r.output, o.mesh);
-  put_array(result, r.output, "densities", o.result.simp.density);
-  put_result_surface(result, r.output, o.result.surface);
+  put_tet_mesh(result, r.output, run.mesh);
+  put_array(result, r.output, "densities", o.simp.density);
+  put_result_surface(result, r.output, o.surface);
   return result;
 }
 

@@ -12,6 +12,7 @@
 
 #include "common/error.h"
 #include "common/face_key.h"
+#include "common/tet_boundary.h"
 
 namespace topopt::io {
 namespace {
@@ -20,36 +21,6 @@ using KeyHash = FaceKeyHash;
 inline FaceKey sorted_key(int a, int b, int c) { return face_key(a, b, c); }
 
 }  // namespace
-
-MatX3i boundary_triangles(const MatX4i& T) {
-  // Faces of tet (a,b,c,d) oriented outwards for a positive tet. All 4 #T faces sorted by
-  // their key: a face met once is on the boundary (sorting beats hashing here by ~3x).
-  const auto& kFace = kTetFace;
-  struct Entry {
-    FaceKey key;
-    int tet, face;
-  };
-  std::vector<Entry> all;
-  all.reserve(4 * T.rows());
-  for (long t = 0; t < T.rows(); ++t)
-    for (int f = 0; f < 4; ++f)
-      all.push_back({sorted_key(T(t, kFace[f][0]), T(t, kFace[f][1]), T(t, kFace[f][2])), static_cast<int>(t), f});
-  std::sort(all.begin(), all.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
-  std::vector<std::array<int, 3>> out;
-  for (size_t i = 0; i < all.size();) {
-    size_t j = i + 1;
-    while (j < all.size() && all[j].key == all[i].key) ++j;
-    if (j == i + 1) {
-      const Entry& e = all[i];
-      out.push_back({T(e.tet, kFace[e.face][0]), T(e.tet, kFace[e.face][1]), T(e.tet, kFace[e.face][2])});
-    }
-    i = j;
-  }
-  std::sort(out.begin(), out.end());
-  MatX3i F(out.size(), 3);
-  for (size_t i = 0; i < out.size(); ++i) F.row(i) << out[i][0], out[i][1], out[i][2];
-  return F;
-}
 
 void write_msh(const std::string& path, const TetMesh& mesh) {
   FILE* f = std::fopen(path.c_str(), "w");
@@ -171,10 +142,11 @@ class Tokens {
     pos_ = end - text_.c_str();
     return v;
   }
-  /// Skips to the line after `marker`.
-  void skip_section(const std::string& end_marker) {
+  /// Skips to the line after `end_marker`; `name` says which section in a message (the
+  /// marker of a section we do not know came from the file and is not repeated).
+  void skip_section(const std::string& end_marker, const std::string& name) {
     size_t e = text_.find(end_marker, pos_);
-    if (e == std::string::npos) fail("missing " + end_marker);
+    if (e == std::string::npos) fail(name + " has no end line");
     pos_ = e + end_marker.size();
   }
   [[noreturn]] void fail(const std::string& what) const {
@@ -209,9 +181,14 @@ TetMesh read_msh(const std::string& path) {
       std::string version = in.word();
       long binary = in.integer();
       in.integer();
-      if (version.rfind("4", 0) != 0) in.fail("MSH version " + version + " is not supported; save as 4.1");
+      if (version.rfind("4", 0) != 0) {
+        const bool looks_like_a_version =
+            version.size() <= 8 && version.find_first_not_of("0123456789.") == std::string::npos;
+        in.fail("MSH version " + (looks_like_a_version ? version + " " : std::string()) +
+                "is not supported; save as 4.1");
+      }
       if (binary) in.fail("binary MSH is not supported; save as ASCII");
-      in.skip_section("$EndMeshFormat");
+      in.skip_section("$EndMeshFormat", "$MeshFormat");
       saw_format = true;
     } else if (sec == "$Entities") {
       long np = in.integer(), nc = in.integer(), ns = in.integer(), nvol = in.integer();
@@ -232,7 +209,7 @@ TetMesh read_msh(const std::string& path) {
           for (long k = 0; k < nb; ++k) in.integer();
         }
       }
-      in.skip_section("$EndEntities");
+      in.skip_section("$EndEntities", "$Entities");
     } else if (sec == "$Nodes") {
       long blocks = in.integer(), total = in.integer();
       in.integer(), in.integer();
@@ -251,7 +228,7 @@ TetMesh read_msh(const std::string& path) {
           nodes.push_back(x);
         }
       }
-      in.skip_section("$EndNodes");
+      in.skip_section("$EndNodes", "$Nodes");
     } else if (sec == "$Elements") {
       long blocks = in.integer();
       in.integer(), in.integer(), in.integer();
@@ -284,11 +261,12 @@ TetMesh read_msh(const std::string& path) {
           }
         }
       }
-      in.skip_section("$EndElements");
+      in.skip_section("$EndElements", "$Elements");
     } else if (!sec.empty() && sec[0] == '$') {
-      in.skip_section("$End" + sec.substr(1));
+      in.skip_section("$End" + sec.substr(1), "a section this reader skips");
     } else {
-      in.fail("unexpected '" + sec + "'");
+      // the text itself is not repeated: the file may be anything readable (mesh.file)
+      in.fail("text outside a $Section");
     }
   }
   if (!saw_format) in.fail("no $MeshFormat section");

@@ -6,6 +6,7 @@
 #pragma once
 #include <string>
 
+#include "common/tet_boundary.h"
 #include "common/types.h"
 
 namespace topopt::io {
@@ -23,7 +24,8 @@ void write_msh(const std::string& path, const TetMesh& mesh);
 /// types are skipped. Throws Error(Io) naming the line for a malformed file.
 TetMesh read_msh(const std::string& path);
 
-/// Boundary triangles of a tet mesh (faces used by one tet), oriented outwards, face 0.
-MatX3i boundary_triangles(const MatX4i& T);
+/// The boundary triangles of a tet mesh live in common/tet_boundary.h (meshing needs them
+/// too); the name is kept here for the callers that read meshes.
+using topopt::boundary_triangles;
 
 }  // namespace topopt::io

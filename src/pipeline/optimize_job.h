@@ -1,27 +1,18 @@
-// The optimisation path shared by `topopt optimize` and the Python module's run_job:
-// a job's mesh → SIMP → the result surface at the volume-matching threshold → smoothing.
+// The optimisation path of a job: SIMP on its mesh with its supports, loads and
+// "optimization" settings, then the result shape at the volume-matching threshold, smoothed;
+// and the files that record it. run_job (run_job.h) is the whole path from the job.
 #pragma once
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "common/progress.h"
-#include "io/job.h"
+#include "pipeline/job.h"
 #include "result/iso_surface.h"
 #include "result/smoothing.h"
 #include "simp/optimizer.h"
 
 namespace topopt::pipeline {
-
-/// The "optimization" section of a job (docs/optimization.md), validated.
-struct OptimizeSettings {
-  simp::SimpParams simp;
-  double threshold = -1;  ///< < 0: the one that meets the volume fraction
-  result::SmoothParams smooth;
-};
-
-/// Reads job.raw["optimization"]. Throws Error(InvalidParameter) naming a bad key.
-OptimizeSettings optimize_settings(const io::Job& job);
 
 struct OptimizeResult {
   simp::SimpResult simp;
@@ -30,19 +21,23 @@ struct OptimizeResult {
   double seconds_simp = 0, seconds_surface = 0;
 };
 
-/// Runs SIMP on `mesh` with the job's supports and loads, then extracts and smooths the
-/// shape. on_iteration gets every iteration. Throws what fem and simp throw (NoSupport,
-/// InvalidParameter, Cancelled).
-OptimizeResult optimize_job(const io::Job& job, const TetMesh& mesh, const Progress& progress = {},
+/// Runs SIMP on `mesh` with the job's supports, loads and job.optimization, then extracts and
+/// smooths the shape. on_iteration gets every iteration. Before SIMP, throws
+/// Error(InvalidParameter) for a load case that puts no force on the part or only loads
+/// supported nodes, or a filter radius larger than the part, and Error(TooLarge) for a
+/// filter that would not fit in memory (problem_checks.h); then what fem and simp throw
+/// (NoSupport, Cancelled).
+OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {});
 
-/// The result shape of given element densities at a threshold (< 0: the one that keeps
-/// `volume_fraction` of the design domain), smoothed.
+/// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
+/// `volume_fraction` of the design domain), smoothed. `threshold_used` (optional) gets it.
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used = nullptr);
 
-/// Writes DIR/density.vtu, DIR/history.csv, DIR/history.json and DIR/result.stl.
-/// Returns the paths written.
+/// Writes DIR/density.vtu, DIR/history.csv, DIR/history.json and DIR/result.stl (each under
+/// a temporary name, then renamed). `dir` must exist (prepare_output_folder). Returns the
+/// paths written.
 std::vector<std::string> write_optimize_outputs(const TetMesh& mesh, const OptimizeResult& r, const std::string& dir);
 
 }  // namespace topopt::pipeline

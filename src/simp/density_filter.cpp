@@ -31,16 +31,16 @@ MatX3d tet_centroids(const TetMesh& mesh) {
 
 DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
                              const FilterParams& params) {
-  const int nd = static_cast<int>(design.size());
+  const int num_design = static_cast<int>(design.size());
   MatX3d cent = tet_centroids(mesh);
   const double r = params.radius;
-  std::vector<std::vector<std::pair<int, double>>> rows(nd);
+  std::vector<std::vector<std::pair<int, double>>> rows(num_design);
   if (r <= 0) {
-    for (int i = 0; i < nd; ++i) rows[i].push_back({i, 1.0});
+    for (int i = 0; i < num_design; ++i) rows[i].push_back({i, 1.0});
   } else {
     // Uniform grid of cell r over the design centroids; neighbours within r.
     Eigen::RowVector3d lo = Eigen::RowVector3d::Constant(1e300);
-    for (int i = 0; i < nd; ++i) lo = lo.cwiseMin(cent.row(design[i]));
+    for (int i = 0; i < num_design; ++i) lo = lo.cwiseMin(cent.row(design[i]));
     auto cell = [&](const Eigen::RowVector3d& p) {
       return std::array<long, 3>{static_cast<long>(std::floor((p[0] - lo[0]) / r)),
                                  static_cast<long>(std::floor((p[1] - lo[1]) / r)),
@@ -48,13 +48,13 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
     };
     auto key = [](long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); };
     std::unordered_map<long, std::vector<int>> grid;
-    grid.reserve(nd);
-    for (int i = 0; i < nd; ++i) {
+    grid.reserve(num_design);
+    for (int i = 0; i < num_design; ++i) {
       auto c = cell(cent.row(design[i]));
       grid[key(c[0], c[1], c[2])].push_back(i);
     }
     const double sigma = r / 3.0;
-    parallel_for(nd, thread_count(params.threads), [&](long b, long e) {
+    parallel_for(num_design, thread_count(params.threads), [&](long b, long e) {
       for (long i = b; i < e; ++i) {
         Eigen::RowVector3d p = cent.row(design[i]);
         auto c = cell(p);
@@ -76,7 +76,7 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
     });
   }
   std::vector<Eigen::Triplet<double>> th, tw;
-  for (int i = 0; i < nd; ++i) {
+  for (int i = 0; i < num_design; ++i) {
     double s = 0;
     for (auto [j, w] : rows[i]) s += w * volume[design[j]];
     for (auto [j, w] : rows[i]) {
@@ -84,9 +84,9 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
       tw.emplace_back(i, j, w);
     }
   }
-  H_.resize(nd, nd);
+  H_.resize(num_design, num_design);
   H_.setFromTriplets(th.begin(), th.end());
-  W_.resize(nd, nd);
+  W_.resize(num_design, num_design);
   W_.setFromTriplets(tw.begin(), tw.end());
 }
 

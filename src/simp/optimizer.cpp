@@ -19,27 +19,36 @@ double mean_edge_length(const TetMesh& mesh) {
   return n ? s / n : 0;
 }
 
+double filter_radius(const TetMesh& mesh, const FilterParams& params) {
+  return params.radius > 0 ? params.radius : 1.5 * mean_edge_length(mesh);
+}
+
+void check_volume_fraction(double volume_fraction, const std::string& name) {
+  if (!(volume_fraction > 0 && volume_fraction < 1))
+    throw Error(ErrorCode::InvalidParameter,
+                name + " must lie strictly between 0 and 1 (the share of the design domain to keep, e.g. 0.3)");
+}
+
 ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                                      const Eigen::MatrixXd& loads, const std::vector<double>& weights,
                                      const SimpParams& params, const Progress& progress,
                                      const Eigen::Matrix3Xd& gravity)
     : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
-  if (!(params.volume_fraction > 0 && params.volume_fraction < 1))
-    throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1 (e.g. 0.3)");
+  check_volume_fraction(params.volume_fraction);
   if (!(params.law.penalty >= 1)) throw Error(ErrorCode::InvalidParameter, "the SIMP penalty must be at least 1");
   const long nt = mesh.T.rows();
   for (long t = 0; t < nt; ++t)
     if (mesh.domain.size() != nt || mesh.domain[t] == 0) design_.push_back(static_cast<int>(t));
-  const int nd = static_cast<int>(design_.size());
-  if (nd == 0)
+  const int num_design = static_cast<int>(design_.size());
+  if (num_design == 0)
     throw Error(ErrorCode::InvalidParameter, "the mesh has no design elements: the non-design solids fill the part");
   if (weights_.empty()) weights_.assign(loads.cols(), 1.0);
   const VecXd volume = tet_volumes(mesh);
-  vd_.resize(nd);
-  for (int i = 0; i < nd; ++i) vd_[i] = volume[design_[i]];
+  vd_.resize(num_design);
+  for (int i = 0; i < num_design; ++i) vd_[i] = volume[design_[i]];
   design_volume_ = vd_.sum();
   FilterParams fp = params.filter;
-  if (fp.radius <= 0) fp.radius = 1.5 * mean_edge_length(mesh);
+  fp.radius = filter_radius(mesh, fp);
   filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
   progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " + std::to_string(filter_->mean_neighbours()) +
                 " neighbours per element");
@@ -73,16 +82,16 @@ VecXd ComplianceProblem::physical(const VecXd& x) const {
 }
 
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
-  const int nd = static_cast<int>(design_.size());
+  const int num_design = static_cast<int>(design_.size());
   VecXd rho_tilde, rho_bar;
   forward(x, rho_tilde, rho_bar);
   // ---- FE analysis
-  for (int i = 0; i < nd; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
+  for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
   fe_->set_scale(scale_);
   // loads: the design tets' weight scaled by ρ̄ (loads_ holds it at ρ̄ = 1), spread to 4 nodes
   Eigen::MatrixXd F = loads_;
   if (gravity_.size())
-    for (int i = 0; i < nd; ++i)
+    for (int i = 0; i < num_design; ++i)
       for (long k = 0; k < F.cols(); ++k)
         for (int a = 0; a < 4; ++a)
           F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += (rho_bar[i] - 1) * quarter_mass_[i] * gravity_.col(k);
@@ -90,14 +99,15 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   // ---- objective c = Σ w Fᵀ U and its sensitivities (w.r.t. ρ̄):
   // dc/dρ̄ = Σ w (2 uᵀ dF/dρ̄ − E'(ρ̄) uᵀ K₀ u) for each element
   double c = 0;
-  VecXd dc_bar = VecXd::Zero(nd);
+  VecXd dc_bar = VecXd::Zero(num_design);
   for (long k = 0; k < F.cols(); ++k) {
     c += weights_[k] * F.col(k).dot(U.col(k));
     if (!dc) continue;
     VecXd energy = fe_->element_energy(U.col(k));
-    for (int i = 0; i < nd; ++i) dc_bar[i] -= weights_[k] * params_.law.derivative(rho_bar[i]) * energy[design_[i]];
+    for (int i = 0; i < num_design; ++i)
+      dc_bar[i] -= weights_[k] * params_.law.derivative(rho_bar[i]) * energy[design_[i]];
     if (gravity_.size())
-      for (int i = 0; i < nd; ++i) {
+      for (int i = 0; i < num_design; ++i) {
         Eigen::Vector3d u_sum = Eigen::Vector3d::Zero();
         for (int a = 0; a < 4; ++a) u_sum += U.block<3, 1>(3 * mesh_.T(design_[i], a), k);
         dc_bar[i] += weights_[k] * 2 * quarter_mass_[i] * gravity_.col(k).dot(u_sum);
@@ -106,7 +116,7 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   if (dc) {
     // ---- chain rule back through projection and filter
     if (params_.heaviside)
-      for (int i = 0; i < nd; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
+      for (int i = 0; i < num_design; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
     *dc = params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar);
   }
   return c;
@@ -140,9 +150,9 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   ComplianceProblem problem(mesh, material, supports, loads, weights, params, progress, gravity);
   SimpResult res;
   res.design = problem.design();
-  const int nd = static_cast<int>(res.design.size());
-  Mma mma(nd, 1, params.move);
-  VecXd x = VecXd::Constant(nd, params.volume_fraction);
+  const int num_design = static_cast<int>(res.design.size());
+  Mma mma(num_design, 1, params.move);
+  VecXd x = VecXd::Constant(num_design, params.volume_fraction);
   double previous = 0;
   int calm = 0;
   for (int it = 1; it <= params.max_iterations; ++it) {
@@ -201,7 +211,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   res.variables = x;
   VecXd rho = problem.physical(x);
   res.density = VecXd::Ones(mesh.T.rows());
-  for (int i = 0; i < nd; ++i) res.density[res.design[i]] = rho[i];
+  for (int i = 0; i < num_design; ++i) res.density[res.design[i]] = rho[i];
   return res;
 }
 

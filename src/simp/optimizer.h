@@ -108,4 +108,12 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
 /// Mean edge length of the mesh's tets (for default filter radii).
 double mean_edge_length(const TetMesh& mesh);
 
+/// The filter radius SIMP uses for `params` on `mesh`: the given one, or 1.5 × the mean
+/// edge length when it is <= 0.
+double filter_radius(const TetMesh& mesh, const FilterParams& params);
+
+/// The one check of a volume fraction's range, (0, 1). Throws Error(InvalidParameter)
+/// "`name` must lie strictly between 0 and 1 (...)".
+void check_volume_fraction(double volume_fraction, const std::string& name = "the volume fraction");
+
 }  // namespace topopt::simp

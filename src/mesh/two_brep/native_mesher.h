@@ -2,8 +2,10 @@
 // steps of DESIGN.md into one conformal tagged tet mesh. Both models' surface meshes are
 // built stage by stage on one node pool (ModelSurface), and nodes, segments, triangles and
 // tets move between them by the classification of Ω̄ against Ω (brep/classify.h); the
-// volumes are filled by the 3D advancing front (Ω̄'s solids first, then Ω around their tets).
-// Non-design solids that touch each other share their vertices, edges and touching faces.
+// volumes are filled by the 3D advancing front (Ω̄'s solids first, then Ω around their tets:
+// volume_steps.h). Non-design solids that touch each other share their vertices, edges and
+// touching faces. Sizes and the choice of mesher are decided by the caller
+// (pipeline/mesh_settings.h), not here.
 #pragma once
 #include <string>
 #include <utility>
@@ -18,14 +20,12 @@
 namespace topopt::mesh {
 
 struct NativeMeshParams {
-  NativeMeshParams() { surface.max_angle = 2 * 3.14159265358979323846 / 40; }
-  /// 40 elements per 2π on curved faces, as the product's default: the faceting error of a
-  /// bore, about (2π/N)²/6 of a ring's volume, stays under the 0.5 % the volumes are held to
+  /// Both models' surface settings (the part's size for both, so that what one transfers
+  /// suits the other). size and min_size must be set (> 0).
   SurfaceMeshParams surface;
-  VolumeFillParams volume;  ///< its size is set from the surface size and the gradation if empty
-  /// Refuse meshes estimated above this many tets (memory: ~1 kB per tet through SIMP); the
-  /// fills stop at twice this, should the estimate be off.
-  double max_tets = 6e6;
+  /// The fills' settings; an empty size is graded from both surfaces at the surface's
+  /// gradation and seeded at the middle of thin walls.
+  VolumeFillParams volume;
 };
 
 /// What a run did: the mesher that made the mesh and the seconds of each stage.
@@ -38,15 +38,10 @@ struct MeshRun {
 /// The 14 steps: one conformal tet mesh of Ω, every tet tagged 0 (design, Ω − Ω̄) or i (the
 /// i-th non-design solid, input order); boundary triangles = Ω's boundary with Ω's FreeCAD
 /// face numbers, and nd_face = the face of Ω̄ a triangle also lies on (load pads).
-/// Throws MeshingFailed naming the face, edge, solid or region that could not be meshed.
-TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params = {}, const Progress& progress = {},
+/// `run` (optional) gets mesher "native" and the seconds of steps 1-7, 8-11, 12, 13-14 and
+/// the conformity check. Throws MeshingFailed naming the face, edge, solid or region that
+/// could not be meshed.
+TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params, const Progress& progress = {},
                     MeshRun* run = nullptr);
-
-/// The product's choice of mesher: "native" (mesh_native), "gmsh" (OCC fragments and Gmsh,
-/// gmsh_fragments.h) or "auto" (native; where it cannot close a mesh, a warning through
-/// `progress` and Gmsh). size, min_size in mm, 0 = automatic; wall_layers as
-/// SurfaceMeshParams::wall_layers (the native mesher only).
-TetMesh mesh_two_breps(const brep::TwoBReps& model, const std::string& mesher, double size, double min_size,
-                       const Progress& progress = {}, MeshRun* run = nullptr, int wall_layers = 0);
 
 }  // namespace topopt::mesh

@@ -1,5 +1,6 @@
-// The interim two-B-Rep mesher on the shared examples: one conformal mesh, domains in input
-// order with the B-Reps' volumes, every boundary triangle tagged with a face of Ω.
+// The Gmsh fallback on the shared examples: one conformal mesh, domains in input order with
+// the B-Reps' volumes, every boundary triangle tagged with a face of Ω. Run as the product
+// runs it, in a child process (pipeline::mesh_with_gmsh_isolated), with the product's sizes.
 #include "mesh/two_brep/gmsh_fragments.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,8 @@
 #include "common/error.h"
 #include "mesh/core/conformity.h"
 #include "mesh/core/tet_quality.h"
+#include "pipeline/mesh_model.h"
+#include "pipeline/mesh_settings.h"
 
 namespace topopt::mesh {
 namespace {
@@ -18,11 +21,21 @@ brep::TwoBReps example(const std::string& name) {
                               brep::read_shape_file(dir + name + "_nondesign.step"));
 }
 
+/// The product's Gmsh parameters for `settings` on `model`.
+FragmentMeshParams params_for(const brep::TwoBReps& model, const pipeline::MeshSettings& settings) {
+  return pipeline::gmsh_mesh_params(
+      settings, pipeline::resolve_mesh_sizes(settings, model.part.diagonal(), std::abs(model.part.solid_volume.sum())));
+}
+
+TetMesh gmsh_mesh(const brep::TwoBReps& model, const pipeline::MeshSettings& settings) {
+  return pipeline::mesh_with_gmsh_isolated(model, params_for(model, settings), 600);
+}
+
 void check(const std::string& name, double size) {
   brep::TwoBReps model = example(name);
-  FragmentMeshParams p;
-  p.size = size;
-  TetMesh m = mesh_with_gmsh_fragments(model, p);
+  pipeline::MeshSettings s;
+  s.size = size;
+  TetMesh m = gmsh_mesh(model, s);
   ConformityReport c = check_conformity(m, &model);
   EXPECT_TRUE(c.ok()) << name << ": " << c.to_json().dump();
   EXPECT_LT(c.max_volume_error, 0.005) << name;
@@ -48,26 +61,25 @@ TEST(GmshFragments, CantileverAndBracketWithPadsInContact) {
 TEST(GmshFragments, NativeAdvancingFrontFillsTheVolumesConformally) {
   // steps 12–14 on Gmsh's surface mesh: non-design solids first, then Ω around their tets
   brep::TwoBReps model = example("cantilever");
-  FragmentMeshParams p;
-  p.size = 2.5;
-  p.native_volume = true;
-  TetMesh m = mesh_with_gmsh_fragments(model, p);
+  pipeline::MeshSettings s;
+  s.size = 2.5;
+  s.mesher = pipeline::Mesher::Gmsh;
+  s.gmsh_volume_by_front = true;
+  TetMesh m = gmsh_mesh(model, s);
   ConformityReport c = check_conformity(m, &model);
   EXPECT_TRUE(c.ok()) << c.to_json().dump();
   EXPECT_LT(c.max_volume_error, 1e-9);  // planar faces: exact
   EXPECT_EQ(c.domain_volume.size(), 3u);
 }
 
-TEST(GmshFragments, TooLargeIsRefusedWithASizeToUse) {
+TEST(GmshFragments, RefusesParamsWithoutSizes) {
+  // the sizes are decided by pipeline::MeshSettings; the check comes before Gmsh starts
   brep::TwoBReps model = example("cantilever");
-  FragmentMeshParams p;
-  p.size = 0.01;
   try {
-    mesh_with_gmsh_fragments(model, p);
+    mesh_with_gmsh_fragments(model, FragmentMeshParams{});
     FAIL();
   } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::TooLarge);
-    EXPECT_NE(std::string(e.what()).find("use a mesh size of at least"), std::string::npos);
+    EXPECT_EQ(e.code(), ErrorCode::Internal);
   }
 }
 

@@ -8,8 +8,6 @@
 
 #include <gtest/gtest.h>
 #include <BRepPrimAPI_MakeBox.hxx>
-#include <BRep_Builder.hxx>
-#include <TopoDS_Compound.hxx>
 
 #include <functional>
 #include <map>
@@ -20,6 +18,9 @@
 #include "fem/elasticity.h"
 #include "mesh/core/conformity.h"
 #include "mesh/core/tet_quality.h"
+#include "pipeline/mesh_model.h"
+#include "pipeline/mesh_settings.h"
+#include "testing/expect_error.h"
 
 namespace topopt::mesh {
 namespace {
@@ -30,22 +31,24 @@ brep::TwoBReps load(const std::string& name, bool with_nd = false) {
                               with_nd ? brep::read_shape_file(dir + name + "_nondesign.step") : TopoDS_Shape());
 }
 
-TetMesh mesh_at(const brep::TwoBReps& model, double factor) {
-  NativeMeshParams p;
-  p.surface.size = factor * model.part.diagonal() / 50;
-  return mesh_native(model, p);
+/// The product's parameters (pipeline/mesh_settings.h) at `factor` times the default size.
+NativeMeshParams params_at(const brep::TwoBReps& model, double factor) {
+  pipeline::MeshSettings s;
+  s.size = factor * model.part.diagonal() / 50;
+  return pipeline::native_mesh_params(s, pipeline::resolve_mesh_sizes(s, model.part.diagonal(), 0));
 }
 
-/// f must throw a topopt::Error with `code` whose message contains `fragment`.
-void expect_error(const std::function<void()>& f, ErrorCode code, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << e.what();
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
+TetMesh mesh_at(const brep::TwoBReps& model, double factor) { return mesh_native(model, params_at(model, factor)); }
+
+/// The product's mesher choice (pipeline::mesh_model) with `mesher` and `wall_layers`.
+TetMesh mesh_with(const brep::TwoBReps& model, pipeline::Mesher mesher, int wall_layers = 0, MeshRun* run = nullptr) {
+  pipeline::MeshSettings s;
+  s.mesher = mesher;
+  s.wall_layers = wall_layers;
+  return pipeline::mesh_model(model, s, {}, run);
 }
+
+using topopt::testing::expect_error;
 
 double triangle_area(const TetMesh& m, int a, int b, int c) {
   return 0.5 * (m.V.row(b) - m.V.row(a)).cross(m.V.row(c) - m.V.row(a)).norm();
@@ -79,7 +82,7 @@ TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
   double deflection[2], spanning[2];
   for (int layers : {0, 2}) {
     const int k = layers ? 1 : 0;
-    const TetMesh m = mesh_two_breps(model, "native", 0, 0, {}, nullptr, layers);
+    const TetMesh m = mesh_with(model, pipeline::Mesher::Native, layers);
     const fem::Supports sup = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
     const fem::LoadSpec tip{fem::LoadSpec::Kind::Force, {2}, {0, 0, -1}, 0, {}};
     const Eigen::MatrixXd F = fem::make_loads(m, mat, {fem::LoadCase{"tip", {tip}, 1}});
@@ -182,41 +185,10 @@ TEST(TwoBRepSteps, LoadPadFaceIsTaggedOnThePartBoundary) {
   EXPECT_NEAR(area, 24.0, 1e-9);
 }
 
-TEST(TwoBRepSteps, MesherChoiceIsCheckedAndReported) {
-  const brep::TwoBReps model = load("cantilever", true);
-  MeshRun run;
-  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
-  EXPECT_EQ(run.mesher, "native");
-  EXPECT_TRUE(run.fallback_reason.empty());
-  ASSERT_EQ(run.seconds.size(), 5u);  // steps 1-7, 8-11, 12, 13-14, the conformity check
-  EXPECT_EQ(run.seconds.back().first, "conformity check");
-  EXPECT_TRUE(check_conformity(m, &model).ok());
-  // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
-  expect_error([&] { mesh_two_breps(model, "auto", 0.01, 0); }, ErrorCode::TooLarge, "mesh size of at least");
-  expect_error([&] { mesh_two_breps(model, "netgen", 0, 0); }, ErrorCode::InvalidParameter, "native");
-}
-
-TEST(TwoBRepSteps, PartialContactIsNamedAndAutoFallsBackToGmsh) {
-  // two non-design blocks inside a box touch on x = 20, but the first one's face there is
-  // smaller than the second one's: the native mesher meshes only identical touching faces
-  // and says so; "auto" then meshes through Gmsh's fragments, conformally
-  auto box = [](double x, double y, double z, double dx, double dy, double dz) {
-    return BRepPrimAPI_MakeBox(gp_Pnt(x, y, z), dx, dy, dz).Shape();
-  };
-  TopoDS_Compound nd;
-  BRep_Builder builder;
-  builder.MakeCompound(nd);
-  builder.Add(nd, box(10, 5, 2, 10, 10, 6));
-  builder.Add(nd, box(20, 2, 1, 10, 16, 8));
-  const brep::TwoBReps model = brep::load_two_breps(box(0, 0, 0, 40, 20, 10), nd);
-  ASSERT_EQ(model.relations.contacts.size(), 1u);
-  expect_error([&] { mesh_native(model); }, ErrorCode::MeshingFailed, "identical touching faces");
-  MeshRun run;
-  const TetMesh m = mesh_two_breps(model, "auto", 0, 0, {}, &run);
-  EXPECT_EQ(run.mesher, "gmsh");
-  EXPECT_NE(run.fallback_reason.find("identical touching faces"), std::string::npos);
-  const ConformityReport c = check_conformity(m, &model);
-  EXPECT_TRUE(c.ok()) << c.to_json().dump();
+TEST(NativeMesher, RefusesParamsWithoutSizes) {
+  // the sizes are decided by pipeline::MeshSettings, never by the mesher
+  const brep::TwoBReps model = load("cantilever");
+  expect_error([&] { mesh_native(model, NativeMeshParams{}); }, ErrorCode::Internal, {"sizes"});
 }
 
 }  // namespace

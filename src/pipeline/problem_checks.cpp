@@ -1,0 +1,106 @@
+// Checks of an optimisation problem before SIMP (see problem_checks.h).
+#include "pipeline/problem_checks.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "common/error.h"
+
+namespace topopt::pipeline {
+namespace {
+
+/// Bytes per filter pair while DensityFilter is built: its neighbour lists (16), two triplet
+/// lists (32), two sparse matrices (24) and a sparse matrix's temporary (12), rounded up.
+constexpr double kBytesPerPair = 90;
+
+/// A figure as a user reads it: 3 significant digits, no exponent below a million.
+std::string number(double v) {
+  std::ostringstream s;
+  if (std::abs(v) >= 100 && std::abs(v) < 1e6)
+    s << std::lround(v);
+  else
+    s << std::setprecision(3) << v;
+  return s.str();
+}
+
+}  // namespace
+
+void check_loads_reach_the_part(const Eigen::MatrixXd& loads, const fem::Supports& supports,
+                                const std::vector<fem::LoadCase>& cases) {
+  for (long c = 0; c < loads.cols(); ++c) {
+    const std::string name = c < static_cast<long>(cases.size()) ? cases[c].name : std::to_string(c + 1);
+    const double total = loads.col(c).cwiseAbs().sum();
+    if (!(total > 0))
+      throw Error(ErrorCode::InvalidParameter,
+                  "load case \"" + name + "\" puts no force on the part: its loads are zero; give a force (N), a " +
+                      "pressure (MPa) or a gravity (mm/s²) that is not zero");
+    double held = 0;
+    for (int dof : supports.dofs) held += std::abs(loads(dof, c));
+    if (held >= total * (1 - 1e-12))
+      throw Error(
+          ErrorCode::InvalidParameter,
+          "load case \"" + name + "\" acts only where the supports hold the part (every node it loads is " +
+              "fixed), so nothing deforms: put the load on a face that is not supported, or support fewer faces");
+  }
+}
+
+std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int bins) {
+  std::vector<Eigen::RowVector3d> centre;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0)
+      centre.push_back(0.25 * (mesh.V.row(mesh.T(t, 0)) + mesh.V.row(mesh.T(t, 1)) + mesh.V.row(mesh.T(t, 2)) +
+                               mesh.V.row(mesh.T(t, 3))));
+  std::vector<double> pairs(static_cast<size_t>(bins), 0.0);
+  const size_t n = centre.size();
+  if (n == 0 || !(radius > 0)) return pairs;
+  const size_t samples = std::min<size_t>(64, n);
+  for (size_t k = 0; k < samples; ++k) {
+    const Eigen::RowVector3d& p = centre[(n * (2 * k + 1)) / (2 * samples)];
+    for (const auto& q : centre) {
+      const double d = (q - p).norm();
+      if (d < radius) pairs[std::min(static_cast<size_t>(d / radius * bins), static_cast<size_t>(bins - 1))] += 1;
+    }
+  }
+  const double scale = static_cast<double>(n) / static_cast<double>(samples);
+  double sum = 0;
+  for (double& p : pairs) p = (sum += p) * scale;
+  return pairs;
+}
+
+double estimated_filter_pairs(const TetMesh& mesh, double radius) { return filter_pairs_within(mesh, radius, 1)[0]; }
+
+void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes) {
+  const Eigen::RowVector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
+  const double diagonal = (hi - lo).norm();
+  if (given && radius > diagonal)
+    throw Error(ErrorCode::InvalidParameter,
+                "job file: 'optimization.filter_radius' (" + number(radius) + " mm) is larger than the part (its " +
+                    "diagonal is " + number(diagonal) + " mm), so the filter would blur the whole design into one " +
+                    "grey: give about twice the mesh size, or the thinnest member you want");
+  if (!(memory_bytes > 0)) return;
+  const int bins = 200;
+  const std::vector<double> within = filter_pairs_within(mesh, radius, bins);
+  const double pairs = within.back();
+  const double budget = 0.5 * memory_bytes / kBytesPerPair;
+  if (pairs <= budget) return;
+  int fits = 0;  // the largest radius k/bins * radius whose pairs fit
+  while (fits < bins && within[fits] <= budget) ++fits;
+  const std::string need = "the density filter of radius " + number(radius) + " mm would hold about " + number(pairs) +
+                           " neighbour pairs (" + number(pairs * kBytesPerPair / 1e9) +
+                           " GB), more than this machine's memory allows: ";
+  if (given)
+    throw Error(ErrorCode::TooLarge,
+                need + "give 'optimization.filter_radius' at most " + number(radius * fits / bins) + " mm");
+  throw Error(ErrorCode::TooLarge, need + "use a coarser mesh size (the automatic radius is 1.5 mean edges)");
+}
+
+double physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
+}
+
+}  // namespace topopt::pipeline

@@ -1,0 +1,38 @@
+// Checks of an optimisation problem on its mesh, before SIMP starts, that turn what would
+// fail deep inside (a singular update, a filter that eats the memory) into a message that
+// says what to change: loads that put no force on the part, and a filter radius larger than
+// the part or asking for more neighbour pairs than memory holds.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+#include "fem/boundary_conditions.h"
+
+namespace topopt::pipeline {
+
+/// Per load case (column c of `loads`, (3*#V) by #cases, named by cases[c].name): throws
+/// Error(InvalidParameter) when its loads sum to nothing ("give a force that is not zero")
+/// or act only on degrees of freedom the supports fix ("move the load or the support").
+void check_loads_reach_the_part(const Eigen::MatrixXd& loads, const fem::Supports& supports,
+                                const std::vector<fem::LoadCase>& cases);
+
+/// About how many (element, neighbour) pairs a density filter of `radius` holds over the
+/// design tets of `mesh` (domain 0): the neighbours of up to 64 tets spread over the design,
+/// counted exactly, times the number of design tets.
+double estimated_filter_pairs(const TetMesh& mesh, double radius);
+
+/// The same estimate for the radii (k + 1) / bins × radius, k = 0 .. bins - 1 (one pass).
+std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int bins);
+
+/// Throws Error(InvalidParameter) when `radius` (mm; given = the user set
+/// 'optimization.filter_radius') exceeds the part's diagonal, and Error(TooLarge) when the
+/// filter's estimated pairs need more than half of `memory_bytes` (each pair ~90 bytes
+/// while the filter is built); both name the largest radius to use, or a coarser mesh when
+/// the radius was the automatic one.
+void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes);
+
+/// The machine's physical memory in bytes (0 when unknown: no memory check).
+double physical_memory_bytes();
+
+}  // namespace topopt::pipeline

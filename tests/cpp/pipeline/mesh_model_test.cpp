@@ -1,0 +1,147 @@
+// The mesher choice: auto meshes natively and reports it, falls back to Gmsh (in a child
+// process) where the native mesher cannot close a mesh, refuses a mesh too large before any
+// meshing, names Gmsh's timeout, and leaves no file behind from Gmsh.
+#include "pipeline/mesh_model.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRep_Builder.hxx>
+#include <TopoDS_Compound.hxx>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include "brep/shape_io.h"
+#include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "fem/elasticity.h"
+#include "mesh/core/conformity.h"
+#include "mesh/two_brep/native_mesher.h"
+#include "testing/expect_error.h"
+
+namespace topopt::pipeline {
+namespace {
+namespace fs = std::filesystem;
+
+brep::TwoBReps example(const std::string& name) {
+  const std::string dir = std::string(TOPOPT_SHARED_DATA) + "/examples/";
+  return brep::load_two_breps(brep::read_shape_file(dir + name + ".step"),
+                              brep::read_shape_file(dir + name + "_nondesign.step"));
+}
+
+/// Two non-design blocks inside a box that touch on x = 20 with faces of different sizes:
+/// the native mesher meshes only identical touching faces.
+brep::TwoBReps partial_contact() {
+  auto box = [](double x, double y, double z, double dx, double dy, double dz) {
+    return BRepPrimAPI_MakeBox(gp_Pnt(x, y, z), dx, dy, dz).Shape();
+  };
+  TopoDS_Compound nd;
+  BRep_Builder builder;
+  builder.MakeCompound(nd);
+  builder.Add(nd, box(10, 5, 2, 10, 10, 6));
+  builder.Add(nd, box(20, 2, 1, 10, 16, 8));
+  return brep::load_two_breps(box(0, 0, 0, 40, 20, 10), nd);
+}
+
+using topopt::testing::expect_error;
+
+MeshSettings with(Mesher mesher, double size = 0) {
+  MeshSettings s;
+  s.mesher = mesher;
+  s.size = size;
+  return s;
+}
+
+TEST(MeshModel, MesherChoiceIsCheckedAndReported) {
+  const brep::TwoBReps model = example("cantilever");
+  mesh::MeshRun run;
+  const TetMesh m = mesh_model(model, with(Mesher::Auto), {}, &run);
+  EXPECT_EQ(run.mesher, "native");
+  EXPECT_TRUE(run.fallback_reason.empty());
+  ASSERT_EQ(run.seconds.size(), 5u);  // steps 1-7, 8-11, 12, 13-14, the conformity check
+  EXPECT_EQ(run.seconds.back().first, "conformity check");
+  EXPECT_TRUE(mesh::check_conformity(m, &model).ok());
+  // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
+  expect_error([&] { mesh_model(model, with(Mesher::Auto, 0.01)); }, ErrorCode::TooLarge, {"mesh size of at least"});
+  expect_error([&] { mesh_model(model, with(Mesher::Gmsh, 0.01)); }, ErrorCode::TooLarge, {"mesh size of at least"});
+}
+
+TEST(MeshModel, AutoFallsBackToGmshInAChildProcess) {
+  const brep::TwoBReps model = partial_contact();
+  ASSERT_EQ(model.relations.contacts.size(), 1u);
+  std::vector<std::string> warnings;
+  Progress p;
+  p.log = [&](LogLevel level, const std::string& m) {
+    if (level == LogLevel::Warning) warnings.push_back(m);
+  };
+  mesh::MeshRun run;
+  const TetMesh m = mesh_model(model, with(Mesher::Auto), p, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_NE(run.fallback_reason.find("identical touching faces"), std::string::npos);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("meshing with Gmsh's OCC fragments instead"), std::string::npos);
+  const mesh::ConformityReport c = mesh::check_conformity(m, &model);
+  EXPECT_TRUE(c.ok()) << c.to_json().dump();
+  // "native" does not fall back
+  expect_error([&] { mesh_model(model, with(Mesher::Native)); }, ErrorCode::MeshingFailed, {"identical touching"});
+}
+
+TEST(MeshModel, GmshPastItsTimeBudgetIsANamedError) {
+  MeshSettings s = with(Mesher::Gmsh);
+  s.gmsh_seconds = 0.05;
+  expect_error([&] { mesh_model(example("rocker"), s); }, ErrorCode::Timeout,
+               {"meshing with Gmsh did not finish within"});
+  // under auto, the native mesher's failure is named first
+  s.mesher = Mesher::Auto;
+  expect_error([&] { mesh_model(partial_contact(), s); }, ErrorCode::Timeout,
+               {"the native mesher could not mesh this part", "identical touching faces",
+                "the Gmsh fallback failed too", "did not finish"});
+}
+
+TEST(MeshModel, GmshInItsChildAfterParallelWorkInTheParent) {
+  // the workbench's process solves (CHOLMOD, BLAS and OpenMP threads) before a later run falls
+  // back to Gmsh: the forked child, which has one thread, must still mesh (not hang)
+  const brep::TwoBReps model = example("cantilever");
+  const TetMesh native = mesh_model(model, with(Mesher::Native, 2));
+  const fem::Supports s =
+      fem::make_supports(native, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}, {true, true, true}, {}}});
+  const Eigen::MatrixXd F = fem::make_loads(
+      native, {}, {fem::LoadCase{"tip", {fem::LoadSpec{fem::LoadSpec::Kind::Gravity, {}, {0, 0, -9810}, 0, {}}}, 1}});
+  fem::Elasticity fe(native, {}, s, {});
+  EXPECT_GT(F.col(0).dot(fe.solve(F).col(0)), 0);
+  MeshSettings g = with(Mesher::Gmsh, 4);
+  g.gmsh_seconds = 120;
+  mesh::MeshRun run;
+  const TetMesh m = mesh_model(model, g, {}, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_TRUE(mesh::check_conformity(m, &model).ok());
+}
+
+TEST(MeshModel, GmshWritesNoFileOfItsOwn) {
+  // Gmsh starts FLTK, which rewrites $HOME/.fltk/fltk.org/fltk.prefs, and Gmsh removes
+  // $HOME/.gmsh-tmp: a HOME of our own must stay as it was (a file Gmsh would delete included)
+  const fs::path home = fs::temp_directory_path() / ("topopt_gmsh_home_" + std::to_string(::getpid()));
+  fs::create_directories(home);
+  std::ofstream(home / ".gmsh-tmp") << "the user's file\n";
+  const char* old = std::getenv("HOME");
+  const std::string saved = old ? old : "";
+  ::setenv("HOME", home.c_str(), 1);
+  mesh::MeshRun run;
+  EXPECT_NO_THROW(mesh_model(example("cantilever"), with(Mesher::Gmsh, 4), {}, &run));
+  if (old)
+    ::setenv("HOME", saved.c_str(), 1);
+  else
+    ::unsetenv("HOME");
+  EXPECT_EQ(run.mesher, "gmsh");
+  std::vector<std::string> left;
+  for (const auto& e : fs::recursive_directory_iterator(home)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{".gmsh-tmp"});
+  EXPECT_TRUE(fs::exists(home / ".gmsh-tmp"));
+  fs::remove_all(home);
+}
+
+}  // namespace
+}  // namespace topopt::pipeline
