@@ -24,6 +24,7 @@ int cmd_mesh(const Args& args) {
       args,
       "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] [--wall-layers N] --out FILE\n"
       "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
+      "                   [--time-budget S]\n"
       "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
       "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
       "  part's face numbers (FreeCAD's FaceN).\n"
@@ -35,13 +36,16 @@ int cmd_mesh(const Args& args) {
       "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh;\n"
       "           auto (default): native, and gmsh with a warning where native fails\n"
       "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
-      "           (a comparison aid)");
+      "           (a comparison aid)\n"
+      "  --time-budget S  seconds allowed for reading, or checking and healing, each input\n"
+      "           (default: 30 s + 15 s per MB of file)");
   if (a.print_help()) return 0;
   std::string part = a.option("part"), nd = a.option("non-design"), out = a.option("out"), stats = a.option("stats");
   mesh::FragmentMeshParams mp;
   mp.size = a.number("size", 0);
   mp.min_size = a.number("min-size", 0);
   const int wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
+  const brep::ForeignParams budget = a.time_budget();
   std::string volume = a.option("volume", "gmsh"), mesher = a.option("mesher", "auto");
   if (mesher != "auto" && mesher != "gmsh" && mesher != "native")
     throw Error(ErrorCode::InvalidParameter, "--mesher takes auto, native or gmsh");
@@ -55,9 +59,9 @@ int cmd_mesh(const Args& args) {
     throw Error(ErrorCode::InvalidParameter, "--out must end in .msh, .vtu or .inp");
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  TopoDS_Shape p = brep::read_shape_file(part);
-  TopoDS_Shape n = nd.empty() ? TopoDS_Shape() : brep::read_shape_file(nd);
-  brep::TwoBReps model = brep::load_two_breps(p, n);
+  TopoDS_Shape p = brep::read_shape_file(part, "part", budget);
+  TopoDS_Shape n = nd.empty() ? TopoDS_Shape() : brep::read_shape_file(nd, "non-design input", budget);
+  brep::TwoBReps model = brep::load_two_breps(p, n, {}, {}, budget);
   auto t1 = clock::now();
   Progress progress;
   progress.report = [](const std::string& stage, double, const std::string& msg) {

@@ -6,7 +6,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "brep/occt_guard.h"
 #include "brep/shape_io.h"
+#include "brep/solid_check.h"
 #include "brep/topology_index.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -19,7 +21,7 @@ namespace topopt::cli {
 int cmd_surface(const Args& args) {
   ArgReader a(args,
               "usage: topopt surface --part PART [--size H] [--min-size H0] [--wall-layers N] [--out FILE.stl]\n"
-              "                      [--stats STATS.json]\n"
+              "                      [--stats STATS.json] [--time-budget S]\n"
               "  Meshes every face of PART (STEP or BREP) with the native surface mesher: a closed,\n"
               "  consistently oriented triangulation per solid, each triangle tagged with its face.\n"
               "  --size   target edge length in mm (default: part diagonal / 50)\n"
@@ -27,6 +29,8 @@ int cmd_surface(const Args& args) {
               "           (sizes from the wall thickness, measured by rays; default 0: off)\n"
               "  --out    binary STL; each triangle's attribute bytes hold its face number (FaceN)\n"
               "  --stats  counts, open edges per solid, self-intersections, angles, time (JSON)\n"
+              "  --time-budget S  seconds allowed for reading, or checking and healing, the part\n"
+              "           (default: 30 s + 15 s per MB of file)\n"
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
   if (a.print_help()) return 0;
   const std::string part = a.option("part"), out = a.option("out"), stats = a.option("stats");
@@ -34,13 +38,17 @@ int cmd_surface(const Args& args) {
   p.size = a.number("size", 0);
   p.min_size = a.number("min-size", 0);
   p.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
+  const brep::ForeignParams budget = a.time_budget();
   if (!a.positionals().empty() || part.empty()) throw Error(ErrorCode::InvalidParameter, "give --part\n" + a.usage());
   if (p.size < 0 || p.min_size < 0) throw Error(ErrorCode::InvalidParameter, "mesh sizes must be positive (mm)");
   if (!out.empty() && std::filesystem::path(out).extension() != ".stl")
     throw Error(ErrorCode::InvalidParameter, "--out must end in .stl");
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(part));
+  std::vector<std::string> notes;  // repairs: a healed part is meshed as healed
+  const TopoDS_Shape shape = brep::check_solids(brep::read_shape_file(part, "part", budget), "part", notes, budget);
+  for (const std::string& note : notes) std::cerr << "note: " << note << "\n";
+  brep::TopologyIndex topo = brep::guard_occt("indexing the part", [&] { return brep::index_topology(shape); });
   auto t1 = clock::now();
   mesh::SurfaceMesh m = mesh::mesh_surface(topo, p);
   auto t2 = clock::now();
