@@ -36,8 +36,9 @@ void bind_mesh(pybind11::module_& m) {
         keep_warnings(progress, warnings);
         {
           pybind11::gil_scoped_release release;
-          TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
-          TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
+          TopoDS_Shape part = brep::read_brep_string(part_brep, "part", {}, progress);
+          TopoDS_Shape nd =
+              nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids", {}, progress);
           mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
           q = mesh::tet_quality(mesh);
         }

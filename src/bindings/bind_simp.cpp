@@ -100,8 +100,9 @@ void bind_simp(pyb::module_& m) {
             mesh = pipeline::job_mesh(job, progress);
           } else {
             if (part_brep.empty()) throw Error(ErrorCode::InvalidParameter, "no part given");
-            TopoDS_Shape part = brep::read_brep_string(part_brep, "part");
-            TopoDS_Shape nd = nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids");
+            TopoDS_Shape part = brep::read_brep_string(part_brep, "part", {}, progress);  // cancellable
+            TopoDS_Shape nd =
+                nd_brep.empty() ? TopoDS_Shape() : brep::read_brep_string(nd_brep, "non-design solids", {}, progress);
             mesh = pipeline::mesh_job_shapes(job, part, nd, progress);
           }
           progress.check_cancel("meshing");

@@ -25,7 +25,12 @@ namespace {
 
 constexpr double kMB = 1024.0 * 1024.0;
 
-std::string seconds_text(double s) { return std::to_string(static_cast<long>(s + 0.5)) + " s"; }
+std::string seconds_text(double s) {
+  std::ostringstream out;
+  out.precision(3);
+  out << s << " s";
+  return out.str();
+}
 
 /// Address space in use now (bytes), from /proc/self/statm; 0 if unknown.
 double address_space_now() {

@@ -182,7 +182,7 @@ TEST(ForeignRead, HangCrashAndHugeAllocationInTheChildAreNamed) {
   });
   EXPECT_EQ(hang.code(), ErrorCode::Timeout);
   EXPECT_STREQ(hang.what(),
-               "the part's file 'p.step' is damaged or very large: OCCT did not finish reading it within 1 s; "
+               "the part's file 'p.step' is damaged or very large: OCCT did not finish reading it within 0.5 s; "
                "re-export it from your CAD system, or allow more time (--time-budget) if it is large and sound");
   const Error crash = error_of([&] {
     run_foreign(input, "reading", {}, [] {
