@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
+#include <BinTools.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
@@ -69,12 +70,12 @@ std::string child_work(const ForeignInput& input, const std::string& doing, doub
   try {
     return work();
   } catch (const Standard_Failure& f) {
-    throw Error(ErrorCode::Io, input.subject + " is damaged: OCCT could not finish " + doing + " it (" +
-                                   occt_failure_kind(f) + "); " + input.advice);
+    throw Error(input.code, input.subject + " is damaged: OCCT could not finish " + doing + " it (" +
+                                occt_failure_kind(f) + "); " + input.advice);
   } catch (const std::bad_alloc&) {
-    throw Error(ErrorCode::Io, input.subject + " is damaged: " + doing + " it asked for more than " +
-                                   std::to_string(static_cast<long>(memory / kMB / 1024 + 0.5)) + " GB of memory; " +
-                                   input.advice);
+    throw Error(input.code, input.subject + " is damaged or too large: " + doing + " it needed more than " +
+                                std::to_string(static_cast<long>(memory / kMB / 1024 + 0.5)) + " GB of memory; " +
+                                input.advice);
   }
 }
 
@@ -163,14 +164,22 @@ TopoDS_Shape parse_brep_text(const std::string& text, const ForeignInput& input)
   return shape;
 }
 
-std::string handover_text(const TopoDS_Shape& shape, const ForeignInput& input) {
-  std::ostringstream out;
-  BRepTools::Write(shape, out);
-  std::string text = out.str();
-  ForeignInput written = input;
-  written.subject = "the BREP text OCCT wrote for " + input.subject;
-  parse_brep_text(text, written);
-  return text;
+std::string handover_bytes(const TopoDS_Shape& shape, const ForeignInput& input) {
+  std::ostringstream out(std::ios::binary);
+  BinTools::Write(shape, out);
+  std::string bytes = out.str();
+  shape_from_handover(bytes, input);
+  return bytes;
+}
+
+TopoDS_Shape shape_from_handover(const std::string& bytes, const ForeignInput& input) {
+  return guard_occt("reading the shape OCCT wrote for " + input.subject, [&] {
+    std::istringstream in(bytes, std::ios::binary);
+    TopoDS_Shape shape;
+    BinTools::Read(shape, in);
+    if (shape.IsNull()) throw Error(ErrorCode::Internal, "the shape OCCT wrote for " + input.subject + " is empty");
+    return shape;
+  });
 }
 
 }  // namespace topopt::brep

@@ -1,7 +1,9 @@
 // Foreign geometry: STEP, IGES and BREP files and BREP strings that come from outside. OCCT
 // can crash, hang or exhaust memory on a damaged one, so every read, check and heal of it
 // runs in a child process (common/isolate.h) with a time and memory budget taken from the
-// input's size; the child hands back BREP text written by OCCT, which the caller re-reads.
+// input's size; the child hands back the shape as binary BREP written by OCCT (exact doubles:
+// OCCT's BREP text keeps 15 digits of edge ranges, and that moves meshes), which the caller
+// re-reads.
 // A crash, a hang or a refusal comes back as a topopt::Error naming the input and saying
 // what to do, and the caller (the CLI, FreeCAD) is unharmed.
 #pragma once
@@ -9,6 +11,7 @@
 #include <functional>
 #include <string>
 
+#include "common/error.h"
 #include "common/progress.h"
 
 namespace topopt::brep {
@@ -30,9 +33,10 @@ struct ForeignParams {
 
 /// One foreign input as messages name it.
 struct ForeignInput {
-  std::string subject;  ///< "the part's file 'x.step'", "the non-design input", ...
-  std::string advice;   ///< what to do when it is damaged: "re-export it from your CAD system"
-  double bytes = 0;     ///< its size (file or text bytes; a shape's estimate: shape_bytes)
+  std::string subject;             ///< "the part's file 'x.step'", "the non-design input", ...
+  std::string advice;              ///< what to do when it is damaged: "re-export it from your CAD system"
+  double bytes = 0;                ///< its size (file or text bytes; a shape's estimate: shape_bytes)
+  ErrorCode code = ErrorCode::Io;  ///< the code of a refusal: Io for a file, InvalidShape for a shape
 };
 
 /// The automatic time budget for an input of `bytes` (ForeignParams::seconds if > 0).
@@ -45,7 +49,7 @@ double shape_bytes(const TopoDS_Shape& shape);
 /// Runs `work` (`doing` the input: "reading", "checking and healing") in a child process
 /// under the input's budget and returns its bytes. In the child, faults end the process
 /// (OCCT's and FreeCAD's signal handlers are reset), memory is limited, and OCCT's
-/// exceptions become Error(Io) in words. Throws, naming the input and giving the advice:
+/// exceptions become Error(input.code) in words. Throws, naming the input and giving the advice:
 /// the child's own Error; Error(Crashed) "... is damaged: OCCT crashed reading it ...";
 /// Error(Timeout) when it runs past the budget; Error(Cancelled) on a cancel.
 std::string run_foreign(const ForeignInput& input, const std::string& doing, const ForeignParams& params,
@@ -61,8 +65,13 @@ void precheck_brep_text(const std::string& text, const ForeignInput& input);
 /// Error(Io) naming the input and the line where reading failed, or an empty shape.
 TopoDS_Shape parse_brep_text(const std::string& text, const ForeignInput& input);
 
-/// The BREP text that carries `shape` out of the child: written by OCCT and parsed back
-/// once in the child, so that the caller's parse of it has already succeeded once.
-std::string handover_text(const TopoDS_Shape& shape, const ForeignInput& input);
+/// The bytes that carry `shape` out of the child: binary BREP written by OCCT (BinTools, every
+/// double exact) and read back once in the child, so that the caller's read of them
+/// (shape_from_handover) has already succeeded once.
+std::string handover_bytes(const TopoDS_Shape& shape, const ForeignInput& input);
+
+/// The shape in bytes made by handover_bytes. Throws Error naming the input if they do not
+/// hold one (OCCT's failures in words).
+TopoDS_Shape shape_from_handover(const std::string& bytes, const ForeignInput& input);
 
 }  // namespace topopt::brep

@@ -26,7 +26,7 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-/// Runs in the child: STEP or IGES through OCCT's reader, handed back as BREP text.
+/// Runs in the child: STEP or IGES through OCCT's reader, handed back as binary BREP.
 template <class Reader>
 std::string read_with(const std::string& path, const char* format, const ForeignInput& input) {
   Reader reader;
@@ -36,7 +36,7 @@ std::string read_with(const std::string& path, const char* format, const Foreign
   reader.TransferRoots();
   TopoDS_Shape shape = reader.OneShape();
   if (shape.IsNull()) throw Error(ErrorCode::Io, input.subject + " holds no shape that can be transferred");
-  return handover_text(shape, input);
+  return handover_bytes(shape, input);
 }
 
 std::string file_text(const std::string& path) {
@@ -47,13 +47,13 @@ std::string file_text(const std::string& path) {
   return s.str();
 }
 
-/// BREP text through the child: pre-checked here, parsed and rewritten there, parsed here.
+/// BREP text through the child: pre-checked here, parsed there, handed back as binary BREP.
 TopoDS_Shape read_brep_text(const std::string& text, const ForeignInput& input, const ForeignParams& params,
                             const Progress& progress) {
   precheck_brep_text(text, input);
   const std::string clean = run_foreign(
-      input, "reading", params, [&] { return handover_text(parse_brep_text(text, input), input); }, progress);
-  return guard_occt("reading " + input.subject, [&] { return parse_brep_text(clean, input); });
+      input, "reading", params, [&] { return handover_bytes(parse_brep_text(text, input), input); }, progress);
+  return shape_from_handover(clean, input);
 }
 
 }  // namespace
@@ -76,7 +76,7 @@ TopoDS_Shape read_shape_file(const std::string& path, const std::string& what, c
   else
     throw Error(ErrorCode::Io,
                 "unknown file type '" + ext + "' for '" + path + "': use .step/.stp, .iges/.igs or .brep");
-  return guard_occt("reading " + input.subject, [&] { return parse_brep_text(clean, input); });
+  return shape_from_handover(clean, input);
 }
 
 TopoDS_Shape read_brep_string(const std::string& text, const std::string& what, const ForeignParams& params,

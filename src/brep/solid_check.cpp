@@ -149,19 +149,23 @@ TopoDS_Shape check_one(const TopoDS_Shape& item, const std::string& label, std::
   return turned_outwards(healed_if_invalid(solid, label, notes), label, notes);
 }
 
-/// Runs in the child: checks and heals every item; returns the notes and, for each item that
-/// changed (made a solid, turned outwards, healed), its BREP text, as JSON
-/// {"notes": [...], "replaced": {"<item>": "<BREP>"}}.
+/// Runs in the child: checks and heals every item. Returns one line of JSON,
+/// {"notes": [...], "replaced": [[item, bytes], ...]}, then for each item that changed (made
+/// a solid, turned outwards, healed) its shape as handover bytes, in that order.
 std::string check_items_here(const std::vector<TopoDS_Shape>& items, const std::string& what,
                              const ForeignInput& input) {
   std::vector<std::string> notes;
-  nlohmann::json replaced = nlohmann::json::object();
+  nlohmann::json replaced = nlohmann::json::array();
+  std::string shapes;
   for (size_t i = 0; i < items.size(); ++i) {
     std::string label = items.size() == 1 ? "the " + what : "item " + std::to_string(i + 1) + " of the " + what;
     TopoDS_Shape checked = check_one(items[i], label, notes);
-    if (!checked.IsEqual(items[i])) replaced[std::to_string(i)] = handover_text(checked, input);
+    if (checked.IsEqual(items[i])) continue;
+    const std::string bytes = handover_bytes(checked, input);
+    replaced.push_back({i, bytes.size()});
+    shapes += bytes;
   }
-  return nlohmann::json{{"notes", notes}, {"replaced", replaced}}.dump();
+  return nlohmann::json{{"notes", notes}, {"replaced", replaced}}.dump() + "\n" + shapes;
 }
 
 }  // namespace
@@ -172,13 +176,18 @@ TopoDS_Shape check_solids(const TopoDS_Shape& shape, const std::string& what, st
   std::vector<TopoDS_Shape> items;
   flatten(shape, items);
   if (items.empty()) throw Error(ErrorCode::InvalidShape, "the " + what + " holds no solid");
-  const ForeignInput input{"the " + what, kRepairAdvice, shape_bytes(shape)};
-  const nlohmann::json answer = nlohmann::json::parse(run_foreign(
-      input, "checking and healing", params, [&] { return check_items_here(items, what, input); }, progress));
-  for (const auto& note : answer["notes"]) notes.push_back(note.get<std::string>());
-  for (const auto& [item, text] : answer["replaced"].items())
-    items[std::stoul(item)] =
-        guard_occt("reading the healed " + what, [&] { return parse_brep_text(text.get<std::string>(), input); });
+  const ForeignInput input{"the " + what, kRepairAdvice, shape_bytes(shape), ErrorCode::InvalidShape};
+  const std::string answer = run_foreign(
+      input, "checking and healing", params, [&] { return check_items_here(items, what, input); }, progress);
+  const size_t line = answer.find('\n');
+  const nlohmann::json head = nlohmann::json::parse(answer.substr(0, line));
+  for (const auto& note : head["notes"]) notes.push_back(note.get<std::string>());
+  size_t at = line + 1;
+  for (const auto& r : head["replaced"]) {
+    const size_t n = r[1].get<size_t>();
+    items[r[0].get<size_t>()] = shape_from_handover(answer.substr(at, n), input);
+    at += n;
+  }
   if (items.size() == 1 && shape.ShapeType() == TopAbs_SOLID) return items[0];
   TopoDS_Compound compound;
   BRep_Builder builder;

@@ -16,7 +16,7 @@ namespace topopt::brep {
 /// `what` names the input in messages ("part", "non-design input").
 /// The checks and repairs run in a child process under `params`' budget (brep/foreign.h):
 /// OCCT's checker and ShapeFix crash or hang on some damaged B-Reps. Items that changed come
-/// back as BREP text written by OCCT; the others are the caller's own shapes, untouched.
+/// back as binary BREP written by OCCT; the others are the caller's own shapes, untouched.
 /// Returns the checked (possibly healed) shape: a solid, or a compound of solids in the
 /// input order. Throws Error(InvalidShape) saying which item is wrong and how, and
 /// Error(Crashed) or Error(Timeout) when OCCT crashed or hung on the input.
