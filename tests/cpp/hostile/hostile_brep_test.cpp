@@ -109,9 +109,9 @@ TEST(HostileBrep, DigitChanges) { info_cases(Damage::Digit, "digit changes"); }
 
 TEST(HostileBrep, MeshingDamagedPartsThatRead) {
   // The interesting ones for the mesher: damage that `info` accepts (a changed digit moves a
-  // point or a radius and the part still checks). Six of them through `topopt mesh`.
+  // point or a radius and the part still checks). Four of them through `topopt mesh`.
   int meshed = 0;
-  for (int seed = 1; seed <= 4 * kCasesPerKind && meshed < 6; ++seed) {
+  for (int seed = 1; seed <= 4 * kCasesPerKind && meshed < 4; ++seed) {
     const fs::path p = write_case(Damage::Digit, seed);
     if (run_cli("info --time-budget 20 --part " + p.string()).code != 0) continue;
     const fs::path out = workspace().dir / ("mesh_" + std::to_string(seed) + ".msh");
@@ -120,7 +120,7 @@ TEST(HostileBrep, MeshingDamagedPartsThatRead) {
     std::cout << "mesh of digit case " << seed << ": " << o.kind << " in " << o.seconds << " s\n";
     ++meshed;
   }
-  EXPECT_EQ(meshed, 6);
+  EXPECT_EQ(meshed, 4);
 }
 
 TEST(HostileBrep, NamedRegressionCasesThroughTheCli) {
