@@ -2,6 +2,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include "bindings/arguments.h"
 #include "bindings/bindings.h"
 #include "common/error.h"
 #include "pipeline/job.h"
@@ -12,18 +13,17 @@ namespace topopt::py {
 void bind_fem(pybind11::module_& m) {
   m.def(
       "solve",
-      [](const MatX3d& nodes, const MatX4i& tets, const MatX3i& tris, const VecXi& tri_face, const VecXi& domain,
-         const std::string& job_json) {
+      [](const pybind11::object& nodes_arg, const pybind11::object& tets_arg, const pybind11::object& tris_arg,
+         const pybind11::object& tri_face_arg, const pybind11::object& domain_arg, const pybind11::object& job_arg) {
         TetMesh mesh;
-        mesh.V = nodes;
-        mesh.T = tets;
-        mesh.F = tris;
-        mesh.face = tri_face;
-        mesh.domain = domain.size() ? domain : VecXi(VecXi::Zero(tets.rows()));
-        if (mesh.face.size() != mesh.F.rows())
-          throw Error(ErrorCode::InvalidParameter, "tri_face must have one face number per triangle");
-        if (mesh.domain.size() != mesh.T.rows())
-          throw Error(ErrorCode::InvalidParameter, "domain must have one tag per tet");
+        mesh.V = points_arg(nodes_arg, "nodes", "#V");
+        mesh.T = index_arg<4>(tets_arg, "tets", mesh.V.rows(), "nodes");
+        mesh.F = index_arg<3>(tris_arg, "tris", mesh.V.rows(), "nodes");
+        mesh.face = tags_arg(tri_face_arg, "tri_face", mesh.F.rows(), "triangle", 0);
+        mesh.domain = tags_arg(domain_arg, "domain", mesh.T.rows(), "tet", 0, true);
+        if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+        const std::string job_json = text_arg(job_arg, "job_json");
+        const MatX3d& nodes = mesh.V;
         pipeline::SolveResult r;
         {
           pybind11::gil_scoped_release release;

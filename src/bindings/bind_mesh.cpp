@@ -2,8 +2,13 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <limits>
+
+#include "bindings/arguments.h"
 #include "bindings/bindings.h"
+#include "brep/occt_guard.h"
 #include "brep/shape_io.h"
+#include "brep/solid_check.h"
 #include "brep/topology_index.h"
 #include "common/error.h"
 #include "mesh/core/conformity.h"
@@ -23,8 +28,9 @@ namespace topopt::py {
 void bind_mesh(pybind11::module_& m) {
   m.def(
       "mesh_shapes",
-      [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep) {
-        const pipeline::Job job = pipeline::parse_job(job_json, "");
+      [](const pybind11::object& job_arg, const pybind11::object& part_arg, const pybind11::object& nd_arg) {
+        const std::string part_brep = text_arg(part_arg, "part_brep"), nd_brep = text_arg(nd_arg, "nondesign_brep");
+        const pipeline::Job job = pipeline::parse_job(text_arg(job_arg, "job_json"), "");
         TetMesh mesh;
         mesh::QualityReport q;
         std::vector<std::string> warnings;  // e.g. the mesher fell back to Gmsh
@@ -33,8 +39,8 @@ void bind_mesh(pybind11::module_& m) {
         {
           pybind11::gil_scoped_release release;
           pipeline::JobShapes shapes;
-          shapes.part = brep::read_brep_string(part_brep, "part");
-          if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids");
+          shapes.part = brep::read_brep_string(part_brep, "part", {}, progress);  // cancellable
+          if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids", {}, progress);
           mesh = pipeline::job_mesh(job, shapes, progress);
           q = mesh::tet_quality(mesh);
         }
@@ -54,14 +60,17 @@ quality figures. The job's "mesh": {"mesher": ...} picks the mesher (default "au
 
   m.def(
       "surface_mesh",
-      [](const std::string& brep, double size, int wall_layers) {
-        if (size < 0)
-          throw Error(ErrorCode::InvalidParameter, "the mesh size must be positive (mm), or 0 for the default");
-        wall_layers = mesh::wall_layers_option(wall_layers);
+      [](const pybind11::object& brep_arg, const pybind11::object& size_arg, const pybind11::object& layers_arg) {
+        const std::string brep = text_arg(brep_arg, "brep");
+        const double size = number_arg(size_arg, "size (mm, 0: the default)", 0, std::numeric_limits<double>::max());
+        const double any = std::numeric_limits<double>::max();
+        const int wall_layers = mesh::wall_layers_option(number_arg(layers_arg, "wall_layers", -any, any));
         pipeline::SurfaceJobResult r;
         {
           pybind11::gil_scoped_release release;
-          const brep::TopologyIndex topo = brep::index_topology(brep::read_brep_string(brep, "shape"));
+          std::vector<std::string> notes;  // a healed shape is meshed as healed
+          const brep::TopologyIndex topo =
+              pipeline::checked_topology(brep::read_brep_string(brep, "shape"), "shape", notes);
           pipeline::MeshSettings settings;  // the sizes, clamp and element budget of every mesher
           settings.size = size;
           settings.wall_layers = wall_layers;
@@ -90,7 +99,12 @@ share_below_20deg.)doc");
 
   m.def(
       "volume_mesh",
-      [](const MatX3d& nodes, const MatX3i& triangles, double size, bool delaunay_bulk) {
+      [](const pybind11::object& nodes_arg, const pybind11::object& triangles_arg, const pybind11::object& size_arg,
+         bool delaunay_bulk) {
+        const MatX3d nodes = points_arg(nodes_arg, "nodes", "#V");
+        const MatX3i triangles = index_arg<3>(triangles_arg, "triangles", nodes.rows(), "nodes");
+        const double size =
+            number_arg(size_arg, "size (mm, 0: from the boundary)", 0, std::numeric_limits<double>::max());
         mesh::VolumeFillResult r;
         double seconds = 0;
         {

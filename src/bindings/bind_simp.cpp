@@ -5,6 +5,9 @@
 
 #include <atomic>
 
+#include <limits>
+
+#include "bindings/arguments.h"
 #include "bindings/bindings.h"
 #include "brep/shape_io.h"
 #include "common/error.h"
@@ -15,11 +18,54 @@
 namespace topopt::py {
 namespace pyb = pybind11;
 
+namespace {
+
+/// extract_surface: the result shape of given densities (a re-extraction without a re-run).
+void bind_extract_surface(pyb::module_& m) {
+  m.def(
+      "extract_surface",
+      [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
+         const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fraction_arg,
+         const pyb::object& smoothing_arg) {
+        TetMesh mesh;
+        mesh.V = points_arg(nodes_arg, "nodes", "#V");
+        mesh.T = index_arg<4>(tets_arg, "tets", mesh.V.rows(), "nodes");
+        mesh.domain = tags_arg(domain_arg, "domain", mesh.T.rows(), "tet", 0, true);
+        if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+        const double any = std::numeric_limits<double>::max();  // densities stored by FreeCAD may pass 1 by rounding
+        const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
+        const double threshold = number_arg(threshold_arg, "threshold", -any, any);
+        const double volume_fraction = number_arg(fraction_arg, "volume_fraction", -any, any);
+        const int smoothing_iterations = int_arg(smoothing_arg, "smoothing_iterations", 0, 10000);
+        if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
+          throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
+        result::TriSurface s;
+        {
+          pyb::gil_scoped_release release;
+          result::SmoothParams sp;
+          sp.iterations = smoothing_iterations;
+          s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
+                                       sp);
+        }
+        return pyb::make_tuple(s.V, s.F);
+      },
+      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold") = -1.0,
+      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20,
+      R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
+volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
+oriented outwards.)doc");
+}
+
+}  // namespace
+
 void bind_simp(pyb::module_& m) {
   m.def(
       "run_job",
-      [](const std::string& job_json, const std::string& part_brep, const std::string& nd_brep, pyb::object callback) {
-        const pipeline::Job job = pipeline::parse_job(job_json, "");
+      [](const pyb::object& job_arg, const pyb::object& part_arg, const pyb::object& nd_arg, pyb::object callback) {
+        const std::string part_brep = text_arg(part_arg, "part_brep"), nd_brep = text_arg(nd_arg, "nondesign_brep");
+        if (!callback.is_none() && !PyCallable_Check(callback.ptr()))
+          throw Error(ErrorCode::InvalidParameter, "callback must be a function taking a dict, or None");
+        const pipeline::Job job = pipeline::parse_job(text_arg(job_arg, "job_json"), "");
         // The callback runs with the GIL held; returning True (or raising) cancels.
         std::atomic<bool> stop{false};
         std::string callback_error;
@@ -49,8 +95,8 @@ void bind_simp(pyb::module_& m) {
           pipeline::JobShapes shapes;
           if (job.mesh.file.empty()) {
             if (part_brep.empty()) throw Error(ErrorCode::InvalidParameter, "no part given");
-            shapes.part = brep::read_brep_string(part_brep, "part");
-            if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids");
+            shapes.part = brep::read_brep_string(part_brep, "part", {}, progress);  // cancellable
+            if (!nd_brep.empty()) shapes.nondesign = brep::read_brep_string(nd_brep, "non-design solids", {}, progress);
           }
           run = pipeline::run_job(job, shapes, progress, [&](const simp::IterationRecord& rec) {
             pyb::gil_scoped_acquire gil;
@@ -95,34 +141,7 @@ called with {"stage", "fraction", "message"} while meshing and {"iteration", "co
 boundary_faces, boundary_nondesign_faces, densities #T, history (list of dicts), threshold,
 surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp,
 surface), warnings (list of strings).)doc");
-
-  m.def(
-      "extract_surface",
-      [](const MatX3d& nodes, const MatX4i& tets, const VecXi& domain, const VecXd& density, double threshold,
-         double volume_fraction, int smoothing_iterations) {
-        TetMesh mesh;
-        mesh.V = nodes;
-        mesh.T = tets;
-        mesh.domain = domain.size() ? domain : VecXi(VecXi::Zero(tets.rows()));
-        if (density.size() != tets.rows() || mesh.domain.size() != tets.rows())
-          throw Error(ErrorCode::InvalidParameter, "one density and one domain tag per tet expected");
-        if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
-          throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
-        result::TriSurface s;
-        {
-          pyb::gil_scoped_release release;
-          result::SmoothParams sp;
-          sp.iterations = smoothing_iterations;
-          s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
-                                       sp);
-        }
-        return pyb::make_tuple(s.V, s.F);
-      },
-      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold") = -1.0,
-      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20,
-      R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
-volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
-oriented outwards.)doc");
+  bind_extract_surface(m);
 }
 
 }  // namespace topopt::py

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "brep/classify.h"
+#include "brep/foreign.h"
 #include "brep/topology_index.h"
 #include "common/progress.h"
 
@@ -21,8 +22,11 @@ struct TwoBReps {
 
 /// Checks both inputs (check_solids), indexes them, verifies that every Ωi lies inside Ω and
 /// that no two overlap, and classifies Ω̄ against Ω. `nondesign` may be a null shape (no
-/// non-design solids). Throws topopt::Error with a message naming what to fix.
+/// non-design solids). The checks and repairs run in a child process under `foreign`'s budget
+/// (check_solids); the indexing and classification after them run here, with OCCT's failures
+/// turned into errors that name the stage (guard_occt). Throws topopt::Error with a message
+/// naming what to fix.
 TwoBReps load_two_breps(const TopoDS_Shape& part, const TopoDS_Shape& nondesign, const ClassifyParams& params = {},
-                        const Progress& progress = {});
+                        const Progress& progress = {}, const ForeignParams& foreign = {});
 
 }  // namespace topopt::brep

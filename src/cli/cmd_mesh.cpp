@@ -26,6 +26,7 @@ using clock = std::chrono::steady_clock;
 const char* kUsage =
     "usage: topopt mesh --part PART [--non-design ND] [--size H] [--min-size H0] [--wall-layers N] --out FILE\n"
     "                   [--stats STATS.json] [--mesher auto|native|gmsh] [--volume gmsh|native]\n"
+    "                   [--time-budget S]\n"
     "  Meshes the part and the non-design solids into one conformal tet mesh: domain 1 =\n"
     "  design, 2.. = non-design solids in input order; boundary triangles tagged with the\n"
     "  part's face numbers (FreeCAD's FaceN).\n"
@@ -39,7 +40,9 @@ const char* kUsage =
     "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh in a\n"
     "           separate process; auto (default): native, and gmsh with a warning where native fails\n"
     "  --volume native with --mesher gmsh: Gmsh's surfaces filled by our 3D front\n"
-    "           (a comparison aid)";
+    "           (a comparison aid)\n"
+    "  --time-budget S  seconds allowed for reading, or checking and healing, each input\n"
+    "           (default: 30 s + 15 s per MB of file)";
 
 pipeline::MeshSettings settings_from(ArgReader& a) {
   pipeline::MeshSettings s;
@@ -137,6 +140,7 @@ int cmd_mesh(const Args& args) {
   const std::string part = a.option("part"), nondesign = a.option("non-design"), out = a.option("out"),
                     stats = a.option("stats");
   const pipeline::MeshSettings settings = settings_from(a);
+  const brep::ForeignParams budget = a.time_budget();
   if (!a.positionals().empty() || part.empty() || out.empty())
     throw Error(ErrorCode::InvalidParameter, "give --part and --out\n" + a.usage());
   const std::string ext = std::filesystem::path(out).extension().string();
@@ -147,7 +151,9 @@ int cmd_mesh(const Args& args) {
   Times t;
   t.start = clock::now();
   const brep::TwoBReps model = brep::load_two_breps(
-      brep::read_shape_file(part), nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(nondesign));
+      brep::read_shape_file(part, "part", budget),
+      nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(nondesign, "non-design input", budget), {}, {},
+      budget);
   t.read = clock::now();
   mesh::MeshRun run;
   TetMesh m = pipeline::mesh_model(model, settings, stderr_progress(), &run);

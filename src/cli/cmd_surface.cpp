@@ -7,7 +7,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "brep/occt_guard.h"
 #include "brep/shape_io.h"
+#include "brep/solid_check.h"
 #include "brep/topology_index.h"
 #include "cli/commands.h"
 #include "common/error.h"
@@ -23,7 +25,7 @@ namespace topopt::cli {
 int cmd_surface(const Args& args) {
   ArgReader a(args,
               "usage: topopt surface --part PART [--size H] [--min-size H0] [--wall-layers N] [--out FILE.stl]\n"
-              "                      [--stats STATS.json]\n"
+              "                      [--stats STATS.json] [--time-budget S]\n"
               "  Meshes every face of PART (STEP or BREP) with the native surface mesher: a closed,\n"
               "  consistently oriented triangulation per solid, each triangle tagged with its face.\n"
               "  --size   target edge length in mm (default: part diagonal / 50; above the diagonal:\n"
@@ -34,6 +36,8 @@ int cmd_surface(const Args& args) {
               "           (sizes from the wall thickness, measured by rays; default 0: off)\n"
               "  --out    binary STL; each triangle's attribute bytes hold its face number (FaceN)\n"
               "  --stats  counts, open edges per solid, self-intersections, angles, time (JSON)\n"
+              "  --time-budget S  seconds allowed for reading, or checking and healing, the part\n"
+              "           (default: 30 s + 15 s per MB of file)\n"
               "  Exit code 1 if a face failed, a solid is not closed or the surface intersects itself.");
   if (a.print_help()) return 0;
   const std::string part = a.option("part"), out = a.option("out"), stats = a.option("stats");
@@ -41,6 +45,7 @@ int cmd_surface(const Args& args) {
   settings.size = a.number("size", 0);
   settings.min_size = a.number("min-size", 0);
   settings.wall_layers = mesh::wall_layers_option(a.number("wall-layers", 0));
+  const brep::ForeignParams budget = a.time_budget();
   if (!a.positionals().empty() || part.empty()) throw Error(ErrorCode::InvalidParameter, "give --part\n" + a.usage());
   pipeline::check_mesh_settings(settings, "--size", "--min-size");
   if (!out.empty() && std::filesystem::path(out).extension() != ".stl")
@@ -49,7 +54,10 @@ int cmd_surface(const Args& args) {
     if (!file.empty()) pipeline::prepare_output_folder(std::filesystem::absolute(file).parent_path().string(), option);
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  brep::TopologyIndex topo = brep::index_topology(brep::read_shape_file(part));
+  std::vector<std::string> notes;  // repairs: a healed part is meshed as healed
+  const brep::TopologyIndex topo =
+      pipeline::checked_topology(brep::read_shape_file(part, "part", budget), "part", notes, budget);
+  for (const std::string& note : notes) std::cerr << "note: " << note << "\n";
   auto t1 = clock::now();
   // the same sizes, clamp and element budget as topopt mesh (pipeline/mesh_settings.h)
   Progress progress;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 
+#include "brep/occt_guard.h"
 #include "brep/report.h"
 #include "brep/shape_io.h"
 #include "brep/topology_index.h"
@@ -138,11 +139,11 @@ std::pair<TopoDS_Shape, TopoDS_Shape> read_shapes(const Request& r, WorkerChanne
   std::pair<TopoDS_Shape, TopoDS_Shape> shapes;
   if (!r.part.empty()) {
     ch.progress("read", 0, "reading the part");
-    shapes.first = brep::read_shape_file(r.part);
+    shapes.first = brep::read_shape_file(r.part, "part");
   }
   if (!r.nondesign.empty()) {
     ch.progress("read", 0.5, "reading the non-design solids");
-    shapes.second = brep::read_shape_file(r.nondesign);
+    shapes.second = brep::read_shape_file(r.nondesign, "non-design input");
   }
   return shapes;
 }
@@ -174,8 +175,9 @@ json op_surface_mesh(const Request& r, WorkerChannel& ch) {
   auto shapes = read_shapes(r, ch);
   if (shapes.first.IsNull()) throw Error(ErrorCode::InvalidParameter, "no shape given");
   std::vector<std::string> warnings;
-  const pipeline::SurfaceJobResult s =
-      pipeline::surface_job(brep::index_topology(shapes.first), settings, ch.make_progress(warnings));
+  const Progress progress = ch.make_progress(warnings);
+  const brep::TopologyIndex topo = pipeline::checked_topology(shapes.first, "shape", warnings, {}, progress);
+  const pipeline::SurfaceJobResult s = pipeline::surface_job(topo, settings, progress);
   json result = {{"failed_faces", s.mesh.failed_faces},
                  {"failure_reasons", s.mesh.reasons},
                  {"open_edges_per_solid", s.open_edges_per_solid},
@@ -329,6 +331,7 @@ int cmd_worker(const Args& args) {
   end_with_parent();
   WorkerChannel ch;
   try {
+    OCC_CATCH_SIGNALS  // an access violation inside OCCT comes back here as an error line
     ch.inject_at(fault_from_environment());
     const Request r = read_request(pos[0]);
     write_result(r.output, run_operation(r, ch));
@@ -337,7 +340,8 @@ int cmd_worker(const Args& args) {
   } catch (const Error& e) {
     ch.error(error_code_name(e.code()), e.what());
   } catch (const Standard_Failure& e) {
-    ch.error("Internal", std::string("geometry kernel error: ") + (e.GetMessageString() ? e.GetMessageString() : "?"));
+    const Error error = brep::occt_error(e, "working on the request");
+    ch.error(error_code_name(error.code()), error.what());
   } catch (const std::bad_alloc&) {
     ch.error("TooLarge", "out of memory: use a coarser mesh size");
   } catch (const std::exception& e) {

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "brep/foreign.h"
+
 namespace topopt::cli {
 
 using Args = std::vector<std::string>;
@@ -24,7 +26,12 @@ class ArgReader {
   ArgReader(const Args& args, std::string usage);
   /// Value of --name, or `fallback` if absent. Throws InvalidParameter if given without a value.
   std::string option(const std::string& name, const std::string& fallback = "");
+  /// Value of --name as a finite number, or `fallback` if absent. Throws InvalidParameter
+  /// for anything else ("abc", "nan", "inf").
   double number(const std::string& name, double fallback);
+  /// --time-budget S: the seconds allowed for reading, or checking and healing, one input
+  /// (brep::ForeignParams::seconds; absent or 0: from the input's size).
+  brep::ForeignParams time_budget();
   bool flag(const std::string& name);
   bool has(const std::string& name) const;
   /// Remaining positional arguments; call after every option and flag has been read.

@@ -1,9 +1,12 @@
 // build/topopt: meshing, analysis and topology optimisation from the shell.
+#include <OSD.hxx>
 #include <Standard_Failure.hxx>
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <map>
 
+#include "brep/occt_guard.h"
 #include "cli/commands.h"
 #include "common/error.h"
 
@@ -31,11 +34,20 @@ double ArgReader::number(const std::string& name, double fallback) {
   try {
     size_t end = 0;
     double v = std::stod(s, &end);
-    if (end != s.size()) throw std::invalid_argument(s);
+    if (end != s.size() || !std::isfinite(v)) throw std::invalid_argument(s);
     return v;
   } catch (const std::exception&) {
-    throw Error(ErrorCode::InvalidParameter, "--" + name + " takes a number, not '" + s + "'");
+    throw Error(ErrorCode::InvalidParameter, "--" + name + " takes a finite number, not '" + s + "'");
   }
+}
+
+brep::ForeignParams ArgReader::time_budget() {
+  brep::ForeignParams p;
+  p.seconds = number("time-budget", 0);
+  if (p.seconds < 0)
+    throw Error(ErrorCode::InvalidParameter,
+                "--time-budget takes the seconds allowed for reading or checking one input (0: from its size)");
+  return p;
 }
 
 bool ArgReader::print_help() const {
@@ -93,6 +105,32 @@ int exit_code_for(topopt::ErrorCode code) {
   }
 }
 
+void print_error(const char* command, const topopt::Error& e) {
+  std::cerr << "topopt " << command << ": error (" << topopt::error_code_name(e.code()) << "): " << e.what() << "\n";
+}
+
+/// Runs one sub-command; every failure becomes a message and an exit code. OCCT's failures
+/// (and access violations caught by its handler) are put in words by brep::occt_error.
+int run_command(int (*command)(const topopt::cli::Args&), const topopt::cli::Args& args, const char* name) {
+  try {
+    OCC_CATCH_SIGNALS
+    return command(args);
+  } catch (const topopt::Error& e) {
+    print_error(name, e);
+    return exit_code_for(e.code());
+  } catch (const Standard_Failure& failure) {
+    const topopt::Error e = topopt::brep::occt_error(failure, std::string("the ") + name + " command");
+    print_error(name, e);
+    return exit_code_for(e.code());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "topopt " << name << ": out of memory: use a coarser mesh size\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "topopt " << name << ": internal error: " << e.what() << "\n";
+    return 3;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -109,21 +147,10 @@ int main(int argc, char** argv) {
     std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;
     return 2;
   }
-  Args args(argv + 2, argv + argc);
-  try {
-    return it->second(args);
-  } catch (const topopt::Error& e) {
-    std::cerr << "topopt " << argv[1] << ": error (" << topopt::error_code_name(e.code()) << "): " << e.what() << "\n";
-    return exit_code_for(e.code());
-  } catch (const Standard_Failure& e) {
-    std::cerr << "topopt " << argv[1]
-              << ": geometry kernel error: " << (e.GetMessageString() ? e.GetMessageString() : "unknown") << "\n";
-    return 3;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "topopt " << argv[1] << ": out of memory: use a coarser mesh size\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "topopt " << argv[1] << ": internal error: " << e.what() << "\n";
-    return 3;
-  }
+  // OCCT's signal handler: an access violation on this thread becomes an exception at the
+  // nearest OCC_CATCH_SIGNALS (here, or brep::guard_occt's), reported as an error below.
+  // No floating-point traps: the core relies on IEEE arithmetic. Foreign geometry is read in
+  // child processes that reset these handlers (brep/foreign.h).
+  OSD::SetSignal(Standard_False);
+  return run_command(it->second, Args(argv + 2, argv + argc), argv[1]);
 }

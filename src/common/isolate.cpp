@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
@@ -47,14 +48,19 @@ std::string signal_name(int sig) {
   return std::string(s ? s : "signal") + " (signal " + std::to_string(sig) + ")";
 }
 
-/// Reads the child's answer until EOF; false when the deadline or a cancel came first.
+/// Reads the child's answer until EOF; false when the deadline or a cancel came first. The deadline is
+/// exact: an answer that ends after it counts as late, however short the budget.
 bool read_answer(int fd, double seconds, const Progress& progress, std::string& answer, bool& cancelled) {
-  auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   char buf[1 << 16];
   for (;;) {
+    int wait_ms = 100;
+    if (seconds > 0) wait_ms = static_cast<int>(std::clamp(1000.0 * (seconds - elapsed()) + 1.0, 0.0, 100.0));
     pollfd p{fd, POLLIN, 0};
-    int r = ::poll(&p, 1, 100);
+    int r = ::poll(&p, 1, wait_ms);
     if (r < 0 && errno != EINTR) return true;
+    if (seconds > 0 && elapsed() > seconds) return false;
     if (r > 0) {
       ssize_t k = ::read(fd, buf, sizeof buf);
       if (k < 0 && errno == EINTR) continue;
@@ -63,8 +69,6 @@ bool read_answer(int fd, double seconds, const Progress& progress, std::string& 
       continue;
     }
     if (progress.cancelled && progress.cancelled()) return !(cancelled = true);
-    double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (seconds > 0 && elapsed > seconds) return false;
   }
 }
 

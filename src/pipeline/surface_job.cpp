@@ -4,12 +4,21 @@
 #include <chrono>
 #include <cmath>
 
+#include "brep/occt_guard.h"
+#include "brep/solid_check.h"
+
 namespace topopt::pipeline {
 
 bool SurfaceJobResult::ok() const {
   long open = 0;
   for (long o : open_edges_per_solid) open += o;
   return mesh.failed_faces.empty() && open == 0 && crossings.empty();
+}
+
+brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes,
+                                     const brep::ForeignParams& budget, const Progress& progress) {
+  const TopoDS_Shape checked = brep::check_solids(shape, what, notes, budget, progress);
+  return brep::guard_occt("indexing the " + what, [&] { return brep::index_topology(checked); });
 }
 
 SurfaceJobResult surface_job(const brep::TopologyIndex& topo, const MeshSettings& settings,

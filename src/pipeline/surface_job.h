@@ -4,6 +4,11 @@
 #include <utility>
 #include <vector>
 
+#include <TopoDS_Shape.hxx>
+
+#include <string>
+
+#include "brep/foreign.h"
 #include "brep/topology_index.h"
 #include "common/progress.h"
 #include "mesh/surface/surface_check.h"
@@ -23,6 +28,13 @@ struct SurfaceJobResult {
   /// True when every face meshed, every solid is closed and nothing intersects.
   bool ok() const;
 };
+
+/// The topology of a shape meshed on its own (`topopt surface`, surface_mesh): its solids
+/// checked and healed (brep::check_solids, in a child process under `budget`), then indexed
+/// with OCCT's failures named. `what` names the input in messages; repairs are appended to
+/// `notes`. Throws what check_solids throws (InvalidShape, Crashed, Timeout).
+brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes,
+                                     const brep::ForeignParams& budget = {}, const Progress& progress = {});
 
 /// Meshes the faces of `topo` at the sizes `settings` resolve to (the same defaults, clamp and
 /// element budget as every mesher: resolve_mesh_sizes), then checks each solid: open edges

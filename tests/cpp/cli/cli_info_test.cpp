@@ -24,6 +24,29 @@ TEST(CliInfo, HelpAndUsage) {
   EXPECT_EQ(run_cli("info --part x.step --bogus").code, 2);
 }
 
+TEST(CliInfo, NumbersMustBeFinite) {
+  const std::string part = " --part " + ex("rocker.step");
+  for (const char* bad : {"nan", "inf", "-inf", "1e999"}) {
+    auto r = run_cli("info --tolerance " + std::string(bad) + part);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("--tolerance takes a finite number, not '" + std::string(bad) + "'"), std::string::npos)
+        << r.out;
+  }
+  auto r = run_cli("info --time-budget -5" + part);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--time-budget takes the seconds allowed"), std::string::npos) << r.out;
+  r = run_cli("mesh --size nan --out x.msh" + part);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("--size takes a finite number, not 'nan'"), std::string::npos) << r.out;
+  // a budget too short for the read is a Timeout naming the file, with the advice
+  r = run_cli("info --time-budget 0.001" + part);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("error (Timeout): the part's file '" + ex("rocker.step") +
+                       "' is damaged or very large: OCCT did not finish reading it within 0.001 s"),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(CliInfo, MissingFileIsAClearError) {
   auto r = run_cli("info --part /nonexistent/part.step");
   EXPECT_EQ(r.code, 1);
