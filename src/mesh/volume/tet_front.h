@@ -14,11 +14,9 @@
 #include "common/face_key.h"
 #include "common/types.h"
 #include "mesh/core/spatial_grid.h"
+#include "mesh/volume/node_stars.h"
 
 namespace topopt::mesh {
-
-using Tet = std::array<int, 4>;  ///< node indices, positively oriented
-using Tri = std::array<int, 3>;  ///< node indices
 
 class TetFront {
  public:

@@ -127,18 +127,6 @@ double worst_positive(const std::vector<Vec3>& P, const std::vector<Tet>& tets, 
 
 }  // namespace
 
-NodeStars::NodeStars(size_t nodes, const std::vector<Tet>& tets) : start_(nodes + 1, 0) {
-  for (const Tet& t : tets)
-    if (t[0] >= 0)
-      for (int x : t) ++start_[x + 1];
-  for (size_t i = 1; i < start_.size(); ++i) start_[i] += start_[i - 1];
-  items_.resize(start_.back());
-  std::vector<int> next(start_.begin(), start_.end() - 1);
-  for (size_t t = 0; t < tets.size(); ++t)
-    if (tets[t][0] >= 0)
-      for (int x : tets[t]) items_[next[x]++] = static_cast<int>(t);
-}
-
 TetSweep::TetSweep(std::vector<Vec3>& P_, std::vector<Tet>& tets_)
     : P(P_),
       tets(tets_),

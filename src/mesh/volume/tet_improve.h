@@ -22,28 +22,9 @@
 #include <vector>
 
 #include "common/types.h"
+#include "mesh/volume/node_stars.h"
 
 namespace topopt::mesh {
-
-using Tet = std::array<int, 4>;  ///< node indices, positively oriented
-using Tri = std::array<int, 3>;  ///< node indices
-
-/// The tets around each node as one flat array (CSR): the tets of node v are
-/// items[start[v] .. start[v + 1]), ascending. Removed tets (first index < 0) are left out.
-class NodeStars {
- public:
-  /// nodes: #P (every index in tets below it); tets: #T tets, removed ones with t[0] < 0.
-  NodeStars(size_t nodes, const std::vector<Tet>& tets);
-  struct Range {
-    const int *b, *e;
-    const int* begin() const { return b; }
-    const int* end() const { return e; }
-  };
-  Range of(int v) const { return {items_.data() + start_[v], items_.data() + start_[v + 1]}; }
-
- private:
-  std::vector<int> start_, items_;
-};
 
 /// One sweep over tets being improved: the node stars as the sweep began (still right for the
 /// tets it has not touched and around the nodes it has not locked) and what it has changed.
