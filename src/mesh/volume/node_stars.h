@@ -27,11 +27,13 @@ class NodeStars {
       if (tets[t][0] >= 0)
         for (int x : tets[t]) items_[next[x]++] = static_cast<int>(t);
   }
+  /// A node's tets, for range-for.
   struct Range {
     const int *b, *e;
     const int* begin() const { return b; }
     const int* end() const { return e; }
   };
+  /// The tets of node v (ascending; empty for a node no tet uses).
   Range of(int v) const { return {items_.data() + start_[v], items_.data() + start_[v + 1]}; }
 
  private:

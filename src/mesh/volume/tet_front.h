@@ -34,12 +34,12 @@ class TetFront {
   /// join it. Returns their numbers (-1 for a face that closed against its opposite).
   std::array<int, 3> close_with(int f, int p, std::vector<Tet>& tets);
 
-  bool alive(int id) const { return alive_[id]; }
-  const Tri& face(int id) const { return faces_[id]; }
-  long size() const { return count_; }               ///< live faces
-  size_t capacity() const { return faces_.size(); }  ///< faces ever added (live or not)
-  std::vector<int> alive_faces() const;              ///< the live faces' numbers, ascending
-  int any_alive() const;                             ///< a live face, or -1
+  bool alive(int id) const { return alive_[id]; }       ///< face `id` is on the front
+  const Tri& face(int id) const { return faces_[id]; }  ///< its nodes (also once dead)
+  long size() const { return count_; }                  ///< live faces
+  size_t capacity() const { return faces_.size(); }     ///< faces ever added (live or not)
+  std::vector<int> alive_faces() const;                 ///< the live faces' numbers, ascending
+  int any_alive() const;                                ///< a live face, or -1
   bool active(int v) const { return v < static_cast<int>(active_.size()) && active_[v] > 0; }
 
   /// Live faces whose boxes may meet [lo, hi] (out is cleared first).

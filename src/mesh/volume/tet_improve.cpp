@@ -47,9 +47,10 @@ double compass_maximise(Vec3& x, double step, int iterations, F&& f, double* fir
 /// The ring of the edge (u, w) in cyclic order, from the tets around it (each gives the pair
 /// of its two other nodes); false when they do not close one ring.
 bool ring_in_order(const std::vector<Tet>& tets, const std::vector<int>& ring_tets, int u, int w,
-                   std::vector<int>& ring) {
+                   std::vector<int>& ring, TetSweep::Scratch& scratch) {
   const int k = static_cast<int>(ring_tets.size());
-  std::vector<std::array<int, 2>> pairs;
+  std::vector<std::array<int, 2>>& pairs = scratch.pairs;
+  pairs.clear();
   for (int r : ring_tets) {
     std::array<int, 2> pr{-1, -1};
     int m = 0;
@@ -58,7 +59,8 @@ bool ring_in_order(const std::vector<Tet>& tets, const std::vector<int>& ring_te
     pairs.push_back(pr);
   }
   ring.assign({pairs[0][0], pairs[0][1]});
-  std::vector<char> used(k, 0);
+  std::vector<char>& used = scratch.used;
+  used.assign(k, 0);
   used[0] = 1;
   bool closed = true;
   for (int step = 1; step < k && closed; ++step) {
@@ -82,9 +84,9 @@ bool ring_in_order(const std::vector<Tet>& tets, const std::vector<int>& ring_te
 /// joined to u and w with the best worst radius ratio above `floor`, from the first ring node
 /// that gives it; empty when none is valid and better.
 std::vector<Tet> best_fan(const std::vector<Vec3>& P, int u, int w, const std::vector<int>& ring, double floor,
-                          double& best_q) {
+                          double& best_q, std::vector<Tet>& cand) {
   const int k = static_cast<int>(ring.size());
-  std::vector<Tet> best, cand;
+  std::vector<Tet> best;
   best_q = floor;
   for (int apex = 0; apex < k; ++apex) {
     cand.clear();
@@ -128,12 +130,7 @@ double worst_positive(const std::vector<Vec3>& P, const std::vector<Tet>& tets, 
 }  // namespace
 
 TetSweep::TetSweep(std::vector<Vec3>& P_, std::vector<Tet>& tets_)
-    : P(P_),
-      tets(tets_),
-      stars(P_.size(), tets_),
-      touched(tets_.size(), 0),
-      locked(P_.size(), 0),
-      retired(tets_.size(), 0) {}
+    : P(P_), tets(tets_), stars(P_.size(), tets_), touched(tets_.size(), 0), locked(P_.size(), 0) {}
 
 void TetSweep::tets_with(int u, int w, int x, std::vector<int>& out) const {
   out.clear();
@@ -152,13 +149,14 @@ void TetSweep::end() {
 
 TetReplacement plan_remove_edge(const TetSweep& s, int u, int w) {
   TetReplacement r;
-  std::vector<int> ring_tets, ring;
+  std::vector<int>& ring_tets = s.scratch.tets;
+  std::vector<int>& ring = s.scratch.ring;
   s.tets_with(u, w, -1, ring_tets);
   const int k = static_cast<int>(ring_tets.size());
   if (k < 3 || k > 7) return r;
   for (int rt : ring_tets)
     if (s.touched[rt]) return r;
-  if (!ring_in_order(s.tets, ring_tets, u, w, ring)) return r;
+  if (!ring_in_order(s.tets, ring_tets, u, w, ring, s.scratch)) return r;
   if (s.locked[u] || s.locked[w]) return r;
   for (int x : ring)
     if (s.locked[x]) return r;
@@ -167,9 +165,9 @@ TetReplacement plan_remove_edge(const TetSweep& s, int u, int w) {
   double before = 1;
   for (int rt : ring_tets) before = std::min(before, rho(s.P, s.tets[rt]));
   double after = before;
-  r.new_tets = best_fan(s.P, u, w, ring, before, after);
+  r.new_tets = best_fan(s.P, u, w, ring, before, after, s.scratch.fan);
   if (r.empty()) return r;
-  r.old_tets = std::move(ring_tets);
+  r.old_tets = ring_tets;
   r.before = before, r.after = after;
   return r;
 }
@@ -179,7 +177,7 @@ TetReplacement plan_flip23(const TetSweep& s, int t, int face) {
   const std::vector<Vec3>& P = s.P;
   const Tet& v = s.tets[t];
   const int a = v[kTetFace[face][0]], b = v[kTetFace[face][1]], c = v[kTetFace[face][2]], d = v[face];
-  std::vector<int> around;
+  std::vector<int>& around = s.scratch.other;
   s.tets_with(a, b, c, around);
   if (s.touched[t] || around.size() != 2) return r;
   const int t2 = around[0] == t ? around[1] : around[0];
@@ -348,6 +346,7 @@ CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad) 
 void apply(TetSweep& s, const CavityStar& c) {
   s.P.push_back(c.point);
   const int id = static_cast<int>(s.P.size()) - 1;
+  if (s.retired.size() < s.tets.size()) s.retired.resize(s.tets.size(), 0);
   for (int t : c.cavity) {
     s.retired[t] = s.touched[t] = 1;
     for (int x : s.tets[t]) s.locked[x] = 1;

@@ -36,8 +36,16 @@ struct TetSweep {
   const NodeStars stars;
   std::vector<char> touched;  ///< #T (grows): a tet rewritten, added or retired in this sweep
   std::vector<char> locked;   ///< #P at the start: a node of a changed tet; not used again
-  std::vector<char> retired;  ///< #T at the start: a tet a refill removed (still readable)
+  std::vector<char> retired;  ///< per tet (sized by the first refill): removed by it, still readable
   std::vector<Tet> pending;   ///< tets a refill added, appended when the sweep ends
+  /// Buffers the plans reuse from call to call (no state: only to spare allocations).
+  struct Scratch {
+    std::vector<int> tets, other, ring;
+    std::vector<std::array<int, 2>> pairs;
+    std::vector<char> used;
+    std::vector<Tet> fan;
+  };
+  mutable Scratch scratch;
 
   /// The tets holding nodes u and w (and x, when x >= 0), by the star of u (ascending).
   void tets_with(int u, int w, int x, std::vector<int>& out) const;
