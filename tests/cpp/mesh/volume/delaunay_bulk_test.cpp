@@ -229,10 +229,9 @@ TEST(DelaunayBulk, GivesUpPastTheAllowedShareOfMissingTrianglesAndLeavesTheNodes
   MatX3i F;
   fan_box_surface(V, F);
   std::vector<Eigen::Vector3d> P = points_of(V);
-  DelaunayBulkParams dp;
-  dp.size = [](const double*) { return 0.5; };
-  dp.max_missing_share = 0;  // the fan box lacks some: give up
-  const DelaunayBulkResult r = delaunay_bulk(P, triangles_of(F), dp);
+  DelaunayBulkParams give_up;
+  give_up.max_missing_share = 0;  // the fan box lacks some: it stops before refining
+  const DelaunayBulkResult r = delaunay_bulk(P, triangles_of(F), give_up);
   EXPECT_TRUE(r.gave_up);
   EXPECT_GT(r.missing_triangles, 0);
   EXPECT_TRUE(r.tets.empty());

@@ -173,13 +173,19 @@ Points octahedron_star(const Vec3& x, std::vector<Tet>& tets) {
   return P;
 }
 
-TEST(TetImprove, SmoothNodeMovesToTheCentroidOfItsNeighbours) {
-  // every octahedron vertex is in four of the eight tets: the centroid is the origin, where
-  // each tet has radius ratio 0.7321
+/// The octahedron star with its centre node off the centre, at (0.3, 0.2, 0.1).
+struct DisplacedStar {
   std::vector<Tet> tets;
   Points P = octahedron_star({0.3, 0.2, 0.1}, tets);
   const Points P0 = P;
-  const NodeStars stars(P.size(), tets);
+  const NodeStars stars{P.size(), tets};
+};
+
+TEST(TetImprove, SmoothNodeMovesToTheCentroidOfItsNeighbours) {
+  // every octahedron vertex is in four of the eight tets: the centroid is the origin, where
+  // each tet has radius ratio 0.7321
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
   const NodeMove m = plan_smooth_node(P, tets, stars, 6);
   ASSERT_FALSE(m.empty());
   EXPECT_EQ(P, P0) << "the plan moved the node";
@@ -197,10 +203,8 @@ TEST(TetImprove, SmoothNodeMovesToTheCentroidOfItsNeighbours) {
 }
 
 TEST(TetImprove, SearchNodeClimbsTowardsTheBestPosition) {
-  std::vector<Tet> tets;
-  Points P = octahedron_star({0.3, 0.2, 0.1}, tets);
-  const Points P0 = P;
-  const NodeStars stars(P.size(), tets);
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
   const NodeMove m = plan_search_node(P, tets, stars, 6);
   ASSERT_FALSE(m.empty());
   EXPECT_EQ(P, P0);
@@ -278,10 +282,8 @@ TEST(TetImprove, DriversSweepTheKernelsOverTheBadTets) {
     EXPECT_EQ(good.size(), 2u);
   }
   {  // node moves only from first_new on
-    std::vector<Tet> tets;
-    Points P = octahedron_star({0.3, 0.2, 0.1}, tets);
-    const NodeStars stars(P.size(), tets);
-    const Points P0 = P;
+    DisplacedStar d;
+    auto& [tets, P, P0, stars] = d;
     smooth_nodes(P, tets, stars, 7, 1);
     search_nodes_of_bad_tets(P, tets, stars, 7, 0.9);
     EXPECT_EQ(P, P0);
