@@ -1,11 +1,12 @@
 // Tet improvement after the volume fill: kernels that change a few tets or move one node, and
 // the drivers that sweep them over the bad tets.
 //
-// Every kernel has a check-only mode: plan_<kernel>() says whether the change would improve the mesh
-// and what it would be, and leaves the mesh as it is (a plan that changes nothing is empty);
-// apply() / apply_*() then makes exactly that change. Every orientation decision goes through
-// mesh/core/predicates; quality is the radius ratio (tet_quality.h), and a change is kept only
-// when it raises the worst radius ratio of the tets it touches.
+// Every kernel has a check-only mode: plan_<kernel>() says whether the change would improve
+// the mesh and what it would be, and leaves the mesh as it is (an empty plan: no improving
+// change); apply(plan) then makes exactly that change. Every orientation decision goes
+// through mesh/core/predicates; quality is the radius ratio (tet_quality.h), and a change is
+// kept only when it raises the worst radius ratio of the tets it touches (smoothing: when it
+// does not lower it).
 //
 // Kernels: remove_edge (the k = 3..7 tets around an inner edge replaced by 2(k - 2) tets over
 // a triangulation of their ring; on a ring of three it is the 3-2 flip), flip23 (the face of
