@@ -6,17 +6,35 @@
 
 namespace topopt::mesh {
 
-std::vector<double> node_spacing(const MatX3d& V, const MatX3i& F) {
-  std::vector<double> sum(V.rows(), 0.0);
-  std::vector<int> cnt(V.rows(), 0);
-  for (long t = 0; t < F.rows(); ++t)
+namespace {
+
+/// The mean length of the triangles' edges at each of `nodes` nodes (0 where a node has none):
+/// corner(t, k) is node k of triangle t, x(i) node i's position (an Eigen vector expression).
+template <class Corner, class Point>
+std::vector<double> mean_edge_at_nodes(long nodes, long triangles, Corner&& corner, Point&& x) {
+  std::vector<double> sum(nodes, 0.0);
+  std::vector<int> cnt(nodes, 0);
+  for (long t = 0; t < triangles; ++t)
     for (int k = 0; k < 3; ++k) {
-      const int a = F(t, k), b = F(t, (k + 1) % 3);
-      const double l = (V.row(a) - V.row(b)).norm();
+      const int a = corner(t, k), b = corner(t, (k + 1) % 3);
+      const double l = (x(a) - x(b)).norm();
       sum[a] += l, ++cnt[a], sum[b] += l, ++cnt[b];
     }
-  for (long i = 0; i < V.rows(); ++i) sum[i] = cnt[i] ? sum[i] / cnt[i] : 0.0;
+  for (long i = 0; i < nodes; ++i) sum[i] = cnt[i] ? sum[i] / cnt[i] : 0.0;
   return sum;
+}
+
+}  // namespace
+
+std::vector<double> node_spacing(const MatX3d& V, const MatX3i& F) {
+  return mean_edge_at_nodes(
+      V.rows(), F.rows(), [&](long t, int k) { return F(t, k); }, [&](int i) { return V.row(i); });
+}
+
+std::vector<double> node_spacing(const std::vector<Eigen::Vector3d>& P, const std::vector<std::array<int, 3>>& F) {
+  return mean_edge_at_nodes(
+      static_cast<long>(P.size()), static_cast<long>(F.size()), [&](long t, int k) { return F[t][k]; },
+      [&](int i) -> const Eigen::Vector3d& { return P[i]; });
 }
 
 BackgroundSize::BackgroundSize(const MatX3d& V, const MatX3i& F, double h, double g,

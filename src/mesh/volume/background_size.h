@@ -35,8 +35,11 @@ class BackgroundSize {
   std::vector<float> size_;
 };
 
-/// The mean length of the edges of F at each node of V (0 where a node has none).
+/// The mean length of the edges of F (#F by 3) at each node of V (#V by 3), #V values, 0
+/// where a node has none.
 std::vector<double> node_spacing(const MatX3d& V, const MatX3i& F);
+/// The same on nodes P and triangles F as the volume fill holds them.
+std::vector<double> node_spacing(const std::vector<Eigen::Vector3d>& P, const std::vector<std::array<int, 3>>& F);
 
 /// About how many tets a mesh with edge length size(x) has inside the closed surface (V, F):
 /// Σ cell volume × 6√2 / size³ over ~`cells` grid cells whose centres are inside.

@@ -9,6 +9,7 @@
 
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
+#include "mesh/volume/background_size.h"
 
 namespace topopt::mesh {
 namespace {
@@ -213,64 +214,69 @@ bool may_meet(const Tets& m, const std::vector<Vec3>& P, int t, const std::array
   return !(pos == off || neg == off);
 }
 
-}  // namespace
-
-DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::array<int, 3>>& B,
-                                 const DelaunayBulkParams& params, const Progress& progress) {
-  DelaunayBulkResult out;
-  if (B.empty()) return out;
-  // ---- the boundary's nodes and their sizes (mean length of their boundary edges)
-  std::vector<int> nodes;
-  std::vector<double> hs(P.size(), 0.0), deg(P.size(), 0.0);
+/// The boundary's nodes (ascending) and the corners of their box.
+std::vector<int> boundary_nodes(const std::vector<Vec3>& P, const std::vector<std::array<int, 3>>& B, Vec3& lo,
+                                Vec3& hi) {
+  std::vector<char> on(P.size(), 0);
   for (const auto& t : B)
-    for (int k = 0; k < 3; ++k) {
-      const double l = (P[t[k]] - P[t[(k + 1) % 3]]).norm();
-      hs[t[k]] += l, deg[t[k]] += 1, hs[t[(k + 1) % 3]] += l, deg[t[(k + 1) % 3]] += 1;
-    }
-  Vec3 lo = P[B[0][0]], hi = lo;
+    for (int x : t) on[x] = 1;
+  std::vector<int> nodes;
+  lo = P[B[0][0]], hi = lo;
   for (size_t i = 0; i < P.size(); ++i)
-    if (deg[i] > 0) {
+    if (on[i]) {
       nodes.push_back(static_cast<int>(i));
-      hs[i] /= deg[i];
       lo = lo.cwiseMin(P[i]), hi = hi.cwiseMax(P[i]);
     }
-  // ---- Delaunay tetrahedralisation of the nodes inside a far tet, in Morton order
+  return nodes;
+}
+
+/// The Delaunay tetrahedralisation of the nodes inside a far tet (its four nodes appended to
+/// P at far0 = #P on entry, with size 20 × the box in hs), inserted in Morton order.
+void tetrahedralise(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const std::vector<int>& nodes,
+                    const Vec3& lo, const Vec3& hi) {
   const Vec3 mid = (lo + hi) / 2;
   const double D = std::max((hi - lo).maxCoeff(), 1e-12);
   const int far0 = static_cast<int>(P.size());
   for (const Vec3& s : {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)})
     P.push_back(mid + 20 * D * s);
   hs.resize(P.size(), 20 * D);
-  Tets m(P);
   if (orient3d(P[far0].data(), P[far0 + 1].data(), P[far0 + 2].data(), P[far0 + 3].data()) > 0)
     m.make(far0, far0 + 1, far0 + 2, far0 + 3);
   else
     m.make(far0, far0 + 2, far0 + 1, far0 + 3);
-  {
-    auto morton = [&](int i) {
-      uint64_t code = 0;
-      uint64_t q[3];
-      for (int k = 0; k < 3; ++k) q[k] = static_cast<uint64_t>(std::clamp((P[i][k] - lo[k]) / D, 0.0, 1.0) * 1048575.0);
-      for (int b = 19; b >= 0; --b)
-        for (int k = 0; k < 3; ++k) code = (code << 1) | ((q[k] >> b) & 1);
-      return code;
-    };
-    std::vector<std::pair<uint64_t, int>> order;
-    order.reserve(nodes.size());
-    for (int i : nodes) order.push_back({morton(i), i});
-    std::sort(order.begin(), order.end());
-    int at = 0;
-    for (const auto& [code, i] : order) {
-      const int t = m.locate(at, P[i].data());
-      if (t >= 0 && m.insert(i, t, nullptr)) at = m.last();
-    }
+  auto morton = [&](int i) {
+    uint64_t code = 0;
+    uint64_t q[3];
+    for (int k = 0; k < 3; ++k) q[k] = static_cast<uint64_t>(std::clamp((P[i][k] - lo[k]) / D, 0.0, 1.0) * 1048575.0);
+    for (int b = 19; b >= 0; --b)
+      for (int k = 0; k < 3; ++k) code = (code << 1) | ((q[k] >> b) & 1);
+    return code;
+  };
+  std::vector<std::pair<uint64_t, int>> order;
+  order.reserve(nodes.size());
+  for (int i : nodes) order.push_back({morton(i), i});
+  std::sort(order.begin(), order.end());
+  int at = 0;
+  for (const auto& [code, i] : order) {
+    const int t = m.locate(at, P[i].data());
+    if (t >= 0 && m.insert(i, t, nullptr)) at = m.last();
   }
-  // ---- which boundary triangles it holds, and on which side of each its tets lie
+}
+
+/// Which boundary triangles the tetrahedralisation holds, and what each tet knows of the
+/// region: its faces on boundary triangles (wall bits) and on which side of them it lies.
+struct HeldBoundary {
+  std::vector<char> found;     ///< #B: the triangle is a face of some tet
+  std::vector<char> wall;      ///< per tet: bit i when face i is a boundary triangle
+  std::vector<char> evidence;  ///< per tet: 1 inside (by one of its walls), 2 outside, 3 both
+};
+
+HeldBoundary held_boundary(const Tets& m, const std::vector<std::array<int, 3>>& B) {
   std::unordered_map<FaceKey, int, FaceKeyHash> bindex;
   bindex.reserve(B.size() * 2);
   for (size_t b = 0; b < B.size(); ++b) bindex.emplace(face_key(B[b][0], B[b][1], B[b][2]), static_cast<int>(b));
   const size_t nt = m.v.size();
-  std::vector<char> found(B.size(), 0), wall(nt, 0), evidence(nt, 0);  // evidence: 1 inside, 2 outside
+  HeldBoundary h{std::vector<char>(B.size(), 0), std::vector<char>(nt, 0), std::vector<char>(nt, 0)};
   for (size_t t = 0; t < nt; ++t) {
     if (m.dead[t]) continue;
     for (int i = 0; i < 4; ++i) {
@@ -278,21 +284,23 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
       const int a = m.v[t][f[0]], b = m.v[t][f[1]], c = m.v[t][f[2]];
       auto it = bindex.find(face_key(a, b, c));
       if (it == bindex.end()) continue;
-      found[it->second] = 1;
-      wall[t] |= static_cast<char>(1 << i);
+      h.found[it->second] = 1;
+      h.wall[t] |= static_cast<char>(1 << i);
       const auto& tri = B[it->second];
       // the tet's outward face turns the same way as the region's outward triangle: inside
       const bool same = (tri[0] == a && tri[1] == b) || (tri[1] == a && tri[2] == b) || (tri[2] == a && tri[0] == b);
-      evidence[t] |= same ? 1 : 2;
+      h.evidence[t] |= same ? 1 : 2;
     }
   }
-  out.missing_triangles = std::count(found.begin(), found.end(), 0);
-  if (out.missing_triangles > params.max_missing_share * static_cast<double>(B.size())) {
-    P.resize(far0);
-    out.gave_up = true;
-    return out;
-  }
-  // ---- around every missing triangle, every tet that may meet it is left out
+  return h;
+}
+
+/// Around every missing boundary triangle, every tet that may meet it (other than at a shared
+/// node or edge): found from the stars of its three nodes, then across faces while they may.
+/// Returns the marks (per tet).
+std::vector<char> tets_near_missing(const Tets& m, const std::vector<Vec3>& P, const std::vector<std::array<int, 3>>& B,
+                                    const std::vector<char>& found) {
+  const size_t nt = m.v.size();
   std::vector<int> vtet(P.size(), -1);
   for (size_t t = 0; t < nt; ++t)
     if (!m.dead[t])
@@ -303,10 +311,8 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
   std::vector<int> queue;
   for (size_t b = 0; b < B.size(); ++b) {
     if (found[b]) continue;
-    // from the stars of its three nodes, every tet that may meet it (other than at a shared
-    // node or edge) goes
     queue.clear();
-    for (int x : B[b]) {
+    for (int x : B[b]) {  // the star of x: the tets reached across faces through x
       if (vtet[x] < 0) continue;
       ++ticket;
       const size_t first = queue.size();
@@ -332,8 +338,15 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
         if (may_meet(m, P, n, B[b])) removed[n] = 1, queue.push_back(n);
       }
   }
-  // ---- components of the rest, not crossing boundary triangles: kept when inside
-  std::vector<int> comp(nt, -1);
+  return removed;
+}
+
+/// Components of the tets not removed, not crossing boundary triangles: kept when inside (all
+/// their evidence says so and none touches a far node); the others die, and the survivors'
+/// neighbours across dead tets become walls.
+void keep_inside(Tets& m, const HeldBoundary& held, const std::vector<char>& removed, int far0) {
+  const size_t nt = m.v.size();
+  std::vector<int> comp(nt, -1), queue;
   std::vector<char> keep_comp;
   for (size_t t0 = 0; t0 < nt; ++t0) {
     if (m.dead[t0] || removed[t0] || comp[t0] >= 0) continue;
@@ -344,11 +357,11 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     comp[t0] = c;
     for (size_t k = 0; k < queue.size(); ++k) {
       const int s = queue[k];
-      ev |= evidence[s];
+      ev |= held.evidence[s];
       for (int x : m.v[s]) far |= x >= far0;
       for (int i = 0; i < 4; ++i) {
         const int n = m.nb[s][i];
-        if ((wall[s] >> i) & 1 || n < 0 || removed[n] || comp[n] >= 0) continue;
+        if ((held.wall[s] >> i) & 1 || n < 0 || removed[n] || comp[n] >= 0) continue;
         comp[n] = c;
         queue.push_back(n);
       }
@@ -361,10 +374,14 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     if (!m.dead[t])
       for (int& n : m.nb[t])
         if (n >= 0 && m.dead[n]) n = -1;
-  // ---- refinement: circumcentres of the tets too large for the size, largest first
-  // the size at a point: each node of its tet allows its own size plus kGrading × the
-  // distance to it (a small boundary feature sets the size around it, growing away from it);
-  // the size function, where given, caps that
+}
+
+/// Refinement: circumcentres of the tets too large for the size, largest ratio first. The
+/// size at a point: each node of its tet allows its own size (hs) plus kGrading × the
+/// distance to it (a small boundary feature sets the size around it, growing away from it);
+/// the size function, where given, caps that. Returns the points inserted.
+long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const DelaunayBulkParams& params,
+            const Progress& progress) {
   auto size_at = [&](int t, const Vec3& c) {
     double h = params.size ? params.size(c.data()) : INFINITY;
     for (int x : m.v[t]) h = std::min(h, hs[x] + kGrading * (P[x] - c).norm());
@@ -388,7 +405,7 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
   for (size_t t = 0; t < m.v.size(); ++t)
     if (!m.dead[t]) consider(static_cast<int>(t));
   std::vector<int> created;
-  long popped = 0;
+  long popped = 0, points = 0;
   while (!work.empty() && m.alive() < params.max_tets) {
     const Item it = work.top();
     work.pop();
@@ -407,9 +424,33 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
       P.pop_back(), hs.pop_back();
       continue;
     }
-    ++out.points;
+    ++points;
     for (int n : created) consider(n);
   }
+  return points;
+}
+
+}  // namespace
+
+DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::array<int, 3>>& B,
+                                 const DelaunayBulkParams& params, const Progress& progress) {
+  DelaunayBulkResult out;
+  if (B.empty()) return out;
+  std::vector<double> hs = node_spacing(P, B);  // the boundary nodes' sizes: their mean edge
+  Vec3 lo, hi;
+  const std::vector<int> nodes = boundary_nodes(P, B, lo, hi);
+  const int far0 = static_cast<int>(P.size());
+  Tets m(P);
+  tetrahedralise(m, P, hs, nodes, lo, hi);
+  const HeldBoundary held = held_boundary(m, B);
+  out.missing_triangles = std::count(held.found.begin(), held.found.end(), 0);
+  if (out.missing_triangles > params.max_missing_share * static_cast<double>(B.size())) {
+    P.resize(far0);
+    out.gave_up = true;
+    return out;
+  }
+  keep_inside(m, held, tets_near_missing(m, P, B, held.found), far0);
+  out.points = refine(m, P, hs, params, progress);
   for (size_t t = 0; t < m.v.size(); ++t) {
     if (m.dead[t]) continue;
     out.tets.push_back(m.v[t]);

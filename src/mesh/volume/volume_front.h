@@ -3,18 +3,16 @@
 // (step 14 of the two-B-Rep method starts from Ω̄'s tets). Every decision goes through the
 // exact predicates; existing tets and boundary triangles are never changed.
 //
-// The engine in three parts (DESIGN.md): the front container with its spatial search
-// (FrontIndex, in the .cpp), the geometry of candidate points, and the driver loop
-// fill_volume() below: take the smallest front face, try candidates from the ideal point and
-// from nearby front nodes, accept the best valid tet, update the front; faces that fail are
-// retried with a wider search, a looser quality bound and lower new points; then small
-// cavities are filled from one point (grown by the tets behind their faces when no point
-// sees them all, and filled in pieces as the last resort), every tet checked against the
-// whole front; then stuck regions are re-meshed with a widening neighbourhood. After
-// filling: edge removal (rings of 3-7 tets), 2-3 flips, smoothing and a compass search on
-// the nodes of bad tets; last, point insertion at the tets still bad (the cavity around one
-// re-filled as a star from an optimised new point, which also removes slivers with two
-// faces on the boundary).
+// The engine in three parts (DESIGN.md): the front container with its spatial search and the
+// test every new tet passes (TetFront, tet_front.h); the driver of named steps in
+// volume_front.cpp — the Delaunay bulk first where it holds the boundary (delaunay_bulk.h),
+// then rounds of widening passes (take the smallest front face, try front nodes near the ideal
+// point and new points, accept the first valid tet; faces that fail are retried with a wider
+// search, a looser quality bound and lower new points), small cavities closed from single
+// points (front_cavities.h), and stuck regions re-meshed with a widening neighbourhood; and
+// the tet improvement after filling (tet_improve.h: edge removal for rings of 3-7 tets, 2-3
+// flips, smoothing and a compass search on the nodes of bad tets, then sliver removal by
+// point insertion, which also removes slivers with two faces on the boundary).
 #pragma once
 #include <functional>
 

@@ -1,0 +1,151 @@
+// Tet improvement after the volume fill: kernels that change a few tets or move one node, and
+// the drivers that sweep them over the bad tets.
+//
+// Every kernel has a check-only mode: plan_<kernel>() says whether the change would improve
+// the mesh and what it would be, and leaves the mesh as it is (an empty plan: no improving
+// change); apply(plan) then makes exactly that change. Every orientation decision goes
+// through mesh/core/predicates; quality is the radius ratio (tet_quality.h), and a change is
+// kept only when it raises the worst radius ratio of the tets it touches (smoothing: when it
+// does not lower it).
+//
+// Kernels: remove_edge (the k = 3..7 tets around an inner edge replaced by 2(k - 2) tets over
+// a triangulation of their ring; on a ring of three it is the 3-2 flip), flip23 (the face of
+// two tets replaced by the edge between their apexes), smooth_node (to the centroid of its
+// neighbours), search_node (compass search for the position with the best worst tet around
+// it), refill_cavity (a cavity of tets re-filled as a star from one new point: sliver
+// removal by point insertion, which also removes a tet with two faces on the boundary).
+//
+// Only tets in the given list are ever changed: the caller's fixed tets (the existing ones
+// and the boundary) stay, because a face is flipped only between two listed tets, an edge only
+// when listed tets close a ring around it, and a cavity's faces stay faces of its star.
+#pragma once
+#include <array>
+#include <vector>
+
+#include "common/types.h"
+#include "mesh/volume/node_stars.h"
+
+namespace topopt::mesh {
+
+/// One sweep over tets being improved: the node stars as the sweep began (still right for the
+/// tets it has not touched and around the nodes it has not locked) and what it has changed.
+struct TetSweep {
+  /// P: #P by 3 nodes (a refill appends its point); tets: #T tets (removed ones: t[0] < 0).
+  TetSweep(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets);
+  std::vector<Eigen::Vector3d>& P;
+  std::vector<Tet>& tets;
+  const NodeStars stars;
+  std::vector<char> touched;  ///< #T (grows): a tet rewritten, added or retired in this sweep
+  std::vector<char> locked;   ///< #P at the start: a node of a changed tet; not used again
+  std::vector<char> retired;  ///< per tet (sized by the first refill): removed by it, still readable
+  std::vector<Tet> pending;   ///< tets a refill added, appended when the sweep ends
+  /// Buffers the plans reuse from call to call (no state: only to spare allocations).
+  struct Scratch {
+    std::vector<int> tets, other, ring;
+    std::vector<std::array<int, 2>> pairs;
+    std::vector<char> used;
+    std::vector<Tet> fan;
+  };
+  mutable Scratch scratch;
+
+  /// The tets holding nodes u and w (and x, when x >= 0), by the star of u (ascending).
+  void tets_with(int u, int w, int x, std::vector<int>& out) const;
+  /// Ends the sweep: removed and retired tets leave the list (the others keep their order),
+  /// pending ones are appended.
+  void end();
+};
+
+/// A change of tets: new_tets[m] takes the slot of old_tets[m], the rest are appended (or,
+/// with fewer new tets, the surplus slots are removed). Empty: no improving change.
+struct TetReplacement {
+  std::vector<int> old_tets;
+  std::vector<Tet> new_tets;
+  double before = 0, after = 0;  ///< the worst radius ratio of the old tets and of the new ones
+  bool empty() const { return new_tets.empty(); }
+};
+
+/// Edge removal (check-only): the untouched tets around the inner edge (u, w) — a closed ring
+/// of 3 to 7 of them, no node locked — replaced by the fan triangulation of their ring (from
+/// the ring node that gives the best worst tet) joined to u and w, when every new tet is
+/// positive and the worst radius ratio rises. A ring of three is the 3-2 flip.
+TetReplacement plan_remove_edge(const TetSweep& s, int u, int w);
+/// 2-3 flip (check-only): face `face` (0..3, opposite that node) of untouched tet t, shared
+/// with one other untouched tet, replaced by the edge joining the two apexes (which must not
+/// exist yet and must cross the face's interior), no node locked, when the worst radius
+/// ratio rises.
+TetReplacement plan_flip23(const TetSweep& s, int t, int face);
+/// Makes replacement r: the slots of its old tets are rewritten or removed, the extra tets
+/// appended; all of them are touched and every node of the old tets is locked.
+void apply(TetSweep& s, const TetReplacement& r);
+
+/// A move of node v from `from` to `to`; empty when it would not help (or v has no tets).
+struct NodeMove {
+  int v = -1;
+  Eigen::Vector3d from, to;
+  double before = 0, after = 0;  ///< the worst radius ratio around v before and after
+  bool empty() const { return v < 0; }
+};
+/// Smoothing (check-only): v to the centroid of the other nodes of its tets (each counted once
+/// per tet), when every tet around stays positive and the worst radius ratio around does not
+/// drop. stars: the current stars of tets.
+NodeMove plan_smooth_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v);
+/// Compass search (check-only): steps of a tenth of v's mean edge along ±x, ±y, ±z while the
+/// worst radius ratio around v rises (halved when no direction helps, 40 tries), every tet
+/// staying positive; the best position found when it is better.
+NodeMove plan_search_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v);
+/// Makes move m (P[m.v] = m.to).
+void apply(std::vector<Eigen::Vector3d>& P, const NodeMove& m);
+
+/// A cavity re-filled as a star from one new point.
+struct CavityStar {
+  std::vector<int> cavity;  ///< its tets, ascending
+  std::vector<Tri> faces;   ///< its boundary, each face turned out of the cavity
+  Eigen::Vector3d point;    ///< the star's centre
+  double gain = 0;          ///< worst radius ratio of the star minus the cavity's; > 0 improves
+  bool empty() const { return faces.empty(); }
+};
+/// Refill (check-only): the untouched tets `cavity` (no node locked) as a star of its faces
+/// from the point that maximises the star's worst radius ratio (a compass search from the
+/// faces' centroid, steps of 0.15 of their mean edge), kept when that point sees every face
+/// (the star tiles the cavity exactly), the star's worst tet beats the cavity's and it has no
+/// more tets below kSliverShare × bad than the cavity had. P is as it was on return.
+CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad);
+/// Makes star c: its point is appended to P, its cavity retired (and its nodes locked), its
+/// tets pending until the sweep ends.
+void apply(TetSweep& s, const CavityStar& c);
+
+/// A star may not leave more tets below this share of `bad` than its cavity had.
+constexpr double kSliverShare = 0.25;
+
+// ---- drivers
+
+/// Sweeps of edge removal then 2-3 flips over the tets below `bad` (each tet changed at most
+/// once per sweep, up to 4 sweeps while any flip happens). Returns the number of changes.
+long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
+/// `iterations` sweeps of smooth_node over the nodes from first_new on.
+void smooth_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int first_new,
+                  int iterations);
+/// search_node on the nodes from first_new on of the tets below `bad`, each node once, in the
+/// order of the tets.
+void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars,
+                              int first_new, double bad);
+/// Sliver removal by point insertion: each tet below `bad`, worst first, is taken out with the
+/// best of its candidate cavities (the tets around each of its edges, it with its face
+/// neighbours, and with one more layer of them) re-filled by refill_cavity; up to 3 sweeps.
+/// Returns the number of cavities re-filled.
+long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
+
+struct TetImproveParams {
+  double flip_below = 0.55;      ///< tets below this radius ratio get edge removal and 2-3 flips (0: none)
+  int smoothing_iterations = 1;  ///< smooth_node sweeps per round
+  int quality_rounds = 3;        ///< rounds of flips, smoothing and compass search
+  double sliver_below = 0.4;     ///< compass search at tets below this each round, then point insertion (0: none)
+};
+
+/// The improvement after a fill: `quality_rounds` rounds of flips, smoothing of the nodes
+/// from first_new on and compass search at the bad tets; then up to three rounds of sliver
+/// insertion, each followed by flips and compass search. Nodes below first_new never move.
+void improve_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new,
+                  const TetImproveParams& params);
+
+}  // namespace topopt::mesh

@@ -1,0 +1,312 @@
+// Each tet improvement kernel on a small hand-made configuration whose answer is known (radius
+// ratios worked out by hand and checked numerically): its check-only plan says what would
+// change and leaves the mesh as it was; applying it gives the known tets or position, with the
+// volume kept. Then the drivers that sweep the kernels over the bad tets.
+#include "mesh/volume/tet_improve.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "mesh/core/predicates.h"
+#include "mesh/core/tet_quality.h"
+
+namespace topopt::mesh {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Points = std::vector<Vec3>;
+
+Tet positive(const Points& P, Tet t) {
+  if (predicates::orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data()) < 0) std::swap(t[2], t[3]);
+  return t;
+}
+
+double rho(const Points& P, const Tet& t) { return radius_ratio(P[t[0]], P[t[1]], P[t[2]], P[t[3]]); }
+
+double worst(const Points& P, const std::vector<Tet>& tets) {
+  double w = 1;
+  for (const Tet& t : tets) w = std::min(w, rho(P, t));
+  return w;
+}
+
+/// Sum of the tets' signed volumes; every tet must be positive.
+double volume(const Points& P, const std::vector<Tet>& tets) {
+  double v = 0;
+  for (const Tet& t : tets) {
+    EXPECT_GT(predicates::orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data()), 0);
+    v += (P[t[1]] - P[t[0]]).dot((P[t[2]] - P[t[0]]).cross(P[t[3]] - P[t[0]])) / 6;
+  }
+  return v;
+}
+
+bool has(const Tet& t, int x) { return std::find(t.begin(), t.end(), x) != t.end(); }
+
+/// An equilateral triangle a, b, c (nodes 0-2, circumradius 1, z = 0) and apexes d = (0, 0, h),
+/// e = (0, 0, -h) (nodes 3, 4).
+Points bipyramid(double h) {
+  const double s = std::sqrt(3.0) / 2;
+  return {{1, 0, 0}, {-0.5, s, 0}, {-0.5, -s, 0}, {0, 0, h}, {0, 0, -h}};
+}
+
+/// The bipyramid as the two tets on the face abc.
+std::vector<Tet> two_tets(const Points& P) { return {positive(P, {0, 1, 2, 3}), positive(P, {0, 2, 1, 4})}; }
+
+/// The bipyramid as the three tets around the edge de.
+std::vector<Tet> three_tets(const Points& P) {
+  return {positive(P, {0, 1, 3, 4}), positive(P, {1, 2, 3, 4}), positive(P, {2, 0, 3, 4})};
+}
+
+TEST(TetImprove, Flip23TurnsTwoFlatTetsIntoThreeAroundTheEdgeOfTheirApexes) {
+  // h = 0.3: the two tets on abc have radius ratio 0.2287, the three around de 0.5053
+  Points P = bipyramid(0.3);
+  std::vector<Tet> tets = two_tets(P);
+  const std::vector<Tet> before = tets;
+  const Points P0 = P;
+  const double v0 = volume(P, tets);
+  TetSweep s(P, tets);
+  const int face = static_cast<int>(std::find(tets[0].begin(), tets[0].end(), 3) - tets[0].begin());  // abc
+  const TetReplacement r = plan_flip23(s, 0, face);
+  ASSERT_FALSE(r.empty());
+  EXPECT_EQ(tets, before) << "the plan changed the tets";
+  EXPECT_EQ(P, P0);
+  EXPECT_EQ(r.old_tets, (std::vector<int>{0, 1}));
+  EXPECT_NEAR(r.before, 0.2287, 1e-4);
+  EXPECT_NEAR(r.after, 0.5053, 1e-4);
+  apply(s, r);
+  s.end();
+  ASSERT_EQ(tets.size(), 3u);
+  for (const Tet& t : tets) EXPECT_TRUE(has(t, 3) && has(t, 4)) << "every new tet holds the edge de";
+  EXPECT_NEAR(volume(P, tets), v0, 1e-15);
+  EXPECT_NEAR(worst(P, tets), 0.5053, 1e-4);
+  // h = 1: the two tets (0.927) beat the three (0.660): no flip
+  Points Q = bipyramid(1.0);
+  std::vector<Tet> good = two_tets(Q);
+  TetSweep q(Q, good);
+  const int qf = static_cast<int>(std::find(good[0].begin(), good[0].end(), 3) - good[0].begin());
+  EXPECT_TRUE(plan_flip23(q, 0, qf).empty());
+}
+
+TEST(TetImprove, RemoveEdgeOnARingOfThreeIsTheThreeTwoFlip) {
+  // h = 1: the three tets around de (0.660) become the two on abc (0.927)
+  Points P = bipyramid(1.0);
+  std::vector<Tet> tets = three_tets(P);
+  const std::vector<Tet> before = tets;
+  const double v0 = volume(P, tets);
+  TetSweep s(P, tets);
+  EXPECT_TRUE(plan_remove_edge(s, 0, 1).empty()) << "ab is a boundary edge: two tets, no ring";
+  const TetReplacement r = plan_remove_edge(s, 3, 4);
+  ASSERT_FALSE(r.empty());
+  EXPECT_EQ(tets, before);
+  EXPECT_NEAR(r.before, 0.6600, 1e-4);
+  EXPECT_NEAR(r.after, 0.9271, 1e-4);
+  ASSERT_EQ(r.new_tets.size(), 2u);
+  apply(s, r);
+  s.end();
+  ASSERT_EQ(tets.size(), 2u);
+  for (const Tet& t : tets) {
+    EXPECT_TRUE(has(t, 0) && has(t, 1) && has(t, 2)) << "both tets stand on abc";
+    EXPECT_NE(has(t, 3), has(t, 4));
+  }
+  EXPECT_NEAR(volume(P, tets), v0, 1e-15);
+}
+
+/// Five tets around the edge u = (0, 0, -L), w = (0, 0, L) (nodes 5, 6) over a regular
+/// pentagon of radius 1 (nodes 0-4).
+Points pentagon_ring(double L, std::vector<Tet>& tets) {
+  Points P;
+  for (int i = 0; i < 5; ++i) P.emplace_back(std::cos(2 * M_PI * i / 5), std::sin(2 * M_PI * i / 5), 0);
+  P.emplace_back(0, 0, -L);
+  P.emplace_back(0, 0, L);
+  tets.clear();
+  for (int i = 0; i < 5; ++i) tets.push_back(positive(P, {5, 6, i, (i + 1) % 5}));
+  return P;
+}
+
+TEST(TetImprove, RemoveEdgeReplacesARingOfFiveBySixTets) {
+  // L = 2: the long edge's five needles (0.320) give way to a fan of the pentagon joined to u
+  // and w (0.616); at L = 0.5 the ring (0.988) is better than any fan (0.338)
+  std::vector<Tet> tets;
+  Points P = pentagon_ring(2.0, tets);
+  const double v0 = volume(P, tets);
+  TetSweep s(P, tets);
+  const TetReplacement r = plan_remove_edge(s, 5, 6);
+  ASSERT_FALSE(r.empty());
+  EXPECT_NEAR(r.before, 0.3201, 1e-4);
+  EXPECT_NEAR(r.after, 0.6163, 1e-4);
+  apply(s, r);
+  s.end();
+  ASSERT_EQ(tets.size(), 6u);
+  for (const Tet& t : tets) EXPECT_FALSE(has(t, 5) && has(t, 6)) << "the edge uw is gone";
+  EXPECT_NEAR(volume(P, tets), v0, 1e-14);
+  std::vector<Tet> fat;
+  Points Q = pentagon_ring(0.5, fat);
+  TetSweep q(Q, fat);
+  EXPECT_TRUE(plan_remove_edge(q, 5, 6).empty());
+}
+
+TEST(TetImprove, LockedNodesAndTouchedTetsAreLeftAlone) {
+  std::vector<Tet> tets;
+  Points P = pentagon_ring(2.0, tets);
+  {
+    TetSweep s(P, tets);
+    s.locked[2] = 1;  // a ring node changed earlier in the sweep: its star is stale
+    EXPECT_TRUE(plan_remove_edge(s, 5, 6).empty());
+  }
+  {
+    TetSweep s(P, tets);
+    s.touched[3] = 1;
+    EXPECT_TRUE(plan_remove_edge(s, 5, 6).empty());
+  }
+  TetSweep s(P, tets);
+  EXPECT_FALSE(plan_remove_edge(s, 5, 6).empty());
+}
+
+/// The octahedron of vertices ±e_i (nodes 0-5) as 8 tets around node 6 at x.
+Points octahedron_star(const Vec3& x, std::vector<Tet>& tets) {
+  Points P = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, x};
+  tets.clear();
+  for (int i : {0, 1})
+    for (int j : {2, 3})
+      for (int k : {4, 5}) tets.push_back(positive(P, {6, i, j, k}));
+  return P;
+}
+
+/// The octahedron star with its centre node off the centre, at (0.3, 0.2, 0.1).
+struct DisplacedStar {
+  std::vector<Tet> tets;
+  Points P = octahedron_star({0.3, 0.2, 0.1}, tets);
+  const Points P0 = P;
+  const NodeStars stars{P.size(), tets};
+};
+
+TEST(TetImprove, SmoothNodeMovesToTheCentroidOfItsNeighbours) {
+  // every octahedron vertex is in four of the eight tets: the centroid is the origin, where
+  // each tet has radius ratio 0.7321
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
+  const NodeMove m = plan_smooth_node(P, tets, stars, 6);
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(P, P0) << "the plan moved the node";
+  EXPECT_LT(m.to.norm(), 1e-15);
+  EXPECT_EQ(m.from, P0[6]);
+  EXPECT_NEAR(m.after, 0.7321, 1e-4);
+  EXPECT_LT(m.before, m.after - 0.1);
+  apply(P, m);
+  EXPECT_EQ(P[6], m.to);
+  // at the centroid already: a move onto itself, the worst unchanged
+  const NodeMove again = plan_smooth_node(P, tets, stars, 6);
+  ASSERT_FALSE(again.empty());
+  EXPECT_EQ(again.to, again.from);
+  EXPECT_EQ(again.after, again.before);
+}
+
+TEST(TetImprove, SearchNodeClimbsTowardsTheBestPosition) {
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
+  const NodeMove m = plan_search_node(P, tets, stars, 6);
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(P, P0);
+  EXPECT_GT(m.after, m.before + 0.1);
+  EXPECT_LT(m.to.norm(), 0.5 * m.from.norm()) << "towards the centre";
+  apply(P, m);
+  EXPECT_NEAR(worst(P, tets), m.after, 1e-15);
+  // at the centre no step helps: by symmetry it is the best position
+  P[6] = Vec3::Zero();
+  EXPECT_TRUE(plan_search_node(P, tets, stars, 6).empty());
+}
+
+/// An octahedron (apexes (0, 0, ±1), nodes 4, 5) around a warped square a, c = (±1, 0, w),
+/// b, d = (0, ±1, -w) (nodes 0-3) as five tets: the sliver abcd, the top pyramid split along
+/// ac and the bottom one along bd.
+Points warped_octahedron(double w, std::vector<Tet>& tets) {
+  Points P = {{1, 0, w}, {0, 1, -w}, {-1, 0, w}, {0, -1, -w}, {0, 0, 1}, {0, 0, -1}};
+  tets = {positive(P, {0, 1, 2, 3}), positive(P, {4, 0, 1, 2}), positive(P, {4, 0, 2, 3}), positive(P, {5, 0, 1, 3}),
+          positive(P, {5, 1, 2, 3})};
+  return P;
+}
+
+TEST(TetImprove, RefillCavityReplacesASliverByAStarFromItsCentre) {
+  // w = 0.05: the sliver has radius ratio 0.149; the star of the eight faces from the origin
+  // (the best point, by the symmetries x -> -x and y -> -y) has 0.7296
+  std::vector<Tet> tets;
+  Points P = warped_octahedron(0.05, tets);
+  const std::vector<Tet> before = tets;
+  const Points P0 = P;
+  const double v0 = volume(P, tets);
+  EXPECT_NEAR(worst(P, tets), 0.149, 1e-3);
+  TetSweep s(P, tets);
+  const CavityStar star = plan_refill_cavity(s, {4, 3, 2, 1, 0}, 0.4);
+  ASSERT_FALSE(star.empty());
+  EXPECT_EQ(P, P0) << "the plan left its point behind";
+  EXPECT_EQ(tets, before);
+  EXPECT_EQ(star.cavity, (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(star.faces.size(), 8u);
+  EXPECT_LT(star.point.norm(), 1e-6);
+  EXPECT_NEAR(star.gain, 0.7296 - worst(P, tets), 1e-3);
+  apply(s, star);
+  s.end();
+  ASSERT_EQ(tets.size(), 8u);
+  ASSERT_EQ(P.size(), 7u);
+  for (const Tet& t : tets) EXPECT_TRUE(has(t, 6));
+  EXPECT_NEAR(volume(P, tets), v0, 1e-14);
+  EXPECT_NEAR(worst(P, tets), 0.7296, 1e-3);
+  // a cavity already a star from its best point: nothing to gain
+  std::vector<Tet> regular;
+  Points Q = octahedron_star(Vec3::Zero(), regular);
+  TetSweep q(Q, regular);
+  EXPECT_TRUE(plan_refill_cavity(q, {0, 1, 2, 3, 4, 5, 6, 7}, 0.4).empty());
+  // nor from tets this sweep has changed, or around nodes it has locked
+  std::vector<Tet> again;
+  Points W = warped_octahedron(0.05, again);
+  TetSweep t(W, again);
+  t.touched[0] = 1;
+  EXPECT_TRUE(plan_refill_cavity(t, {0, 1, 2, 3, 4}, 0.4).empty());
+  TetSweep u(W, again);
+  u.locked[4] = 1;
+  EXPECT_TRUE(plan_refill_cavity(u, {0, 1, 2, 3, 4}, 0.4).empty());
+  TetSweep v(W, again);
+  EXPECT_FALSE(plan_refill_cavity(v, {0, 1, 2, 3, 4}, 0.4).empty());
+}
+
+TEST(TetImprove, DriversSweepTheKernelsOverTheBadTets) {
+  {  // flips: the two flat tets become three; two good ones stay
+    Points P = bipyramid(0.3);
+    std::vector<Tet> tets = two_tets(P);
+    EXPECT_EQ(flip_bad_tets(P, tets, 0.55), 1);
+    EXPECT_EQ(tets.size(), 3u);
+    Points Q = bipyramid(1.0);
+    std::vector<Tet> good = two_tets(Q);
+    EXPECT_EQ(flip_bad_tets(Q, good, 0.5), 0);
+    EXPECT_EQ(good.size(), 2u);
+  }
+  {  // node moves only from first_new on
+    DisplacedStar d;
+    auto& [tets, P, P0, stars] = d;
+    smooth_nodes(P, tets, stars, 7, 1);
+    search_nodes_of_bad_tets(P, tets, stars, 7, 0.9);
+    EXPECT_EQ(P, P0);
+    smooth_nodes(P, tets, stars, 6, 1);
+    EXPECT_LT(P[6].norm(), 1e-15);
+    P[6] = P0[6];
+    search_nodes_of_bad_tets(P, tets, stars, 6, 0.9);
+    EXPECT_LT(P[6].norm(), 0.5 * P0[6].norm());
+  }
+  {  // sliver insertion, and the whole improvement with no node allowed to move
+    std::vector<Tet> tets;
+    Points P = warped_octahedron(0.05, tets);
+    EXPECT_EQ(insert_points_at_slivers(P, tets, 0.4), 1);
+    EXPECT_EQ(tets.size(), 8u);
+    Points Q = warped_octahedron(0.05, tets);
+    const Points Q0 = Q;
+    const double v0 = volume(Q, tets);
+    improve_tets(Q, tets, 6, TetImproveParams());
+    EXPECT_GT(worst(Q, tets), 0.7);
+    EXPECT_NEAR(volume(Q, tets), v0, 1e-14);
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(Q[i], Q0[i]);
+  }
+}
+
+}  // namespace
+}  // namespace topopt::mesh
