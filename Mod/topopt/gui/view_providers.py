@@ -26,14 +26,17 @@ class _ViewProvider:
 
 
 class ViewProviderStudy(_ViewProvider):
+    """The study in the tree: everything it made or uses besides its input solids sits under it
+    (constraints with their direction lines, domain meshes, result shape, FEM result and mesh,
+    fields with the density view). `panel` is its study panel and `force_panel` its force
+    panel when open (not saved)."""
     icon = "TopOptStudy.svg"
+    panel = None
+    force_panel = None
 
     def claimChildren(self):
-        obj = self.Object
-        children = list(obj.Constraints)
-        if obj.Result:
-            children.append(obj.Result)
-        return children
+        from topopt.app.study import owned_objects
+        return owned_objects(self.Object)
 
     def doubleClicked(self, vobj):
         from topopt.gui import panels
