@@ -23,11 +23,17 @@ import numpy as np
 
 from . import quiet, vtu
 
+def _rgb(r, g, b):
+    """A colour from 0–255 components: FreeCAD saves colours as 8-bit components, so these
+    come back from a saved document exactly as they were set."""
+    return (r / 255.0, g / 255.0, b / 255.0)
+
+
 #: colours of the domains: design first, then the non-design solids in order
-DOMAIN_COLOURS = [(0.75, 0.75, 0.78), (0.90, 0.45, 0.15), (0.20, 0.55, 0.90), (0.30, 0.70, 0.35),
-                  (0.85, 0.70, 0.20), (0.60, 0.35, 0.80), (0.20, 0.75, 0.75), (0.85, 0.45, 0.65)]
+DOMAIN_COLOURS = [_rgb(191, 191, 199), _rgb(230, 115, 38), _rgb(51, 140, 230), _rgb(77, 179, 89),
+                  _rgb(217, 179, 51), _rgb(153, 89, 204), _rgb(51, 191, 191), _rgb(217, 115, 166)]
 #: the result shape's design part
-RESULT_COLOUR = (0.62, 0.72, 0.84)
+RESULT_COLOUR = _rgb(158, 184, 214)
 
 #: field names in the pipeline (units in the names: FEM's colour bar shows only numbers)
 DENSITY = "Density"
@@ -140,10 +146,11 @@ def _style_domain(obj, d):
 
 # --- the result shape ----------------------------------------------------------------------
 
-def facet_domains(points, triangles, nodes, tets, domain):
+def facet_domains(points, triangles, nodes, tets, domain, tags=None):
     """#Q: for each triangle of the result shape, the non-design solid it lies on (k > 0) or 0.
-    Non-design solids are kept whole and their points are never moved, so a triangle whose
-    three corners are nodes of non-design tets lies on that solid."""
+    `tags` (#Q, the core's surface_tags): -k marks a face of non-design solid k inside the
+    part. Elsewhere: non-design solids are kept whole and their points are never moved, so a
+    triangle whose three corners are nodes of non-design tets lies on that solid."""
     nd = {}
     for k in range(4):
         for node, d in zip(tets[domain > 0, k], domain[domain > 0]):
@@ -151,7 +158,11 @@ def facet_domains(points, triangles, nodes, tets, domain):
     point_domain = np.array([nd.get(np.asarray(p, dtype=np.float64).tobytes(), 0) for p in points], dtype=np.int64)
     corner = point_domain[np.asarray(triangles, dtype=np.int64)]
     on_nd = (corner > 0).all(axis=1)
-    return np.where(on_nd, corner[:, 0], 0)
+    out = np.where(on_nd, corner[:, 0], 0)
+    if tags is not None:
+        tags = np.asarray(tags, dtype=np.int64)
+        out = np.where(tags < 0, -tags, out)
+    return out
 
 
 def colour_result(feature, facet_domain):

@@ -112,16 +112,16 @@ def _report_warnings(result):
         FreeCAD.Console.PrintWarning("TopOpt: %s\n" % w)
 
 
-def _result_feature(study, shape, points, triangles, nodes, tets, domain):
+def _result_feature(study, shape, points, triangles, tags, nodes, tets, domain):
     """The study's result shape (created once, updated later), its faces on non-design solids
-    coloured apart."""
+    coloured apart (tags: the core's surface_tags)."""
     feature = study.Result
     if feature is None:
         feature = study.Document.addObject("Mesh::Feature", study.Name + "_Result")
         study.Result = feature
     feature.Label = "%s result" % study.Label
     feature.Mesh = shape
-    results.colour_result(feature, results.facet_domains(points, triangles, nodes, tets, domain))
+    results.colour_result(feature, results.facet_domains(points, triangles, nodes, tets, domain, tags))
     return feature
 
 
@@ -142,8 +142,8 @@ def apply(study, result):
     study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
     study.Threshold = float(result.get("threshold", 0.5))
     study.Status = result.get("status", "done")
-    feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"], nodes, tets,
-                              domain)
+    feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
+                              result.get("surface_tags"), nodes, tets, domain)
     results.update_fem_objects(study, result, study.Threshold)
     if study.DomainMeshes:
         results.show_domains(study, nodes, tets, domain)
@@ -211,8 +211,8 @@ def reextract(study, threshold, cancel=None):
     shape = result_mesh(result["surface_points"], result["surface_triangles"])
     with transaction(study.Document, "TopOpt threshold %.2f" % threshold):
         study.Threshold = threshold
-        feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"], nodes, tets,
-                                  domain)
+        feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
+                                  result.get("surface_tags"), nodes, tets, domain)
         results.set_density_cut(study, threshold)
         quiet.recompute(study.Document)
     results.style_result(feature)

@@ -34,6 +34,22 @@ class ViewProviderStudy(_ViewProvider):
     panel = None
     force_panel = None
 
+    def attach(self, vobj):
+        self.Object = vobj.Object
+        # a reopened document: the result shape's view reads its FaceColors before the mesh is
+        # loaded and shows none; colour it again once loading is done
+        from PySide import QtCore
+        QtCore.QTimer.singleShot(0, self._colour_result)
+
+    def _colour_result(self):
+        try:
+            result = self.Object.Result
+        except Exception:  # the study was deleted or its document closed meanwhile
+            return
+        if result is not None and "FaceColors" in result.PropertiesList:
+            from topopt.app import results
+            results.style_result(result)
+
     def claimChildren(self):
         from topopt.app.study import owned_objects
         return owned_objects(self.Object)

@@ -176,8 +176,9 @@ class RockerFlow(unittest.TestCase):
         settle()
         self.assertEqual(len(study.DomainMeshes), 4)  # design + 3 rings
         self.assertIn("non-design 1", study.DomainMeshes[1].Label)
-        for o in [study.Part] + list(study.NonDesign):
-            o.Visibility = False
+        for o in study.Document.Objects:
+            if o.TypeId.startswith("Part::") or o.TypeId.startswith("App::"):  # imported shapes, groups
+                o.Visibility = False
         fit()
         screenshot("06_mesh_by_domain")
         for o in study.DomainMeshes:
@@ -230,8 +231,16 @@ class RockerFlow(unittest.TestCase):
         FreeCADGui.runCommand("FEM_ResultShow")
         settle(40)
         self.assertTrue(FreeCADGui.Control.activeDialog())
-        screenshot("11_fem_result_panel")
+        study.AnalysisMesh.Visibility = True
+        radios = [b for b in FreeCADGui.getMainWindow().findChildren(QtGui.QRadioButton)
+                  if "Mises" in b.text() and b.isVisible()]
+        self.assertTrue(radios)
+        radios[0].click()
+        settle(40)
+        fit()
+        screenshot("11_fem_result_panel_von_mises")
         close_task_panel()
+        study.AnalysisMesh.Visibility = False
         FreeCADGui.activateWorkbench("TopOptWorkbench")
         study.Result.Visibility = True
 
@@ -277,8 +286,30 @@ class RockerFlow(unittest.TestCase):
         children = study.ViewObject.Proxy.claimChildren()
         for name in ("Result", "FemResult", "AnalysisMesh", "Fields"):
             self.assertIn(getattr(study, name), children)
+        for o in doc.Objects:
+            o.Visibility = False
+        study.Result.Visibility = True
         fit()
-        screenshot("13_reopened")
+        screenshot("13_reopened_result")
+        self.assertGreater(self.coloured_pixels(os.path.join(SHOTS, "13_reopened_result_3d.png")), 500)
+        study.Result.Visibility = False
+        study.DensityView.Visibility = True
+        fit()
+        screenshot("14_reopened_density")
+
+
+    @staticmethod
+    def coloured_pixels(path):
+        """Pixels of a picture that are clearly coloured (not white, grey or black): the rings'
+        colours on the result shape."""
+        img = QtGui.QImage(path)
+        count = 0
+        for x in range(0, img.width(), 3):
+            for y in range(0, img.height(), 3):
+                c = QtGui.QColor(img.pixel(x, y))
+                if max(c.red(), c.green(), c.blue()) - min(c.red(), c.green(), c.blue()) > 60:
+                    count += 1
+        return count
 
 
 if __name__ == "__main__":
