@@ -51,10 +51,21 @@ def _free_task_view(study):
         raise TopOptError("another task panel is open: close it (OK or Cancel) first", "InvalidParameter")
 
 
-class NewStudy:
+class _Command:
+    """A workbench command: its menu text, tooltip and icon as class attributes; active when
+    there is a study to act on (subclasses say otherwise)."""
+    menu, tip, icon = "", "", ""
+
     def GetResources(self):
-        return {"MenuText": "New study", "Pixmap": _icon("TopOptNewStudy.svg"),
-                "ToolTip": "Select the part first, then the non-design solids to keep, and create a study"}
+        return {"MenuText": self.menu, "ToolTip": self.tip, "Pixmap": _icon(self.icon)}
+
+    def IsActive(self):
+        return active_study() is not None
+
+
+class NewStudy(_Command):
+    menu, icon = "New study", "TopOptNewStudy.svg"
+    tip = "Select the part first, then the non-design solids to keep, and create a study"
 
     def IsActive(self):
         return FreeCAD.ActiveDocument is not None and bool(FreeCADGui.Selection.getSelection())
@@ -82,16 +93,9 @@ def _selected_refs():
     return [r for r in refs if r[1]]
 
 
-class _AddConstraint:
+class _AddConstraint(_Command):
     """Creates a constraint on the selected faces of the study's part or non-design solids, then
     opens FreeCAD FEM's own task panel for it (so users keep their habits)."""
-    menu, tip, icon = "", "", ""
-
-    def GetResources(self):
-        return {"MenuText": self.menu, "ToolTip": self.tip, "Pixmap": _icon(self.icon)}
-
-    def IsActive(self):
-        return active_study() is not None
 
     @_guarded
     def Activated(self):
@@ -117,18 +121,13 @@ class AddFixed(_AddConstraint):
         return ObjectsFem.makeConstraintFixed(study.Document, "Fixed")
 
 
-class AddForce:
+class AddForce(_Command):
     """A FEM force on the selected faces in TopOpt's force panel, whose direction is always
     given: a vector (x, y, z) or a picked straight edge or planar face. With a force of the
     study selected, edits it in the same panel."""
-
-    def GetResources(self):
-        return {"MenuText": "Force", "Pixmap": _icon("TopOptForce.svg"),
-                "ToolTip": "A total force on the selected faces, in a direction you give (x, y, z) or pick; "
-                           "with a force selected, edit it"}
-
-    def IsActive(self):
-        return active_study() is not None
+    menu, icon = "Force", "TopOptForce.svg"
+    tip = ("A total force on the selected faces, in a direction you give (x, y, z) or pick; with a force "
+           "selected, edit it")
 
     @_guarded
     def Activated(self):
@@ -161,13 +160,8 @@ class AddPressure(_AddConstraint):
         return ObjectsFem.makeConstraintPressure(study.Document, "Pressure")
 
 
-class AddSymmetry:
-    def GetResources(self):
-        return {"MenuText": "Symmetry plane", "Pixmap": _icon("TopOptSymmetry.svg"),
-                "ToolTip": "The selected planar faces lie on a symmetry plane"}
-
-    def IsActive(self):
-        return active_study() is not None
+class AddSymmetry(_Command):
+    menu, tip, icon = "Symmetry plane", "The selected planar faces lie on a symmetry plane", "TopOptSymmetry.svg"
 
     @_guarded
     def Activated(self):
@@ -183,14 +177,9 @@ class AddSymmetry:
             study.Document.recompute()
 
 
-class RunStudy:
-    def GetResources(self):
-        return {"MenuText": "Run", "Pixmap": _icon("TopOptRun.svg"),
-                "ToolTip": "Mesh, optimise and show the result of the study (its panel opens with the live plot "
-                           "and Stop)"}
-
-    def IsActive(self):
-        return active_study() is not None
+class RunStudy(_Command):
+    menu, icon = "Run", "TopOptRun.svg"
+    tip = "Mesh, optimise and show the result of the study (its panel opens with the live plot and Stop)"
 
     @_guarded
     def Activated(self):
@@ -198,14 +187,10 @@ class RunStudy:
         open_study_panel(active_study()).start_run()
 
 
-class MeshStudy:
-    def GetResources(self):
-        return {"MenuText": "Mesh", "Pixmap": _icon("TopOptMesh.svg"),
-                "ToolTip": "Mesh the part and the non-design solids into one tagged mesh and show it, "
-                           "coloured by domain (with the study's mesh settings)"}
-
-    def IsActive(self):
-        return active_study() is not None
+class MeshStudy(_Command):
+    menu, icon = "Mesh", "TopOptMesh.svg"
+    tip = ("Mesh the part and the non-design solids into one tagged mesh and show it, coloured by domain "
+           "(with the study's mesh settings)")
 
     @_guarded
     def Activated(self):
@@ -220,10 +205,8 @@ class MeshStudy:
             ", ".join(o.Label for o in study.DomainMeshes)))
 
 
-class ExportStl:
-    def GetResources(self):
-        return {"MenuText": "Export result as STL", "Pixmap": _icon("TopOptExportStl.svg"),
-                "ToolTip": "Write the study's result shape to an STL file"}
+class ExportStl(_Command):
+    menu, tip, icon = "Export result as STL", "Write the study's result shape to an STL file", "TopOptExportStl.svg"
 
     def IsActive(self):
         s = active_study()
@@ -238,11 +221,13 @@ class ExportStl:
             FreeCAD.Console.PrintMessage("TopOpt: result written to %s\n" % path)
 
 
-class BuildCore:
-    def GetResources(self):
-        return {"MenuText": "Build the native core", "Pixmap": _icon("TopOptBuildCore.svg"),
-                "ToolTip": "Build TopOpt's compiled core in this clone of the repository (%s)"
-                           % (topopt.build_command() or "not available: this TopOpt was installed")}
+class BuildCore(_Command):
+    menu, icon = "Build the native core", "TopOptBuildCore.svg"
+
+    @property
+    def tip(self):
+        return "Build TopOpt's compiled core in this clone of the repository (%s)" % (
+            topopt.build_command() or "not available: this TopOpt was installed")
 
     def IsActive(self):
         return topopt.source_root() is not None

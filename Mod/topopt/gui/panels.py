@@ -396,10 +396,9 @@ class StudyPanel:
         return int(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
 
     def is_open(self):
-        """True while the panel is shown (FreeCAD drops `form` when it closes a task dialog
-        without asking it, e.g. for another command's panel)."""
-        form = getattr(self, "form", None)
-        return not self.closed and form is not None and form.isVisible()
+        """True until the panel is closed, by OK or Cancel or by FreeCAD (which drops `form`
+        when it closes a task dialog without asking it, e.g. for another command's panel)."""
+        return not self.closed and getattr(self, "form", None) is not None
 
     def _close(self):
         self.closed = True

@@ -87,7 +87,8 @@ class RunResults(unittest.TestCase):
         work = -100.0 * u[xyz[:, 0] > 59.9, 2].mean()
         self.assertAlmostEqual(work / self.study.ComplianceHistory[-1], 1.0, delta=0.2)
         self.assertGreater(max(res.vonMises), 0)
-        self.assertEqual(res.Stats[3], max(res.DisplacementLengths))  # FEM's own statistics filled
+        self.assertEqual(res.Stats[7], max(res.DisplacementLengths))  # FEM's own statistics filled
+        self.assertEqual(res.Stats[9], max(res.vonMises))
 
     def test_fields_and_density_view(self):
         pipe, clip = self.study.Fields, self.study.DensityView
@@ -152,7 +153,8 @@ class DomainMeshesAndReopen(unittest.TestCase):
 class Progress(unittest.TestCase):
     def test_fraction_goes_forward_and_stages_are_counted_once(self):
         t = progress.Tracker("optimize", max_iterations=50, clock=iter(range(1000)).__next__)
-        records = [{"stage": "read", "fraction": 0.0}, {"stage": "mesh", "fraction": -1, "message": "checking the part"},
+        records = [{"stage": "read", "fraction": 0.0},
+                   {"stage": "mesh", "fraction": -1, "message": "checking the part"},
                    {"stage": "brep", "fraction": 0.5}, {"stage": "mesh", "fraction": 0.3, "message": "volumes"}]
         records += [{"iteration": i, "compliance": 100.0 / i, "volume": 0.3} for i in range(1, 6)]
         records += [{"stage": "surface", "fraction": -1}]

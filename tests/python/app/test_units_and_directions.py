@@ -172,7 +172,8 @@ class StudyUnits(unittest.TestCase):
         self.study.Density = "5 mm"
         with self.assertRaises(TopOptError) as e:
             study_to_job(self.study)
-        self.assertIn("Density is 5 mm", str(e.exception))
+        self.assertIn("Density is 5", str(e.exception))
+        self.assertIn("not in a unit of the same kind as t/mm^3: write it like '7850 kg/m^3'", str(e.exception))
 
 
 class OlderDocuments(unittest.TestCase):
@@ -189,12 +190,13 @@ class OlderDocuments(unittest.TestCase):
             study.addProperty("App::PropertyFloat", name, "Material", "")
             setattr(study, name, value)
         path = os.path.join(tempfile.mkdtemp(), "older.FCStd")
+        force_name = force.Name
         api.save(doc, path)
         FreeCAD.closeDocument(doc.Name)
         doc = FreeCAD.openDocument(path)
         try:
             study = doc.getObject("TopOptStudy")
-            force = doc.getObject(force.Name)
+            force = doc.getObject(force_name)
             self.assertEqual(study.getTypeIdOfProperty("YoungsModulus"), "App::PropertyPressure")
             self.assertAlmostEqual(study.YoungsModulus.getValueAs("MPa"), 200000.0)
             job = study_to_job(study)

@@ -13,7 +13,7 @@ import unittest
 
 import FreeCAD
 import FreeCADGui
-from PySide import QtCore, QtGui
+from PySide import QtGui
 
 from topopt.app.study import is_study
 

@@ -95,7 +95,8 @@ except Exception:
 sys.stdout.flush()
 os._exit(code)
 """)
-        p = subprocess.run(["freecadcmd", "-c", "exec(open(%r).read())" % script], env=dict(os.environ, FREECAD_USER_HOME=home),
+        p = subprocess.run(["freecadcmd", "-c", "exec(open(%r).read())" % script],
+                           env=dict(os.environ, FREECAD_USER_HOME=home),
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=600)
         out = p.stdout.decode("utf-8", "replace")
         self.assertEqual(p.returncode, 0, out)
