@@ -245,7 +245,8 @@ def export_stl(study, path):
     if os.path.isdir(path):
         raise TopOptError("%s is a folder: give a file name ending in .stl" % path, "Io")
     try:
-        study.Result.Mesh.write(path)
+        with quiet.no_progress_lines():
+            study.Result.Mesh.write(path)
     except Exception as e:  # OSError, or FreeCAD's own exception types
         raise TopOptError("cannot write %s (%s): check that the folder is writable"
                           % (path, getattr(e, "strerror", None) or e), "Io") from None

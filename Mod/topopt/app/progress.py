@@ -3,6 +3,7 @@ a label in the user's words for the current stage, one line per stage for headle
 and the run summary for the report view. Shared by the GUI (panel, status bar, progress
 dialogs) and headless scripts; no FreeCAD GUI here.
 """
+import contextlib
 import math
 import time
 
@@ -15,6 +16,7 @@ TITLES = {
     "surface": "extracting the result shape",
     "solve": "analysing the last iterate",
     "write": "writing the results",
+    "document": "updating the document",
 }
 
 #: operation → stage → (start, end) of the stage's share of the whole operation
@@ -115,6 +117,15 @@ class Tracker:
         self.stage = None
         self.fraction = 1.0
         return self.clock() - self.started
+
+    @contextlib.contextmanager
+    def timed(self, stage):
+        """Counts the time spent inside as `stage` (work done after the worker, in FreeCAD)."""
+        start = self.clock()
+        try:
+            yield
+        finally:
+            self.stages.append([stage, self.clock() - start])
 
     def percent(self):
         return int(round(100 * self.fraction))

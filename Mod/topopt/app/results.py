@@ -274,9 +274,17 @@ def _style_fem_objects(study):
             obj.ViewObject.Visibility = False
     clip = study.DensityView
     if clip is not None and clip.ViewObject is not None:
-        vo = clip.ViewObject
-        vo.DisplayMode = "Surface"
-        fields = vo.getEnumerationsOfProperty("Field")
-        if DENSITY in fields:
-            vo.Field = DENSITY
-        vo.Visibility = False
+        style_density_view(clip)
+        clip.ViewObject.Visibility = False
+
+
+def style_density_view(clip):
+    """With the GUI: the density view as a surface coloured by Density (FEM's colour bar)."""
+    vo = clip.ViewObject
+    if vo is None:
+        return
+    if DENSITY not in vo.getEnumerationsOfProperty("Field"):
+        vo.DisplayMode = "Outline"  # FEM's view lists a filter's fields again when its display mode changes
+    vo.DisplayMode = "Surface"
+    if DENSITY in vo.getEnumerationsOfProperty("Field"):
+        vo.Field = DENSITY

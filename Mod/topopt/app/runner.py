@@ -186,9 +186,11 @@ def run(study, on_progress=None, cancel=None, verbose=True):
         return on_progress(record) if on_progress is not None else None
 
     result = execute(prepared, follow, cancel)
-    with transaction(study.Document, "TopOpt run"):
-        feature = apply(study, result)
-    seconds = tracker.finish()
+    tracker.finish()
+    with tracker.timed("document"):
+        with transaction(study.Document, "TopOpt run"):
+            feature = apply(study, result)
+    seconds = tracker.clock() - tracker.started
     if verbose:
         report_run(study, result, tracker, seconds)
     return feature

@@ -166,6 +166,7 @@ class Study:
         self.ensure_properties(obj)
         from . import directions
         directions.migrate_scripted_forces(obj)
+        attach_view_provider(obj, "ViewProviderStudy")
 
     def execute(self, obj):
         pass
@@ -176,6 +177,19 @@ class Study:
     def __setstate__(self, state):
         if state:
             self.Type = state.get("Type", PROXY_TYPE)
+
+
+def attach_view_provider(obj, name):
+    """With the GUI, gives `obj` TopOpt's view provider `name` (topopt.gui.view_providers) when
+    it has none: a document saved without the GUI holds no view data, and its objects would
+    open without their icon, their children in the tree and their panel."""
+    vobj = getattr(obj, "ViewObject", None) if FreeCAD.GuiUp else None
+    if vobj is None:
+        return
+    from topopt.gui import view_providers
+    cls = getattr(view_providers, name)
+    if not isinstance(getattr(vobj, "Proxy", None), cls):
+        cls(vobj)
 
 
 def is_study(obj):
@@ -207,7 +221,5 @@ def make_study(doc, part, nondesign=(), name="TopOptStudy"):
     Study(obj)
     obj.Part = part
     obj.NonDesign = list(nondesign)
-    if FreeCAD.GuiUp:
-        from topopt.gui import view_providers
-        view_providers.ViewProviderStudy(obj.ViewObject)
+    attach_view_provider(obj, "ViewProviderStudy")
     return obj

@@ -309,9 +309,9 @@ class StudyPanel:
     def _finish(self, kind, payload):
         self.timer.stop()
         self.thread = None
-        seconds = self.tracker.finish()
+        self.tracker.finish()
         if kind == "done":
-            self._apply(payload, seconds)
+            self._apply(payload)
         elif payload.code == "Cancelled" and self.cancel_requested:
             self.status.setText("stopped (%s); the document is as it was" % payload)
             self.status_bar.done("run stopped")
@@ -323,13 +323,15 @@ class StudyPanel:
         self._set_running(False)
         self._begin_edit()
 
-    def _apply(self, result, seconds):
+    def _apply(self, result):
         try:
-            with runner.transaction(self.doc, "TopOpt run"):
-                runner.apply(self.study, result)
+            with self.tracker.timed("document"):
+                with runner.transaction(self.doc, "TopOpt run"):
+                    runner.apply(self.study, result)
         except TopOptError as e:
             report_error(e)
             return
+        seconds = self.tracker.clock() - self.tracker.started
         runner.report_run(self.study, result, self.tracker, seconds)
         self.progress.setValue(100)
         self.status.setText("%s in %.0f s" % (self.study.Status, seconds))

@@ -37,18 +37,25 @@ class ViewProviderStudy(_ViewProvider):
     def attach(self, vobj):
         self.Object = vobj.Object
         # a reopened document: the result shape's view reads its FaceColors before the mesh is
-        # loaded and shows none; colour it again once loading is done
+        # loaded and shows none, and a density view saved without the GUI holds no data (FEM's
+        # filters compute only with it); both are redone once loading is done
         from PySide import QtCore
-        QtCore.QTimer.singleShot(0, self._colour_result)
+        QtCore.QTimer.singleShot(0, self._after_load)
 
-    def _colour_result(self):
+    def _after_load(self):
         try:
-            result = self.Object.Result
+            result, density = self.Object.Result, self.Object.DensityView
         except Exception:  # the study was deleted or its document closed meanwhile
             return
+        from topopt.app import results
         if result is not None and "FaceColors" in result.PropertiesList:
-            from topopt.app import results
             results.style_result(result)
+        if density is not None and density.ViewObject is not None and \
+                results.DENSITY not in density.ViewObject.getEnumerationsOfProperty("Field"):
+            density.touch()
+            from topopt.app import quiet
+            quiet.recompute(density.Document)
+            results.style_density_view(density)
 
     def claimChildren(self):
         from topopt.app.study import owned_objects

@@ -155,6 +155,33 @@ class Workbench(unittest.TestCase):
         screenshot("workbench_density.png")
         panel.accept()
 
+    def test_a_document_made_without_the_gui_opens_grouped_and_coloured(self):
+        import subprocess
+        import tempfile
+        path = os.path.join(tempfile.mkdtemp(), "headless.FCStd")
+        script = os.path.join(os.path.dirname(path), "make.py")
+        with open(script, "w") as f:
+            f.write("""import os, sys
+sys.path.insert(0, %r)
+import helpers
+from topopt.app import api
+doc, study = helpers.box_study("Headless", iterations=4, mesh_size=4.0)
+api.run(study, verbose=False)
+api.save(doc, %r)
+os._exit(0)
+""" % (os.path.join(HERE, "..", "app"), path))
+        subprocess.run(["freecadcmd", "-c", "exec(open(%r).read())" % script], check=True, timeout=600,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        doc = FreeCAD.openDocument(path)
+        settle(40)
+        study = doc.getObject("TopOptStudy")
+        from topopt.gui.view_providers import ViewProviderStudy
+        self.assertIsInstance(study.ViewObject.Proxy, ViewProviderStudy)  # icon, tree, panel
+        self.assertIn(study.Result, study.ViewObject.Proxy.claimChildren())
+        self.assertTrue(study.Result.ViewObject.Coloring)
+        self.assertEqual(study.DensityView.ViewObject.Field, "Density")  # computed now, with the GUI
+        FreeCAD.closeDocument(doc.Name)
+
     def test_cancel_takes_the_panels_edits_back(self):
         FreeCADGui.activateWorkbench("TopOptWorkbench")
         doc, part, keeps = lever_document("GuiCancel")

@@ -4,8 +4,9 @@ with the command that builds it; the menu command builds it in place (with progr
 workbench then works without a restart; a new FreeCADCmd imports it from the clone and runs a
 study. Runs with /usr/bin/python3 (ctest: install.clone); FreeCAD runs as child processes.
 
-Environment: TOPOPT_SOURCE (the repository: its HEAD commit is cloned), CCACHE_BASEDIR (set by
-ctest to the clone's home, so that the build reuses compiled objects).
+Environment: TOPOPT_SOURCE (the repository: its HEAD commit is cloned). The build runs with
+CCACHE_BASEDIR at the clone's parent folder, so that ccache reuses the objects of a build of
+the same sources elsewhere.
 """
 import os
 import shutil
@@ -24,7 +25,8 @@ def run_freecad(home, script, gui=False, timeout=1500):
     path = os.path.join(home, "script.py")
     with open(path, "w") as f:
         f.write(textwrap.dedent(script))
-    env = dict(os.environ, FREECAD_USER_HOME=home, **GUI_ENV)
+    # the build in the clone reuses compiled objects: ccache hashes paths relative to its base
+    env = dict(os.environ, FREECAD_USER_HOME=home, CCACHE_BASEDIR=os.path.join(home, "Mod"), **GUI_ENV)
     if gui:
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", path]
     else:
