@@ -138,6 +138,14 @@ class RockerFlow(unittest.TestCase):
         close_task_panel()
         self.assertEqual(float(study.MeshSize), 2.5)
         self.add_force(study, part, "Face9", 1000.0, preset="-Y")
+        count, names = len(study.Constraints), sorted(o.Name for o in study.Document.Objects)
+        select(part, "Face11")
+        FreeCADGui.runCommand("TopOpt_Force")
+        settle()
+        study.ViewObject.Proxy.force_panel.reject()  # Cancel takes the new force away
+        settle()
+        self.assertEqual(len(study.Constraints), count)
+        self.assertEqual(sorted(o.Name for o in study.Document.Objects), names)
         self.add_force(study, part, "Face11", 600.0, vector=(1, 0, 0))
         forces = [c for c in study.Constraints if c.TypeId == "Fem::ConstraintForce"]
         self.assertEqual(len(forces), 2)
