@@ -99,15 +99,15 @@ def core_problem():
         missing.append("the worker program (topopt/bin/topopt)")
     if not missing:
         return None
-    what = " and ".join(missing)
+    what = " and ".join(missing) + (" are" if len(missing) > 1 else " is")
     command = build_command()
     if command:
-        return ("TopOpt's native core is not built yet: %s is missing.\n\nBuild it once with\n\n    %s\n\n"
+        return ("TopOpt's native core is not built yet: %s missing.\n\nBuild it once with\n\n    %s\n\n"
                 "(or the menu Topology Optimization > Build the native core). The build needs CMake, a C++ "
                 "compiler and the libraries that 'sudo scripts/setup --build-deps' installs on Debian or "
                 "Ubuntu." % (what, command))
-    return ("TopOpt's native core is missing or does not match this FreeCAD (%s). Install the TopOpt "
-            "package for this system again." % what)
+    return ("TopOpt's native core is missing or does not match this FreeCAD: %s missing. Install the "
+            "TopOpt package for this system again." % what)
 
 
 def native():

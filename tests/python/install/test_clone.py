@@ -10,6 +10,7 @@ the same sources elsewhere.
 """
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import textwrap
@@ -31,8 +32,16 @@ def run_freecad(home, script, gui=False, timeout=1500):
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "freecad", path]
     else:
         cmd = ["freecadcmd", "-c", "exec(open(%r).read())" % path]
-    p = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout, cwd=home)
-    return p.returncode, p.stdout.decode("utf-8", "replace")
+    # its own session: on a timeout the whole group goes (FreeCAD, Xvfb, a build FreeCAD started)
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, cwd=home,
+                         start_new_session=True)
+    try:
+        out, _ = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        out, _ = p.communicate()
+        return "timeout", out.decode("utf-8", "replace")
+    return p.returncode, out.decode("utf-8", "replace")
 
 
 _PRELUDE = """
@@ -62,7 +71,7 @@ try:
     import FreeCAD, FreeCADGui
     FreeCAD.ConfigSet("TopOptNoDialogs", "1")
     import topopt
-    print("@@package", topopt.__file__)
+    print("@@package", os.path.normpath(topopt.__file__))
     print("@@listed", "TopOptWorkbench" in FreeCADGui.listWorkbenches())
     FreeCADGui.activateWorkbench("TopOptWorkbench")
     print("@@commands", all(c in FreeCADGui.listCommands() for c in ("TopOpt_NewStudy", "TopOpt_BuildCore")))
@@ -119,7 +128,7 @@ try:
     import FreeCAD, Part
     import topopt
     from topopt.app import api
-    print("@@native", topopt.native().__file__)
+    print("@@native", os.path.normpath(topopt.native().__file__))
     doc = FreeCAD.newDocument("Clone")
     beam = doc.addObject("Part::Feature", "Beam")
     beam.Shape = Part.makeBox(40, 8, 8)
