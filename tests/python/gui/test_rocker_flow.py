@@ -288,6 +288,8 @@ class RockerFlow(unittest.TestCase):
         settle(40)
         study = doc.getObject(name)
         self.assertNotIn("defects", report_text()[len(before):])
+        # the colours and views restored after loading are no edit: closing asks nothing
+        self.assertFalse(FreeCADGui.getDocument(doc.Name).Modified)
         self.assertEqual(len(study.Result.FaceColors), study.Result.Mesh.CountFacets)
         self.assertTrue(study.Result.ViewObject.Coloring)
         self.assertEqual(study.DensityView.ViewObject.Field, "Density")

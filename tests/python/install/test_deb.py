@@ -1,7 +1,10 @@
 """The Debian package (scripts/package, CPack): built, its control data and contents checked,
 and its files, unpacked into a fresh FreeCAD user home's Mod folder as dpkg would lay them
-under /usr/share/freecad/Mod, load in FreeCADCmd and run a study. Runs with /usr/bin/python3
-(ctest: install.deb); it does not install anything into the system.
+under /usr/share/freecad/Mod, load in FreeCADCmd and run a study; and, where the test runs as
+root and may make a private mount namespace, the package installed with dpkg and FreeCAD's GUI
+started, which lists the workbench. Runs with /usr/bin/python3 (ctest: install.deb). The
+system is never changed: that install happens under copy-on-write overlays of /usr, /etc and
+/var/lib/dpkg that exist only in the test's own mount namespace and vanish with it.
 
 Environment: TOPOPT_SOURCE (the repository), TOPOPT_PACKAGE_BUILD_DIR (where scripts/package
 builds; default build-package/ in the repository), CCACHE_BASEDIR.
@@ -10,6 +13,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+import textwrap
 import unittest
 
 SOURCE = os.environ.get("TOPOPT_SOURCE", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".."))
@@ -64,7 +68,7 @@ class DebianPackage(unittest.TestCase):
         self.assertNotIn("__pycache__", self.files)
         self.assertNotIn("/tests/", self.files)
         self.assertNotIn("/src/", self.files)
-        worker = [line for line in self.files.splitlines() if line.endswith("topopt/bin/topopt")][0]
+        worker = [line for line in self.files.splitlines() if line.endswith("./%s/topopt/bin/topopt" % MOD)][0]
         self.assertTrue(worker.startswith("-rwxr-xr-x"), worker)
 
     def test_unpacked_workbench_loads_and_runs(self):
@@ -79,7 +83,7 @@ class DebianPackage(unittest.TestCase):
 try:
     import FreeCAD, Part, topopt
     from topopt.app import api
-    print("@@package", topopt.__file__, topopt.core_problem())
+    print("@@package", os.path.normpath(topopt.__file__), topopt.core_problem())
     doc = FreeCAD.newDocument("Deb")
     beam = doc.addObject("Part::Feature", "Beam")
     beam.Shape = Part.makeBox(40, 8, 8)
@@ -102,6 +106,67 @@ os._exit(code)
         self.assertEqual(p.returncode, 0, out)
         self.assertIn("@@package %s None" % os.path.join(home, "Mod", "TopOpt", "topopt", "__init__.py"), out)
         self.assertIn("@@solid True", out)
+
+    def test_dpkg_install_lists_the_workbench(self):
+        if os.geteuid() != 0 or shutil.which("unshare") is None:
+            self.skipTest("installing with dpkg needs root and unshare (a private mount namespace)")
+        probe = subprocess.run(["unshare", "-m", "--propagation", "private", "true"], stderr=subprocess.PIPE)
+        if probe.returncode != 0:
+            self.skipTest("no private mount namespace here: " + probe.stderr.decode().strip())
+        out = subprocess.run(["unshare", "-m", "--propagation", "private", "bash", "-c", _INSTALL_AND_LIST,
+                              "install", self.deb, self.tmp],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
+        log = out.stdout.decode("utf-8", "replace")
+        self.assertEqual(out.returncode, 0, log)
+        self.assertIn("Setting up freecad-topopt (%s)" % version(), log)
+        with open(os.path.join(self.tmp, "listed.txt")) as f:
+            listed = dict(line.rstrip("\n").split(" ", 1) for line in f)
+        self.assertIn("TopOptWorkbench", listed["workbenches"].split(), listed)
+        self.assertEqual(listed["active"], "TopOptWorkbench")
+        self.assertEqual(os.path.normpath(listed["module"]), "/usr/share/freecad/Mod/TopOpt/topopt/__init__.py")
+        self.assertEqual(listed["core_problem"], "None")
+        self.assertIn("/usr/bin/topopt", log)  # the command-line tool on the PATH runs
+        self.assertIn("usage: topopt", log)
+        # the host never saw the package
+        self.assertFalse(os.path.exists("/usr/share/freecad/Mod/TopOpt"))
+        status = subprocess.run(["dpkg-query", "-W", "freecad-topopt"], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE)
+        self.assertNotEqual(status.returncode, 0, status.stdout)
+
+
+#: Run by bash in a private mount namespace with $1 = the .deb and $2 = a scratch folder:
+#: overlays /usr, /etc and /var/lib/dpkg (their changes go to a tmpfs), installs the package
+#: with dpkg, runs topopt from the PATH and starts FreeCAD's GUI under Xvfb with a fresh user
+#: home, which writes $2/listed.txt (the workbenches it lists, the one activated, where topopt
+#: was imported from and whether its core loads).
+_INSTALL_AND_LIST = textwrap.dedent(r"""
+    set -euo pipefail
+    deb="$1"; tmp="$2"; ovl="$tmp/overlays"
+    mkdir -p "$ovl"
+    mount -t tmpfs tmpfs "$ovl"
+    for d in usr etc var/lib/dpkg; do
+      n="${d//\//_}"; mkdir -p "$ovl/$n.up" "$ovl/$n.work"
+      mount -t overlay overlay -o "lowerdir=/$d,upperdir=$ovl/$n.up,workdir=$ovl/$n.work" "/$d"
+    done
+    dpkg -i "$deb"
+    command -v topopt
+    topopt --help 2>&1 | head -n 3 || true
+    mkdir -p "$tmp/syshome/Mod"
+    cat > "$tmp/list.py" <<PY
+    import os
+    import FreeCADGui
+    import topopt
+    with open("$tmp/listed.txt", "w") as out:
+        out.write("workbenches %s\n" % " ".join(sorted(FreeCADGui.listWorkbenches())))
+        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        out.write("active %s\n" % FreeCADGui.activeWorkbench().name())
+        out.write("module %s\n" % topopt.__file__)
+        out.write("core_problem %s\n" % topopt.core_problem())
+    os._exit(0)
+    PY
+    export FREECAD_USER_HOME="$tmp/syshome" QTWEBENGINE_DISABLE_SANDBOX=1 QTWEBENGINE_CHROMIUM_FLAGS=--no-sandbox
+    timeout 600 xvfb-run -a -s "-screen 0 1280x1024x24" freecad "$tmp/list.py" > "$tmp/freecad.log" 2>&1
+    """)
 
 
 if __name__ == "__main__":
