@@ -8,13 +8,12 @@ Exits with a non-zero status on any failure (FreeCADCmd itself would not).
 import json
 import os
 import sys
-import time
 import traceback
 
 import FreeCAD
 import Part
 
-from topopt.app import api
+from topopt.app import api, quiet
 
 
 def main():
@@ -31,7 +30,7 @@ def main():
         o = doc.addObject("Part::Feature", "Keep%d" % (i + 1))
         o.Shape = solid
         keep.append(o)
-    doc.recompute()
+    quiet.recompute(doc)
     opt = job["optimization"]
     study = api.new_study(doc, part, keep, volume_fraction=opt["volume_fraction"],
                           mesh_size=job["mesh"]["size"])
@@ -40,27 +39,16 @@ def main():
     api.add_fixed(study, job["supports"][0]["faces"])
     load = job["load_cases"][0]["loads"][0]
     api.add_force(study, load["faces"], tuple(load["vector"]))
-    doc.recompute()
+    quiet.recompute(doc)
 
-    t0 = time.time()
-
-    def progress(record):
-        if "iteration" in record and record["iteration"] % 10 == 0:
-            print("  iteration %3d: compliance %.2f N·mm, volume %.3f" % (
-                record["iteration"], record["compliance"], record["volume"]))
-        elif "stage" in record and record["stage"] == "mesh":
-            print("  " + record["message"])
-
-    result = api.run(study, progress)
-    print("run: %s in %.1f s; %d tets; result shape %d triangles, %s, volume %.0f mm³" % (
-        study.Status, time.time() - t0, len(study.MeshTets) // 4, result.Mesh.CountFacets,
-        "closed" if result.Mesh.isSolid() else "NOT closed", result.Mesh.Volume))
+    result = api.run(study)  # one line per stage, then the run summary
     stl = api.export_stl(study, os.path.join(out, "lever_result.stl"))
-    fcstd = os.path.join(out, "lever_study.FCStd")
-    doc.saveAs(fcstd)
+    fcstd = api.save(doc, os.path.join(out, "lever_study.FCStd"))
     with open(os.path.join(out, "lever_history.json"), "w") as f:
         json.dump({"compliance": list(study.ComplianceHistory), "volume": list(study.VolumeHistory),
                    "status": study.Status}, f, indent=1)
+    print("result shape: %d triangles, %s, volume %.0f mm³" % (
+        result.Mesh.CountFacets, "closed" if result.Mesh.isSolid() else "NOT closed", result.Mesh.Volume))
     print("document: %s\nSTL: %s" % (fcstd, stl))
     if not result.Mesh.isSolid():
         raise RuntimeError("the result shape is not closed")

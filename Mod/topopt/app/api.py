@@ -10,6 +10,9 @@ import os
 import Part
 
 from . import checks
+from . import directions
+from . import quiet
+from . import units
 from . import worker
 from .errors import TopOptError  # noqa: F401  (part of the API)
 
@@ -66,7 +69,7 @@ def surface_mesh(shape, size=0.0, doc=None, name="SurfaceMesh", wall_layers=0):
     tri = [tuple(int(i) for i in t) for t in result["triangles"]]
     feature = doc.addObject("Mesh::Feature", name)
     feature.Mesh = Mesh.Mesh([[pts[a], pts[b], pts[c]] for a, b, c in tri])
-    doc.recompute()
+    quiet.recompute(doc)
     return result, feature
 
 
@@ -126,7 +129,10 @@ def _add_constraint(study, make, configure):
         configure(c)
         study.Constraints = list(study.Constraints) + [c]
     except BaseException:
+        line = directions.helper_line(c)
         doc.removeObject(c.Name)
+        if line is not None:
+            doc.removeObject(line.Name)
         raise
     return c
 
@@ -166,7 +172,9 @@ def add_symmetry(study, faces, obj=None):
 
 
 def add_force(study, faces, vector, obj=None):
-    """A total force (N, a 3-vector) spread over the faces by area."""
+    """A total force (N, a 3-vector) spread over the faces by area. FEM's force constraint
+    gets the magnitude and, as its direction reference, a hidden line along the vector
+    (topopt.app.directions), so that FEM draws and applies exactly this vector."""
     import FreeCAD
     refs = _faces(study, faces, obj)
     try:
@@ -183,11 +191,8 @@ def add_force(study, faces, vector, obj=None):
 
     def configure(c):
         c.References = refs
-        c.Force = v.Length
-        # FreeCAD's force takes its direction from a reference edge or face; scripted forces get
-        # their direction stored directly in DirectionVector's place through a hidden property.
-        c.addProperty("App::PropertyVector", "TopOptDirection", "TopOpt", "Force direction (script)")
-        c.TopOptDirection = FreeCAD.Vector(v).normalize()
+        units.set_prop(c, "Force", v.Length, "N")
+        directions.set_vector_direction(c, v)
     return _add_constraint(study, _fem("makeConstraintForce", "Force"), configure)
 
 
@@ -198,7 +203,7 @@ def add_pressure(study, faces, value, obj=None):
 
     def configure(c):
         c.References = refs
-        c.Pressure = abs(value)
+        units.set_prop(c, "Pressure", abs(value), "MPa")
         c.Reversed = value < 0
     return _add_constraint(study, _fem("makeConstraintPressure", "Pressure"), configure)
 
@@ -209,13 +214,22 @@ def job_of(study):
     return study_to_job(study)
 
 
-def run(study, on_progress=None, cancel=None):
-    """Runs the study (mesh → SIMP → result surface) in the worker process and returns the
-    result Mesh feature. on_progress(record) is called per stage and iteration and returns
-    True to cancel (False or None to go on); cancel(), if given, is polled several times a
-    second and cancels on True. The document is only changed when the run succeeds."""
+def run(study, on_progress=None, cancel=None, verbose=True):
+    """Runs the study (mesh → SIMP → result surface → analysis of the last iterate) in the
+    worker process and returns the result Mesh feature; the study's other results (FEM result,
+    fields, density view) are linked from it. on_progress(record) is called per stage and
+    iteration and returns True to cancel (False or None to go on); cancel(), if given, is
+    polled several times a second and cancels on True. The document is only changed when the
+    run succeeds, in one undo step. With `verbose`, one line per stage and the run summary
+    (with where the results are) go to the report view, or standard output without the GUI."""
     from . import runner
-    return runner.run(study, on_progress, cancel)
+    return runner.run(study, on_progress, cancel, verbose)
+
+
+def save(doc, path=None):
+    """Saves `doc` (as doc.saveAs(path) does, or doc.save() without a path) without FreeCAD's
+    console progress lines in headless scripts. Returns the file's path."""
+    return quiet.save(doc, path)
 
 
 def export_stl(study, path):
@@ -231,7 +245,8 @@ def export_stl(study, path):
     if os.path.isdir(path):
         raise TopOptError("%s is a folder: give a file name ending in .stl" % path, "Io")
     try:
-        study.Result.Mesh.write(path)
+        with quiet.no_progress_lines():
+            study.Result.Mesh.write(path)
     except Exception as e:  # OSError, or FreeCAD's own exception types
         raise TopOptError("cannot write %s (%s): check that the folder is writable"
                           % (path, getattr(e, "strerror", None) or e), "Io") from None

@@ -8,7 +8,9 @@ loads on load pads whose faces lie on the part's boundary.
 import Part
 
 from . import checks
+from . import directions
 from . import errors
+from . import units
 from .study import is_study
 
 
@@ -57,48 +59,48 @@ def face_names(study, references, what):
     return names
 
 
-def _vec(v):
-    return [float(v.x), float(v.y), float(v.z)]
+def _components(study, c, label):
+    """FEM's displacement constraint: the fixed components (a prescribed non-zero value is
+    refused: TopOpt fixes components, it does not move them)."""
+    fix = [axis for axis in "xyz" if getattr(c, axis + "Fix")]
+    moved = [axis for axis in "xyz" if not getattr(c, axis + "Fix") and not getattr(c, axis + "Free")
+             and abs(units.prop(c, axis + "Displacement", "mm")) > 0]
+    if moved:
+        raise errors.TopOptError("%s prescribes a non-zero displacement; TopOpt supports only fixed "
+                                 "components (tick Fix or Free)" % label, "InvalidParameter")
+    if not fix:
+        raise errors.TopOptError("%s fixes no component: tick xFix, yFix or zFix" % label, "InvalidParameter")
+    return {"type": "components", "faces": face_names(study, c.References, label), "fix": fix}
+
+
+def _force(study, c, label):
+    """FEM's force: its magnitude (N; a float in FreeCAD 0.20, a quantity in 1.x) along the
+    direction FEM applies and draws (directions.direction_of)."""
+    force = units.prop(c, "Force", "N")
+    d = directions.direction_of(c)
+    return {"type": "force", "faces": face_names(study, c.References, label), "vector": [force * x for x in d]}
 
 
 def constraint_to_job(study, c):
-    """(kind, item) for one constraint object: kind is "support" or "load"."""
+    """(kind, item) for one constraint object: kind is "support" or "load". Values are read
+    whether FreeCAD stores them as floats (0.20) or quantities (1.x)."""
     t = c.TypeId
     proxy_type = getattr(getattr(c, "Proxy", None), "Type", "")
     label = "'%s'" % c.Label
     if t == "Fem::ConstraintFixed":
         return "support", {"type": "fixed", "faces": face_names(study, c.References, label)}
     if t == "Fem::ConstraintDisplacement":
-        fix = [axis for axis in "xyz" if getattr(c, axis + "Fix")]
-        moved = [axis for axis in "xyz" if not getattr(c, axis + "Fix") and not getattr(c, axis + "Free")
-                 and abs(getattr(c, axis + "Displacement")) > 0]
-        if moved:
-            raise errors.TopOptError("%s prescribes a non-zero displacement; TopOpt supports only fixed "
-                                     "components (tick Fix or Free)" % label, "InvalidParameter")
-        if not fix:
-            raise errors.TopOptError("%s fixes no component: tick xFix, yFix or zFix" % label,
-                                     "InvalidParameter")
-        return "support", {"type": "components", "faces": face_names(study, c.References, label), "fix": fix}
+        return "support", _components(study, c, label)
     if proxy_type == "TopOpt::SymmetryPlane":
         return "support", {"type": "symmetry", "faces": face_names(study, c.References, label)}
     if t == "Fem::ConstraintForce":
-        force = checks.number(c.Force, "%s: Force" % label)
-        d = c.TopOptDirection if "TopOptDirection" in c.PropertiesList else c.DirectionVector
-        for axis in "xyz":
-            checks.number(getattr(d, axis), "%s: the direction's %s" % (label, axis))
-        if d.Length == 0:
-            raise errors.TopOptError("%s has no direction: pick an edge or face for it" % label, "InvalidParameter")
-        d = d.normalize() if hasattr(d, "normalize") else d
-        return "load", {"type": "force", "faces": face_names(study, c.References, label),
-                        "vector": [force * x for x in _vec(d)]}
+        return "load", _force(study, c, label)
     if t == "Fem::ConstraintPressure":
-        p = checks.number(c.Pressure, "%s: Pressure" % label)
+        p = units.prop(c, "Pressure", "MPa")
         return "load", {"type": "pressure", "faces": face_names(study, c.References, label),
                         "value": -p if c.Reversed else p}
-    if t == "Fem::ConstraintSelfWeight":
-        g = 9806.65  # mm/s², FreeCAD's self weight is in multiples of g
-        return "load", {"type": "gravity", "vector": [checks.number(getattr(c, "Gravity_" + axis), "%s: Gravity_%s"
-                                                                    % (label, axis)) * g for axis in "xyz"]}
+    if t == "Fem::ConstraintSelfWeight" or proxy_type == "Fem::ConstraintSelfWeight":
+        return "load", {"type": "gravity", "vector": units.gravity(c)}
     raise errors.TopOptError("%s (%s) is not a support or load TopOpt knows: use fixed, displacement, "
                              "force, pressure, self weight or a TopOpt symmetry plane" % (label, t),
                              "InvalidParameter")
@@ -132,37 +134,37 @@ def study_to_job(study):
     }
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]
-    if n["Threshold"] >= 0:
-        job["optimization"]["threshold"] = n["Threshold"]
+    # no threshold: a run always extracts the shape that keeps the volume fraction; the study's
+    # Threshold is the shown result's (the slider's), never an input of the next run
     return job
 
 
-#: the study's numeric properties: (name, low, high, open low, open high); None = no bound
+#: the study's numeric properties: (name, unit or None, low, high, open low, open high); None = no bound
 _NUMBERS = [
-    ("VolumeFraction", 0.0, 1.0, True, True),
-    ("YoungsModulus", 0.0, None, True, False),
-    ("PoissonRatio", -1.0, 0.5, True, True),
-    ("Density", 0.0, None, False, False),
-    ("MeshSize", 0.0, None, False, False),
-    ("WallLayers", 0, 4, False, False),
-    ("Penalty", 1.0, 10.0, False, False),
-    ("FilterRadius", 0.0, None, False, False),
-    ("MaxIterations", 1, 10000, False, False),
+    ("VolumeFraction", None, 0.0, 1.0, True, True),
+    ("YoungsModulus", "MPa", 0.0, None, True, False),
+    ("PoissonRatio", None, -1.0, 0.5, True, True),
+    ("Density", "t/mm^3", 0.0, None, False, False),
+    ("MeshSize", "mm", 0.0, None, False, False),
+    ("WallLayers", None, 0, 4, False, False),
+    ("Penalty", None, 1.0, 10.0, False, False),
+    ("FilterRadius", "mm", 0.0, None, False, False),
+    ("MaxIterations", None, 1, 10000, False, False),
 ]
 
 
 def study_numbers(study):
-    """The study's numeric properties as plain numbers, each checked: finite, in its range,
-    the threshold -1 (automatic) or in (0, 1). Raises TopOptError naming the property."""
+    """The study's numeric properties as plain numbers in the core's units (MPa, t/mm³, mm),
+    each checked: finite, in its range, with a unit of the right kind. Raises TopOptError
+    naming the property."""
     out = {}
-    for name, low, high, open_low, open_high in _NUMBERS:
+    for name, unit, low, high, open_low, open_high in _NUMBERS:
         if name in study.PropertiesList:
-            out[name] = checks.in_range(getattr(study, name), name, low, high, open_low, open_high)
+            value = getattr(study, name)
+            if unit is not None:
+                value = units.value_in(value, unit, name)
+            out[name] = checks.in_range(value, name, low, high, open_low, open_high)
     out.setdefault("WallLayers", 0)
     for name in ("WallLayers", "MaxIterations"):
         out[name] = int(out[name])
-    threshold = checks.number(study.Threshold, "Threshold")
-    if threshold >= 0:
-        threshold = checks.in_range(threshold, "Threshold (-1 for automatic)", 0.0, 1.0, True, True)
-    out["Threshold"] = threshold
     return out

@@ -1,12 +1,19 @@
 """Running a study: prepare (document → strings, GUI thread), execute (the worker process,
 any thread, touches no document), apply (results → document, GUI thread). Headless scripts
 call run(). Meshing, runs and re-extraction run in the worker process (topopt.app.worker):
-whatever fails there, the document is only touched after success.
+whatever fails there, the document is only touched after success, and apply() happens in one
+undo transaction ("TopOpt run"), so Edit > Undo takes a whole run back.
 """
+import contextlib
+
 import FreeCAD
+import numpy as np
 
 from . import checks
 from . import job as jobmod
+from . import progress
+from . import quiet
+from . import results
 from . import worker
 from .errors import TopOptError
 
@@ -23,6 +30,10 @@ class PreparedRun:
         self.part_brep = part_brep
         self.nondesign_brep = nondesign_brep
 
+    @property
+    def max_iterations(self):
+        return int(self.job["optimization"]["max_iterations"])
+
 
 def prepare(study):
     job = jobmod.study_to_job(study)
@@ -31,30 +42,56 @@ def prepare(study):
     return PreparedRun(job, part.exportBrepToString(), nd.exportBrepToString() if nd else "")
 
 
+@contextlib.contextmanager
+def transaction(doc, name):
+    """One undo step named `name` for what happens inside (Edit > Undo takes it back whole);
+    if anything inside raises, the step is aborted, which restores the document where undo is
+    on (it always is with the GUI)."""
+    doc.openTransaction(name)
+    try:
+        yield
+    except BaseException:
+        doc.abortTransaction()
+        raise
+    doc.commitTransaction()
+
+
 def execute(prepared, on_progress=None, cancel=None):
-    """Runs mesh → SIMP → surface in the worker process. on_progress(record) gets a dict per
-    stage ({"stage", "fraction", "message"}) and iteration ({"iteration", "compliance",
-    "volume", "change", "seconds"}) in the calling thread; it returns True to cancel, False or
-    None to go on. cancel(), if given, is polled several times a second and cancels on True
-    (this is how a Cancel button stops a worker that has gone silent). Returns the result
-    dict: nodes, tets, domain, boundary_triangles, boundary_faces, boundary_nondesign_faces,
-    densities, history, threshold, surface_points, surface_triangles, surface_tags, status,
-    seconds, warnings. Raises TopOptError (see worker.run)."""
+    """Runs mesh → SIMP → surface → the last iterate's analysis in the worker process.
+    on_progress(record) gets a dict per stage ({"stage", "fraction", "message"}) and iteration
+    ({"iteration", "compliance", "volume", "change", "seconds"}) in the calling thread; it
+    returns True to cancel, False or None to go on. cancel(), if given, is polled several
+    times a second and cancels on True (this is how a Cancel button stops a worker that has
+    gone silent). Returns the result dict: nodes, tets, domain, boundary_triangles,
+    boundary_faces, boundary_nondesign_faces, densities, displacement (#V x 3, mm) and
+    von_mises (#T, MPa) of the last iterate, history, threshold, surface_points,
+    surface_triangles, surface_tags, status, seconds, warnings. Raises TopOptError (see
+    worker.run)."""
     return worker.run("optimize", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
                       on_progress=on_progress, cancel=cancel)
 
 
+def store_mesh(study, nodes, tets, domain):
+    """Keeps the analysis mesh in the study (for re-extraction and the domain view)."""
+    study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in nodes]
+    study.MeshTets = [int(i) for i in np.asarray(tets).reshape(-1)]
+    study.MeshDomains = [int(i) for i in domain]
+
+
 def mesh_only(study, on_progress=None, cancel=None):
-    """Meshes the study's shapes (no optimisation) in the worker process and stores the tagged
-    mesh in the study. Returns the result dict (nodes, tets, domain, boundary triangles and
-    faces, min_radius_ratio, mean_radius_ratio, warnings)."""
+    """Meshes the study's shapes (no optimisation) in the worker process, stores the tagged
+    mesh in the study and shows it (DomainMeshes: one FEM mesh per domain). The densities of
+    an earlier run no longer match the mesh and are dropped (its result objects stay).
+    Returns the result dict (nodes, tets, domain, boundary triangles and faces,
+    min_radius_ratio, mean_radius_ratio, warnings)."""
     prepared = prepare(study)
     result = worker.run("mesh", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
                         on_progress=on_progress, cancel=cancel)
-    study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]
-    study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
-    study.MeshDomains = [int(i) for i in result["domain"]]
-    study.Densities = []
+    with transaction(study.Document, "TopOpt mesh"):
+        store_mesh(study, result["nodes"], result["tets"], result["domain"])
+        study.Densities = []
+        results.show_domains(study, result["nodes"], result["tets"], result["domain"])
+        quiet.recompute(study.Document)
     _report_warnings(result)
     return result
 
@@ -65,7 +102,8 @@ def result_mesh(points, triangles):
     import Mesh
     vectors = [FreeCAD.Vector(float(p[0]), float(p[1]), float(p[2])) for p in points]
     facets = [[vectors[int(t[0])], vectors[int(t[1])], vectors[int(t[2])]] for t in triangles]
-    return Mesh.Mesh(facets)
+    with quiet.no_progress_lines():
+        return Mesh.Mesh(facets)
 
 
 def _report_warnings(result):
@@ -74,40 +112,97 @@ def _report_warnings(result):
         FreeCAD.Console.PrintWarning("TopOpt: %s\n" % w)
 
 
-def apply(study, result):
-    """Stores the run's mesh, densities and history in the study and shows the result shape as
-    a Mesh feature (created once, updated on later runs). Returns that feature. Everything is
-    converted before the first property is set, so that a bad result leaves the study as it was."""
-    doc = study.Document
-    shape = result_mesh(result["surface_points"], result["surface_triangles"])
-    study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in result["nodes"]]
-    study.MeshTets = [int(i) for i in result["tets"].reshape(-1)]
-    study.MeshDomains = [int(i) for i in result["domain"]]
-    study.Densities = [float(x) for x in result["densities"]]
-    study.ComplianceHistory = [float(h["compliance"]) for h in result["history"]]
-    study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
-    study.Status = result.get("status", "done")
-    _report_warnings(result)
+def _result_feature(study, shape, points, triangles, tags, nodes, tets, domain):
+    """The study's result shape (created once, updated later), its faces on non-design solids
+    coloured apart (tags: the core's surface_tags)."""
     feature = study.Result
     if feature is None:
-        feature = doc.addObject("Mesh::Feature", study.Name + "_Result")
+        feature = study.Document.addObject("Mesh::Feature", study.Name + "_Result")
         study.Result = feature
+    feature.Label = "%s result" % study.Label
     feature.Mesh = shape
-    doc.recompute()
+    results.colour_result(feature, results.facet_domains(points, triangles, nodes, tets, domain, tags))
     return feature
 
 
-def run(study, on_progress=None, cancel=None):
-    """prepare → execute → apply in the calling thread; returns the result Mesh feature."""
-    return apply(study, execute(prepare(study), on_progress, cancel))
+def apply(study, result):
+    """Stores the run in the study and makes or refreshes its objects: the result shape, the
+    FEM result of the last iterate with its mesh, the fields and density view, and the domain
+    meshes if the study shows them. Everything is converted before the first property is set,
+    so that a bad result leaves the study as it was. Returns the result shape's feature.
+    Callers wrap it in an undo transaction (run() does)."""
+    doc = study.Document
+    shape = result_mesh(result["surface_points"], result["surface_triangles"])
+    nodes = np.asarray(result["nodes"], dtype=np.float64)
+    tets = np.asarray(result["tets"], dtype=np.int64)
+    domain = np.asarray(result["domain"], dtype=np.int64)
+    store_mesh(study, nodes, tets, domain)
+    study.Densities = [float(x) for x in result["densities"]]
+    study.ComplianceHistory = [float(h["compliance"]) for h in result["history"]]
+    study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
+    study.Threshold = float(result.get("threshold", 0.5))
+    study.Status = result.get("status", "done")
+    feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
+                              result.get("surface_tags"), nodes, tets, domain)
+    results.update_fem_objects(study, result, study.Threshold)
+    if study.DomainMeshes:
+        results.show_domains(study, nodes, tets, domain)
+    quiet.recompute(doc)
+    results.style_result(feature)
+    return feature
+
+
+def where_results_are(study):
+    """A line naming the run's objects and their main figures."""
+    parts = []
+    if study.Result is not None:
+        parts.append("%s (the shape, %.4g mm³)" % (study.Result.Label, study.Result.Mesh.Volume))
+    res = study.FemResult
+    if res is not None and res.DisplacementLengths:
+        parts.append("%s (FEM result: largest displacement %.4g mm, largest von Mises stress %.4g MPa)"
+                     % (res.Label, max(res.DisplacementLengths), max(res.vonMises or [0.0])))
+    if study.DensityView is not None:
+        parts.append("%s (density view)" % study.DensityView.Label)
+    return "  results: " + ("; ".join(parts) if parts else "none")
+
+
+def report_run(study, result, tracker, seconds):
+    """Prints the run summary to the report view (FreeCAD's console without the GUI)."""
+    lines = progress.run_summary(study, result, tracker, seconds) + [where_results_are(study)]
+    FreeCAD.Console.PrintMessage("\n".join(lines) + "\n")
+    _report_warnings(result)
+
+
+def run(study, on_progress=None, cancel=None, verbose=True):
+    """prepare → execute → apply in the calling thread, apply as one undo step; returns the
+    result Mesh feature. With `verbose`, prints one line per stage as it starts and the run
+    summary with where the results are (the report view; standard output without the GUI)."""
+    prepared = prepare(study)
+    tracker = progress.Tracker("optimize", prepared.max_iterations)
+
+    def follow(record):
+        if tracker.update(record) and verbose:
+            FreeCAD.Console.PrintMessage(progress.stage_line(tracker.stage, prepared.max_iterations) + "\n")
+        return on_progress(record) if on_progress is not None else None
+
+    result = execute(prepared, follow, cancel)
+    tracker.finish()
+    with tracker.timed("document"):
+        with transaction(study.Document, "TopOpt run"):
+            feature = apply(study, result)
+    seconds = tracker.clock() - tracker.started
+    if verbose:
+        report_run(study, result, tracker, seconds)
+    return feature
 
 
 def reextract(study, threshold, cancel=None):
     """Re-extracts the result shape from the stored densities at another threshold (no
-    re-run), in the worker process. threshold: in (0, 1); cancel(): polled, True cancels.
-    Stopped after REEXTRACT_TIMEOUT seconds. Returns the result Mesh feature.
-    Raises TopOptError if the study has no result, if what it stored is damaged, or if the
-    worker fails (the document is then unchanged)."""
+    re-run), in the worker process, and moves the density view's cut there; one undo step
+    ("TopOpt threshold"). threshold: in (0, 1); cancel(): polled, True cancels. Stopped after
+    REEXTRACT_TIMEOUT seconds. Returns the result Mesh feature. Raises TopOptError if the
+    study has no result, if what it stored is damaged, or if the worker fails (the document
+    is then unchanged). The study's Threshold is the shown shape's: runs never read it."""
     if not study.Densities:
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
     threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
@@ -116,9 +211,11 @@ def reextract(study, threshold, cancel=None):
                                                    "densities": densities},
                         params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
     shape = result_mesh(result["surface_points"], result["surface_triangles"])
-    study.Threshold = threshold
-    feature = study.Result or study.Document.addObject("Mesh::Feature", study.Name + "_Result")
-    study.Result = feature
-    feature.Mesh = shape
-    study.Document.recompute()
+    with transaction(study.Document, "TopOpt threshold %.2f" % threshold):
+        study.Threshold = threshold
+        feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
+                                  result.get("surface_tags"), nodes, tets, domain)
+        results.set_density_cut(study, threshold)
+        quiet.recompute(study.Document)
+    results.style_result(feature)
     return feature

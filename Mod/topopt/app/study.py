@@ -1,4 +1,5 @@
-"""The TopOpt study: a document object that holds everything one optimisation needs.
+"""The TopOpt study: a document object that holds everything one optimisation needs, and
+links to everything a run made (all shown under it in the tree).
 
 Saved in .FCStd files with its proxy's module path "topopt.app.study": never move or rename
 this module or the classes in it, or saved documents stop loading their studies.
@@ -7,12 +8,69 @@ import FreeCAD
 
 PROXY_TYPE = "TopOpt::Study"
 
+#: the study's links to what runs and the Mesh command made: (name, doc)
+RESULT_LINKS = [
+    ("Result", "The smoothed result shape (Mesh feature); non-design solids coloured apart"),
+    ("FemResult", "The last SIMP iterate as a FEM result: displacement and von Mises stress "
+                  "(FEM's result panel and post-processing work on it)"),
+    ("AnalysisMesh", "The tagged analysis mesh as a FEM mesh (the FEM result's mesh)"),
+    ("Fields", "The run's fields for FEM's post-processing: Density, Domain, Displacement, von Mises"),
+    ("DensityView", "The material where the density reaches the threshold, coloured by density"),
+]
+
 
 def _add(obj, kind, name, group, doc, default=None):
     if name not in obj.PropertiesList:
         obj.addProperty(kind, name, group, doc)
         if default is not None:
             setattr(obj, name, default)
+
+
+def _add_density(obj, text, doc):
+    """Adds the property Density holding `text` (a quantity such as "7850 kg/m^3"): an
+    App::PropertyDensity where this FreeCAD has one (0.21 and later), else an
+    App::PropertyString (FreeCAD 0.20 has no density property)."""
+    try:
+        obj.addProperty("App::PropertyDensity", "Density", "Material", doc)
+    except Exception:  # FreeCAD 0.20: no such type
+        obj.addProperty("App::PropertyString", "Density", "Material", doc)
+    obj.Density = text
+
+
+def _density_to_retype(obj):
+    """True when the study's Density is an older document's float (t/mm³), or FreeCAD 0.20's
+    text in a FreeCAD that has App::PropertyDensity."""
+    kind = obj.getTypeIdOfProperty("Density") if "Density" in obj.PropertiesList else None
+    if kind == "App::PropertyFloat":
+        return True
+    if kind != "App::PropertyString":
+        return False
+    try:
+        obj.addProperty("App::PropertyDensity", "TopOptDensityProbe", "", "")
+    except Exception:  # no such type here
+        return False
+    obj.removeProperty("TopOptDensityProbe")
+    return True
+
+
+def _retype(obj, name, kind, group, doc, convert):
+    """Re-creates property `name` as `kind` when a document saved by an older version holds it
+    with another type, keeping its value through convert(old value)."""
+    if name in obj.PropertiesList and obj.getTypeIdOfProperty(name) != kind:
+        old = getattr(obj, name)
+        obj.removeProperty(name)
+        obj.addProperty(kind, name, group, doc)
+        setattr(obj, name, convert(old))
+
+
+def _density_text(value):
+    """A density as the quantity text the study stores: a Quantity or text as it is, a plain
+    float as older versions stored it (t/mm³)."""
+    if isinstance(value, FreeCAD.Units.Quantity):
+        return "%.6g kg/m^3" % value.getValueAs("kg/m^3")
+    if isinstance(value, str):
+        return value
+    return "%.6g kg/m^3" % (float(value) * 1e12)
 
 
 class Study:
@@ -24,16 +82,35 @@ class Study:
         self.ensure_properties(obj)
 
     def ensure_properties(self, obj):
-        """Adds any property the object lacks (documents saved by older versions)."""
+        """Adds any property the object lacks and gives old documents' properties their
+        current types (documents saved by older versions load as studies of this one)."""
+        self._geometry(obj)
+        self._material(obj)
+        self._mesh(obj)
+        self._optimization(obj)
+        self._results(obj)
+
+    def _geometry(self, obj):
         _add(obj, "App::PropertyLink", "Part", "Geometry", "The whole part Ω: one solid")
         _add(obj, "App::PropertyLinkList", "NonDesign", "Geometry",
              "Non-design solids Ω̄ (material to keep), in order")
         _add(obj, "App::PropertyLinkList", "Constraints", "Geometry",
              "Supports and loads: FEM constraints (fixed, displacement, force, pressure, "
              "self weight) and TopOpt symmetry planes")
-        _add(obj, "App::PropertyFloat", "YoungsModulus", "Material", "Young's modulus E (MPa)", 210000.0)
-        _add(obj, "App::PropertyFloat", "PoissonRatio", "Material", "Poisson's ratio", 0.3)
-        _add(obj, "App::PropertyFloat", "Density", "Material", "Mass density (t/mm³), for self weight", 7.85e-9)
+
+    def _material(self, obj):
+        doc_e, doc_rho = "Young's modulus E", "Mass density, for self weight"
+        _retype(obj, "YoungsModulus", "App::PropertyPressure", "Material", doc_e, lambda v: "%.12g MPa" % v)
+        if _density_to_retype(obj):
+            text = _density_text(obj.Density)  # an older document's float, or 0.20's text
+            obj.removeProperty("Density")
+            _add_density(obj, text, doc_rho)
+        _add(obj, "App::PropertyPressure", "YoungsModulus", "Material", doc_e, "210000 MPa")
+        _add(obj, "App::PropertyFloat", "PoissonRatio", "Material", "Poisson's ratio ν", 0.3)
+        if "Density" not in obj.PropertiesList:
+            _add_density(obj, "7850 kg/m^3", doc_rho)
+
+    def _mesh(self, obj):
         _add(obj, "App::PropertyLength", "MeshSize", "Mesh", "Target element size; 0 = automatic", 0.0)
         if "Mesher" not in obj.PropertiesList:
             obj.addProperty("App::PropertyEnumeration", "Mesher", "Mesh",
@@ -43,9 +120,10 @@ class Study:
         _add(obj, "App::PropertyInteger", "WallLayers", "Mesh",
              "Element layers across walls thinner than two mesh sizes (native mesher; 0 = off, "
              "2 = two layers, more elements)", 0)
+
+    def _optimization(self, obj):
         # a plain float, checked when the study is run (job.study_numbers): a constrained float
-        # would silently clamp 0 to its lower bound and run (documents saved with the older
-        # PropertyFloatConstraint load without its bounds, so they behave the same)
+        # would silently clamp 0 to its lower bound and run
         _add(obj, "App::PropertyFloat", "VolumeFraction", "Optimization",
              "Share of the design domain's volume to keep, strictly between 0 and 1", 0.3)
         _add(obj, "App::PropertyFloat", "Penalty", "Optimization", "SIMP penalty p", 3.0)
@@ -59,9 +137,16 @@ class Study:
                             "Update scheme: optimality criteria or MMA")
             obj.Update = ["oc", "mma"]
         _add(obj, "App::PropertyInteger", "MaxIterations", "Optimization", "Iteration cap", 80)
-        _add(obj, "App::PropertyFloat", "Threshold", "Result",
-             "Density threshold of the result shape; -1 = the one that meets the volume", -1.0)
-        _add(obj, "App::PropertyLink", "Result", "Result", "The smoothed result shape (Mesh feature)")
+
+    def _results(self, obj):
+        doc_t = ("Density threshold of the shown result shape: the run's (the one that keeps the volume "
+                 "fraction) until the threshold slider moves it; never an input of the next run")
+        _add(obj, "App::PropertyFloat", "Threshold", "Result", doc_t, -1.0)
+        obj.setDocumentationOfProperty("Threshold", doc_t)  # older documents: it used to be an input
+        for name, doc in RESULT_LINKS:
+            _add(obj, "App::PropertyLink", name, "Result", doc)
+        _add(obj, "App::PropertyLinkList", "DomainMeshes", "Result",
+             "The tagged mesh by domain (FEM meshes: design, then each non-design solid)")
         _add(obj, "App::PropertyFloatList", "ComplianceHistory", "Result", "Compliance per iteration (N·mm)")
         _add(obj, "App::PropertyFloatList", "VolumeHistory", "Result", "Volume fraction per iteration")
         _add(obj, "App::PropertyString", "Status", "Result", "What the last run did")
@@ -71,14 +156,17 @@ class Study:
         _add(obj, "App::PropertyIntegerList", "MeshTets", "Result", "Analysis mesh tets, 4 per tet")
         _add(obj, "App::PropertyIntegerList", "MeshDomains", "Result", "0 design, i non-design solid i")
         _add(obj, "App::PropertyFloatList", "Densities", "Result", "Element densities of the last run")
-        for name in ("Status", "MeshNodes", "MeshTets", "MeshDomains", "Densities",
-                     "ComplianceHistory", "VolumeHistory"):
+        for name in ("Status", "MeshNodes", "MeshTets", "MeshDomains", "Densities", "ComplianceHistory",
+                     "VolumeHistory", "Threshold", "DomainMeshes") + tuple(n for n, _ in RESULT_LINKS):
             obj.setEditorMode(name, 1)  # read-only in the property editor
         for name in ("MeshNodes", "MeshTets", "MeshDomains", "Densities"):
             obj.setEditorMode(name, 2)  # and hidden: they are large
 
     def onDocumentRestored(self, obj):
         self.ensure_properties(obj)
+        from . import directions
+        directions.migrate_scripted_forces(obj)
+        attach_view_provider(obj, "ViewProviderStudy")
 
     def execute(self, obj):
         pass
@@ -91,8 +179,39 @@ class Study:
             self.Type = state.get("Type", PROXY_TYPE)
 
 
+def attach_view_provider(obj, name):
+    """With the GUI, gives `obj` TopOpt's view provider `name` (topopt.gui.view_providers) when
+    it has none: a document saved without the GUI holds no view data, and its objects would
+    open without their icon, their children in the tree and their panel."""
+    vobj = getattr(obj, "ViewObject", None) if FreeCAD.GuiUp else None
+    if vobj is None:
+        return
+    from topopt.gui import view_providers
+    cls = getattr(view_providers, name)
+    if not isinstance(getattr(vobj, "Proxy", None), cls):
+        cls(vobj)
+
+
 def is_study(obj):
     return getattr(getattr(obj, "Proxy", None), "Type", None) == PROXY_TYPE
+
+
+def owned_objects(study):
+    """Every object the study made or refers to besides its inputs, in tree order:
+    constraints with their direction lines, the domain meshes, then the result objects."""
+    from . import directions
+    out = []
+    for c in study.Constraints:
+        out.append(c)
+        line = directions.helper_line(c)
+        if line is not None:
+            out.append(line)
+    out += [o for o in study.DomainMeshes if o is not None]
+    for name, _ in RESULT_LINKS:
+        obj = getattr(study, name, None)
+        if obj is not None and not (name == "DensityView" and study.Fields is not None):
+            out.append(obj)  # the density view sits under the fields (FEM's pipeline claims it)
+    return out
 
 
 def make_study(doc, part, nondesign=(), name="TopOptStudy"):
@@ -102,7 +221,5 @@ def make_study(doc, part, nondesign=(), name="TopOptStudy"):
     Study(obj)
     obj.Part = part
     obj.NonDesign = list(nondesign)
-    if FreeCAD.GuiUp:
-        from topopt.gui import view_providers
-        view_providers.ViewProviderStudy(obj.ViewObject)
+    attach_view_provider(obj, "ViewProviderStudy")
     return obj

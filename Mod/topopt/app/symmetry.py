@@ -2,7 +2,6 @@
 
 Saved in .FCStd with the proxy path "topopt.app.symmetry": keep it.
 """
-import FreeCAD
 
 PROXY_TYPE = "TopOpt::SymmetryPlane"
 
@@ -17,6 +16,10 @@ class SymmetryPlane:
     def execute(self, obj):
         pass
 
+    def onDocumentRestored(self, obj):
+        from .study import attach_view_provider
+        attach_view_provider(obj, "ViewProviderSymmetry")
+
     def __getstate__(self):
         return {"Type": self.Type}
 
@@ -30,7 +33,6 @@ def make_symmetry_plane(doc, references=(), name="SymmetryPlane"):
     obj = doc.addObject("App::FeaturePython", name)
     SymmetryPlane(obj)
     obj.References = list(references)
-    if FreeCAD.GuiUp:
-        from topopt.gui import view_providers
-        view_providers.ViewProviderSymmetry(obj.ViewObject)
+    from .study import attach_view_provider
+    attach_view_provider(obj, "ViewProviderSymmetry")
     return obj

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from .. import package_dir
+from .. import compiled_dirs, core_problem
 from . import checks
 from .errors import TopOptError
 
@@ -48,12 +48,13 @@ _STAGES = {
 
 
 def executable():
-    """The worker program staged with this package (topopt/bin/topopt)."""
-    path = os.path.join(package_dir(), "bin", "topopt")
-    if not os.access(path, os.X_OK):
-        raise TopOptError("TopOpt's worker program is missing (%s): rebuild with scripts/build and "
-                          "install the workbench again" % path, "Internal")
-    return path
+    """The worker program staged with this package (topopt/bin/topopt; in a clone of the
+    repository, the in-place build's)."""
+    for folder in compiled_dirs():
+        path = os.path.join(folder, "bin", "topopt")
+        if os.access(path, os.X_OK):
+            return path
+    raise TopOptError(core_problem() or "TopOpt's worker program is missing", "Internal")
 
 
 def _write_request(folder, operation, job, part, nondesign, arrays, params):

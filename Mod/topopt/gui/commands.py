@@ -1,5 +1,5 @@
-"""Workbench commands. Each one checks its preconditions and reports problems in the
-report view; none may raise into FreeCAD."""
+"""Workbench commands. Each one checks its preconditions and reports problems in the report
+view (and a message box); none may raise into FreeCAD. Every command has its own icon."""
 import FreeCAD
 import FreeCADGui
 
@@ -14,14 +14,18 @@ def _icon(name):
 
 
 def active_study():
-    """The selected study, or the only study of the active document."""
+    """The selected study (or the study of a selected constraint), or the only study of the
+    active document."""
     doc = FreeCAD.ActiveDocument
     if doc is None:
         return None
+    studies = [o for o in doc.Objects if is_study(o)]
     for obj in FreeCADGui.Selection.getSelection():
         if is_study(obj):
             return obj
-    studies = [o for o in doc.Objects if is_study(o)]
+        for s in studies:
+            if obj in s.Constraints:
+                return s
     return studies[0] if len(studies) == 1 else None
 
 
@@ -37,10 +41,31 @@ def _guarded(f):
     return wrapper
 
 
-class NewStudy:
+def _free_task_view(study):
+    """Closes the study's panel (keeping its edits) so that another task panel can open; a
+    TopOptError when a run is going."""
+    from topopt.gui.panels import close_study_panel
+    if not close_study_panel(study):
+        raise TopOptError("the study is running: wait for the run to end or stop it first", "InvalidParameter")
+    if FreeCADGui.Control.activeDialog():
+        raise TopOptError("another task panel is open: close it (OK or Cancel) first", "InvalidParameter")
+
+
+class _Command:
+    """A workbench command: its menu text, tooltip and icon as class attributes; active when
+    there is a study to act on (subclasses say otherwise)."""
+    menu, tip, icon = "", "", ""
+
     def GetResources(self):
-        return {"MenuText": "New study", "Pixmap": _icon("TopOptStudy.svg"),
-                "ToolTip": "Select the part first, then the non-design solids to keep, and create a study"}
+        return {"MenuText": self.menu, "ToolTip": self.tip, "Pixmap": _icon(self.icon)}
+
+    def IsActive(self):
+        return active_study() is not None
+
+
+class NewStudy(_Command):
+    menu, icon = "New study", "TopOptNewStudy.svg"
+    tip = "Select the part first, then the non-design solids to keep, and create a study"
 
     def IsActive(self):
         return FreeCAD.ActiveDocument is not None and bool(FreeCADGui.Selection.getSelection())
@@ -51,33 +76,32 @@ class NewStudy:
         if not sel:
             raise TopOptError("select the part (a solid) first, then any non-design solids")
         from topopt.gui.waiting import WaitDialog
-        with WaitDialog("Checking the shapes") as wait:  # checks, with clear errors
+        with WaitDialog("Checking the shapes", "info") as wait:  # checks, with clear errors
             api.info(sel[0].Shape, [o.Shape for o in sel[1:]] or None, cancel=wait.cancel)
-        FreeCAD.ActiveDocument.openTransaction("New TopOpt study")
-        study = api.new_study(FreeCAD.ActiveDocument, sel[0], sel[1:])
-        FreeCAD.ActiveDocument.commitTransaction()
-        FreeCAD.ActiveDocument.recompute()
+        doc = FreeCAD.ActiveDocument
+        from topopt.app.runner import transaction
+        with transaction(doc, "New TopOpt study"):
+            study = api.new_study(doc, sel[0], sel[1:])
+            doc.recompute()
         from topopt.gui.panels import open_study_panel
         open_study_panel(study)
 
 
-class _AddConstraint:
+def _selected_refs():
+    refs = [(s.Object, tuple(n for n in s.SubElementNames if n.startswith("Face")))
+            for s in FreeCADGui.Selection.getSelectionEx()]
+    return [r for r in refs if r[1]]
+
+
+class _AddConstraint(_Command):
     """Creates a constraint on the selected faces of the study's part or non-design solids, then
     opens FreeCAD FEM's own task panel for it (so users keep their habits)."""
-    menu, tip, icon, maker = "", "", "", None
-
-    def GetResources(self):
-        return {"MenuText": self.menu, "ToolTip": self.tip, "Pixmap": self.icon}
-
-    def IsActive(self):
-        return active_study() is not None
 
     @_guarded
     def Activated(self):
         study = active_study()
-        refs = [(s.Object, tuple(n for n in s.SubElementNames if n.startswith("Face")))
-                for s in FreeCADGui.Selection.getSelectionEx()]
-        refs = [r for r in refs if r[1]]
+        _free_task_view(study)
+        refs = _selected_refs()
         doc = study.Document
         doc.openTransaction(self.menu)
         c = self.make(study)
@@ -90,61 +114,72 @@ class _AddConstraint:
 
 
 class AddFixed(_AddConstraint):
-    menu, tip = "Fixed support", "Fix the selected faces"
-    icon = _icon("TopOptFixed.svg")
+    menu, tip, icon = "Fixed support", "Fix the selected faces", "TopOptFixed.svg"
 
     def make(self, study):
         import ObjectsFem
         return ObjectsFem.makeConstraintFixed(study.Document, "Fixed")
 
 
-class AddForce(_AddConstraint):
-    menu, tip = "Force", "A total force on the selected faces"
-    icon = _icon("TopOptForce.svg")
+class AddForce(_Command):
+    """A FEM force on the selected faces in TopOpt's force panel, whose direction is always
+    given: a vector (x, y, z) or a picked straight edge or planar face. With a force of the
+    study selected, edits it in the same panel."""
+    menu, icon = "Force", "TopOptForce.svg"
+    tip = ("A total force on the selected faces, in a direction you give (x, y, z) or pick; with a force "
+           "selected, edit it")
 
-    def make(self, study):
+    @_guarded
+    def Activated(self):
+        study = active_study()
+        _free_task_view(study)
+        from topopt.gui.force_panel import open_force_panel, selected_faces
+        chosen = [o for o in FreeCADGui.Selection.getSelection() if o in study.Constraints
+                  and o.TypeId == "Fem::ConstraintForce"]
+        if chosen:
+            open_force_panel(study, chosen[0], "Edit TopOpt force")
+            return
+        faces = selected_faces(study)
+        doc = study.Document
+        doc.openTransaction("TopOpt force")
         import ObjectsFem
-        return ObjectsFem.makeConstraintForce(study.Document, "Force")
+        c = ObjectsFem.makeConstraintForce(doc, "Force")
+        refs = {}
+        for obj, n in faces:
+            refs.setdefault(obj, []).append(n)
+        c.References = [(obj, tuple(names)) for obj, names in refs.items()]
+        study.Constraints = list(study.Constraints) + [c]
+        open_force_panel(study, c, "TopOpt force")
 
 
 class AddPressure(_AddConstraint):
-    menu, tip = "Pressure", "A pressure on the selected faces"
-    icon = _icon("TopOptPressure.svg")
+    menu, tip, icon = "Pressure", "A pressure on the selected faces", "TopOptPressure.svg"
 
     def make(self, study):
         import ObjectsFem
         return ObjectsFem.makeConstraintPressure(study.Document, "Pressure")
 
 
-class AddSymmetry(_AddConstraint):
-    menu, tip = "Symmetry plane", "The selected planar faces lie on a symmetry plane"
-    icon = _icon("TopOptSymmetry.svg")
-
-    def make(self, study):
-        from topopt.app.symmetry import make_symmetry_plane
-        return make_symmetry_plane(study.Document)
+class AddSymmetry(_Command):
+    menu, tip, icon = "Symmetry plane", "The selected planar faces lie on a symmetry plane", "TopOptSymmetry.svg"
 
     @_guarded
     def Activated(self):
         study = active_study()
-        refs = [(s.Object, tuple(n for n in s.SubElementNames if n.startswith("Face")))
-                for s in FreeCADGui.Selection.getSelectionEx()]
-        refs = [r for r in refs if r[1]]
+        refs = _selected_refs()
         if not refs:
             raise TopOptError("select the planar faces on the symmetry plane first")
-        c = self.make(study)
-        c.References = refs
-        study.Constraints = list(study.Constraints) + [c]
-        study.Document.recompute()
+        from topopt.app.runner import transaction
+        from topopt.app.symmetry import make_symmetry_plane
+        with transaction(study.Document, "Symmetry plane"):
+            c = make_symmetry_plane(study.Document, refs)
+            study.Constraints = list(study.Constraints) + [c]
+            study.Document.recompute()
 
 
-class RunStudy:
-    def GetResources(self):
-        return {"MenuText": "Run", "Pixmap": _icon("TopOptWorkbench.svg"),
-                "ToolTip": "Mesh, optimise and show the result shape of the study"}
-
-    def IsActive(self):
-        return active_study() is not None
+class RunStudy(_Command):
+    menu, icon = "Run", "TopOptRun.svg"
+    tip = "Mesh, optimise and show the result of the study (its panel opens with the live plot and Stop)"
 
     @_guarded
     def Activated(self):
@@ -152,33 +187,26 @@ class RunStudy:
         open_study_panel(active_study()).start_run()
 
 
-class MeshStudy:
-    def GetResources(self):
-        return {"MenuText": "Mesh", "Pixmap": _icon("TopOptStudy.svg"),
-                "ToolTip": "Mesh the part and the non-design solids into one tagged mesh and show it, "
-                           "coloured by domain"}
-
-    def IsActive(self):
-        return active_study() is not None
+class MeshStudy(_Command):
+    menu, icon = "Mesh", "TopOptMesh.svg"
+    tip = ("Mesh the part and the non-design solids into one tagged mesh and show it, coloured by domain "
+           "(with the study's mesh settings)")
 
     @_guarded
     def Activated(self):
         from topopt.app import runner
-        from topopt.gui import display
         study = active_study()
         from topopt.gui.waiting import WaitDialog
-        FreeCAD.Console.PrintMessage("TopOpt: meshing %s…\n" % study.Label)
-        with WaitDialog("Meshing %s" % study.Label) as wait:
+        FreeCAD.Console.PrintMessage("TopOpt: meshing %s\n" % study.Label)
+        with WaitDialog("Meshing %s" % study.Label, "mesh") as wait:
             result = runner.mesh_only(study, wait.on_progress, wait.cancel)
-        display.show_domains(study)
-        FreeCAD.Console.PrintMessage("TopOpt: %d nodes, %d tets (mean radius ratio %.2f)\n" % (
-            len(result["nodes"]), len(result["tets"]), result["mean_radius_ratio"]))
+        FreeCAD.Console.PrintMessage("TopOpt: %d nodes, %d tets (mean radius ratio %.2f): %s\n" % (
+            len(result["nodes"]), len(result["tets"]), result["mean_radius_ratio"],
+            ", ".join(o.Label for o in study.DomainMeshes)))
 
 
-class ExportStl:
-    def GetResources(self):
-        return {"MenuText": "Export result as STL", "Pixmap": _icon("TopOptStudy.svg"),
-                "ToolTip": "Write the study's result shape to an STL file"}
+class ExportStl(_Command):
+    menu, tip, icon = "Export result as STL", "Write the study's result shape to an STL file", "TopOptExportStl.svg"
 
     def IsActive(self):
         s = active_study()
@@ -186,21 +214,66 @@ class ExportStl:
 
     @_guarded
     def Activated(self):
-        from PySide2 import QtWidgets
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), "Export result",
-                                                        "", "STL (*.stl)")
+        from PySide import QtGui
+        path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), "Export result", "", "STL (*.stl)")
         if path:
             api.export_stl(active_study(), path)
             FreeCAD.Console.PrintMessage("TopOpt: result written to %s\n" % path)
 
 
+class BuildCore(_Command):
+    menu, icon = "Build the native core", "TopOptBuildCore.svg"
+
+    @property
+    def tip(self):
+        return "Build TopOpt's compiled core in this clone of the repository (%s)" % (
+            topopt.build_command() or "not available: this TopOpt was installed")
+
+    def IsActive(self):
+        return topopt.source_root() is not None
+
+    @_guarded
+    def Activated(self):
+        from topopt.gui.build_core import build_native_core
+        build_native_core()
+
+
 COMMANDS = [("TopOpt_NewStudy", NewStudy), ("TopOpt_Fixed", AddFixed), ("TopOpt_Force", AddForce),
             ("TopOpt_Pressure", AddPressure), ("TopOpt_Symmetry", AddSymmetry),
-            ("TopOpt_Mesh", MeshStudy), ("TopOpt_Run", RunStudy), ("TopOpt_ExportStl", ExportStl)]
+            ("TopOpt_Mesh", MeshStudy), ("TopOpt_Run", RunStudy), ("TopOpt_ExportStl", ExportStl),
+            ("TopOpt_BuildCore", BuildCore)]
+
+_STUDY = ["TopOpt_NewStudy"]
+_CONSTRAINTS = ["TopOpt_Fixed", "TopOpt_Force", "TopOpt_Pressure", "TopOpt_Symmetry"]
+_SOLVE = ["TopOpt_Mesh", "TopOpt_Run"]
+_RESULT = ["TopOpt_ExportStl"]
+
+#: toolbars: (title, command names with separators)
+TOOLBARS = [("Topology Optimization", _STUDY + ["Separator"] + _CONSTRAINTS + ["Separator"] + _SOLVE
+             + ["Separator"] + _RESULT)]
+#: the menu: the same groups, then the build of the core
+MENU = TOOLBARS[0][1] + ["Separator", "TopOpt_BuildCore"]
 
 
 def register():
-    """Registers the commands; returns their names for the toolbar and menu."""
+    """Registers the commands; returns their names."""
     for name, cls in COMMANDS:
         FreeCADGui.addCommand(name, cls())
     return [name for name, _ in COMMANDS]
+
+
+def tell_if_core_missing():
+    """When the native core is missing, says so in one dialog with the command that builds it
+    (the report view gets the same text). Returns True when something was said."""
+    problem = topopt.core_problem()
+    if problem is None:
+        return False
+    FreeCAD.Console.PrintError("TopOpt: %s\n" % problem.replace("\n\n", " ").replace("\n", " "))
+    mw = FreeCADGui.getMainWindow()
+    if mw is not None and mw.isVisible() and not FreeCAD.ConfigGet("TopOptNoDialogs"):
+        from PySide import QtCore, QtGui
+        box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "TopOpt: native core missing", problem,
+                                QtGui.QMessageBox.Ok, mw)
+        box.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)  # the command can be copied
+        box.exec_()
+    return True

@@ -137,8 +137,20 @@ TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
   EXPECT_NEAR(kept, 0.4, 0.05);  // the result shape keeps the volume fraction
   for (const char* name :
        {"nodes", "tets", "domain", "boundary_triangles", "boundary_faces", "boundary_nondesign_faces", "densities",
-        "surface_points", "surface_triangles", "surface_tags"})
+        "surface_points", "surface_triangles", "surface_tags", "displacement", "von_mises"})
     EXPECT_NE(std::find(result["arrays"].begin(), result["arrays"].end(), name), result["arrays"].end()) << name;
+  // the last iterate's analysis: held at x = 0, bent down at the loaded end x = 60
+  const RowMatXd U = npy_real(read_npy((dir_ / "out" / "displacement.npy").string()), 3, "displacement");
+  ASSERT_EQ(U.rows(), V.rows());
+  EXPECT_EQ(read_npy((dir_ / "out" / "von_mises.npy").string()).rows(), T.rows());
+  double tip = 0;
+  int at_tip = 0;
+  for (long i = 0; i < V.rows(); ++i) {
+    if (V(i, 0) < 1e-9) EXPECT_EQ(U.row(i).norm(), 0.0);
+    if (V(i, 0) > 60 - 1e-9) tip += U(i, 2), ++at_tip;
+  }
+  ASSERT_GT(at_tip, 0);
+  EXPECT_LT(tip / at_tip, 0.0);
 }
 
 TEST_F(CliWorker, ExtractSurfaceOfAFullCubeIsTheCube) {

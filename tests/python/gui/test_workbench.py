@@ -7,7 +7,7 @@ import unittest
 import FreeCAD
 import FreeCADGui
 import Part
-from PySide2 import QtWidgets
+from PySide import QtGui
 
 from topopt.app import api
 from topopt.app.study import is_study
@@ -19,7 +19,7 @@ SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
 
 def settle(n=20):
     for _ in range(n):
-        QtWidgets.QApplication.processEvents()
+        QtGui.QApplication.processEvents()
 
 
 def screenshot(name):
@@ -64,7 +64,7 @@ class Workbench(unittest.TestCase):
         commands = FreeCADGui.listCommands()
         for name in ("TopOpt_NewStudy", "TopOpt_Fixed", "TopOpt_Force", "TopOpt_Run", "TopOpt_ExportStl"):
             self.assertIn(name, commands)
-        toolbars = [t.windowTitle() for t in FreeCADGui.getMainWindow().findChildren(QtWidgets.QToolBar)
+        toolbars = [t.windowTitle() for t in FreeCADGui.getMainWindow().findChildren(QtGui.QToolBar)
                     if t.isVisible()]
         self.assertIn("Topology Optimization", toolbars)
 
@@ -86,7 +86,9 @@ class Workbench(unittest.TestCase):
         api.add_fixed(study, "Face9")
         api.add_force(study, "Face10", (0, -2000, 0))
         doc.recompute()
-        self.assertEqual(len(study.ViewObject.Proxy.claimChildren()), 2)
+        children = study.ViewObject.Proxy.claimChildren()
+        force = study.Constraints[1]
+        self.assertEqual(children, [study.Constraints[0], force, force.Direction[0]])  # the force's line after it
         self.assertIsNotNone(FreeCADGui.Control.activeDialog())
         FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
         FreeCADGui.SendMsgToActiveView("ViewFit")
@@ -107,8 +109,9 @@ class Workbench(unittest.TestCase):
         FreeCADGui.Selection.addSelection(study)
         FreeCADGui.runCommand("TopOpt_Mesh")
         settle()
-        domains = [o for o in doc.Objects if o.Name.startswith(study.Name + "_MeshDomain")]
+        domains = study.DomainMeshes
         self.assertEqual(len(domains), 4)  # design + 3 non-design solids
+        self.assertEqual(sum(o.FemMesh.VolumeCount for o in domains), len(study.MeshTets) // 4)
         part.Visibility = False
         for o in keeps:
             o.Visibility = False
@@ -120,17 +123,22 @@ class Workbench(unittest.TestCase):
         # Run from the panel, on its worker thread, and wait for it
         from topopt.gui.panels import open_study_panel
         panel = open_study_panel(study)
-        self.assertEqual(panel.mesher.currentText(), "auto")
-        self.assertEqual(panel.layers.value(), 0)  # layers across thin walls: off by default
-        panel.mesher.setCurrentText("native")  # the run takes the panel's choice
-        panel.start_run()
+        widgets = {b.prop: b.widget for b in panel.bindings}
+        self.assertEqual(widgets["Mesher"].currentText(), "auto")
+        self.assertEqual(widgets["WallLayers"].value(), 0)  # layers across thin walls: off by default
+        widgets["Mesher"].setCurrentText("native")  # the panel edits the study itself
         self.assertEqual(study.Mesher, "native")
+        study.VolumeFraction = 0.4  # the property editor's change shows in the panel
+        settle()
+        self.assertAlmostEqual(widgets["VolumeFraction"].value(), 0.4)
+        panel.start_run()
+        self.assertAlmostEqual(study.VolumeFraction, 0.4)  # Run does not write the panel over it
         self.assertFalse(panel.run_button.isEnabled())
         panel.wait(600)
         self.assertIsNotNone(study.Result, panel.status.text())
         self.assertTrue(study.Result.Mesh.isSolid())
         self.assertGreater(len(panel.plot.compliance), 1)  # the live plot got the iterations
-        self.assertIsNotNone(doc.getObject(study.Name + "_Density"))
+        self.assertIsNotNone(study.DensityView)
         FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
         FreeCADGui.SendMsgToActiveView("ViewFit")
         path = screenshot("workbench_result.png")
@@ -141,11 +149,79 @@ class Workbench(unittest.TestCase):
         panel.reextract()
         settle()
         self.assertGreater(study.Result.Mesh.Volume, before)
-        density = doc.getObject(study.Name + "_Density")
+        density = study.DensityView
         study.Result.Visibility = False
         density.Visibility = True
         screenshot("workbench_density.png")
-        FreeCADGui.Control.closeDialog()
+        panel.accept()
+
+    def test_a_document_made_without_the_gui_opens_grouped_and_coloured(self):
+        import subprocess
+        import tempfile
+        path = os.path.join(tempfile.mkdtemp(), "headless.FCStd")
+        script = os.path.join(os.path.dirname(path), "make.py")
+        with open(script, "w") as f:
+            f.write("""import os, sys
+sys.path.insert(0, %r)
+import helpers
+from topopt.app import api
+doc, study = helpers.box_study("Headless", iterations=4, mesh_size=4.0)
+api.run(study, verbose=False)
+api.save(doc, %r)
+os._exit(0)
+""" % (os.path.join(HERE, "..", "app"), path))
+        subprocess.run(["freecadcmd", "-c", "exec(open(%r).read())" % script], check=True, timeout=600,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        doc = FreeCAD.openDocument(path)
+        settle(40)
+        study = doc.getObject("TopOptStudy")
+        from topopt.gui.view_providers import ViewProviderStudy
+        self.assertIsInstance(study.ViewObject.Proxy, ViewProviderStudy)  # icon, tree, panel
+        self.assertIn(study.Result, study.ViewObject.Proxy.claimChildren())
+        self.assertTrue(study.Result.ViewObject.Coloring)
+        self.assertEqual(study.DensityView.ViewObject.Field, "Density")  # computed now, with the GUI
+        FreeCAD.closeDocument(doc.Name)
+
+    def test_cancel_takes_the_panels_edits_back(self):
+        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        doc, part, keeps = lever_document("GuiCancel")
+        doc.UndoMode = 1
+        study = api.new_study(doc, part, keeps, volume_fraction=0.35, mesh_size=4.0)
+        from topopt.gui.panels import open_study_panel
+        panel = open_study_panel(study)
+        widgets = {b.prop: b.widget for b in panel.bindings}
+        widgets["VolumeFraction"].setValue(0.6)
+        widgets["MeshSize"].setValue(7.0)
+        self.assertAlmostEqual(study.VolumeFraction, 0.6)
+        panel.reject()
+        self.assertAlmostEqual(study.VolumeFraction, 0.35)
+        self.assertAlmostEqual(float(study.MeshSize), 4.0)
+        panel = open_study_panel(study)
+        {b.prop: b.widget for b in panel.bindings}["VolumeFraction"].setValue(0.5)
+        panel.accept()
+        self.assertAlmostEqual(study.VolumeFraction, 0.5)
+        self.assertIn("Edit TopOpt study", doc.UndoNames)
+        doc.undo()
+        self.assertAlmostEqual(study.VolumeFraction, 0.35)
+
+    def test_icons_one_per_command_and_the_plot_legends_apart(self):
+        from topopt.gui import commands
+        icons = [cls().GetResources()["Pixmap"] for _, cls in commands.COMMANDS]
+        self.assertEqual(len(set(icons)), len(icons))
+        for path in icons:
+            self.assertTrue(os.path.isfile(path), path)
+        self.assertIn("Separator", commands.TOOLBARS[0][1])
+        from topopt.gui.plot import HistoryPlot
+        plot = HistoryPlot()
+        plot.resize(240, 180)
+        plot.set_history([120.0, 80.0, 61.5], [0.3, 0.3, 0.3])
+        metrics = QtGui.QFontMetrics(plot.font())
+        rect = plot.plot_rect(metrics, ["150"])
+        self.assertGreaterEqual(rect.top(), 2 * metrics.height())  # two legend lines above the axes
+        image = QtGui.QImage(240, 180, QtGui.QImage.Format_ARGB32)
+        plot.render(image)
+        os.makedirs(SHOTS, exist_ok=True)
+        image.save(os.path.join(SHOTS, "plot_240px.png"))
 
     def test_bad_selection_reports_and_does_not_crash(self):
         FreeCADGui.activateWorkbench("TopOptWorkbench")

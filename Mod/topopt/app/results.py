@@ -1,0 +1,290 @@
+"""A run's results as FreeCAD objects, all linked from the study (and shown under it):
+
+- Result: the smoothed result shape, a Mesh feature whose faces on non-design solids are
+  coloured apart (a FaceColors list the mesh view uses, so the colours come back on reopen);
+- AnalysisMesh: the tagged analysis mesh as a FEM mesh;
+- FemResult: the last SIMP iterate as a FEM mechanical result on that mesh (displacement,
+  von Mises stress): FEM's result panel and its post-processing work on it;
+- Fields: a FEM post-processing pipeline with the run's fields (Density and Displacement per
+  node, von Mises stress and Domain per tet), saved in the document;
+- DensityView: a scalar clip of Fields on Density at the result's threshold, coloured by
+  density with FEM's colour bar: where the material stays;
+- DomainMeshes: the Mesh command's FEM meshes, one per domain (refreshed by a run).
+
+A re-run updates these objects in place; nothing stale is left. Works headless (no view
+settings then) and with the GUI.
+"""
+import os
+import shutil
+import tempfile
+
+import FreeCAD
+import numpy as np
+
+from . import quiet, vtu
+
+def _rgb(r, g, b):
+    """A colour from 0–255 components: FreeCAD saves colours as 8-bit components, so these
+    come back from a saved document exactly as they were set."""
+    return (r / 255.0, g / 255.0, b / 255.0)
+
+
+#: colours of the domains: design first, then the non-design solids in order
+DOMAIN_COLOURS = [_rgb(191, 191, 199), _rgb(230, 115, 38), _rgb(51, 140, 230), _rgb(77, 179, 89),
+                  _rgb(217, 179, 51), _rgb(153, 89, 204), _rgb(51, 191, 191), _rgb(217, 115, 166)]
+#: the result shape's design part
+RESULT_COLOUR = _rgb(158, 184, 214)
+
+#: field names in the pipeline (units in the names: FEM's colour bar shows only numbers)
+DENSITY = "Density"
+DISPLACEMENT = "Displacement (mm)"
+VON_MISES = "von Mises stress (MPa)"
+DOMAIN = "Domain (0 design, k non-design solid k)"
+
+
+def domain_colour(d):
+    return DOMAIN_COLOURS[int(d) % len(DOMAIN_COLOURS)]
+
+
+def tet_volumes(nodes, tets):
+    """#T volumes (mm³) of the tets."""
+    a, b, c, d = (nodes[tets[:, k]] for k in range(4))
+    return np.abs(np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)) / 6.0
+
+
+def nodal_average(tets, values, count, weights):
+    """#V node values: the `weights`-weighted mean of the values of the tets around each node
+    (0 at nodes no tet uses)."""
+    total = np.zeros(count)
+    weight = np.zeros(count)
+    for k in range(4):
+        np.add.at(total, tets[:, k], values * weights)
+        np.add.at(weight, tets[:, k], weights)
+    return np.divide(total, weight, out=np.zeros(count), where=weight > 0)
+
+
+def kept_volume_fraction(nodes, tets, domain, densities, threshold):
+    """Share of the design domain's volume in tets whose density reaches `threshold` (what the
+    threshold slider shows before it re-extracts the shape)."""
+    vol = tet_volumes(nodes, tets)
+    design = domain == 0
+    total = vol[design].sum()
+    return float(vol[design & (densities >= threshold)].sum() / total) if total > 0 else 0.0
+
+
+def volume_threshold(nodes, tets, domain, densities, fraction):
+    """The density threshold at which the design tets at or above it hold `fraction` of the
+    design domain's volume (for documents of older versions that did not keep the run's)."""
+    vol = tet_volumes(nodes, tets)
+    design = domain == 0
+    order = np.argsort(-densities[design])
+    kept = np.cumsum(vol[design][order])
+    if len(kept) == 0 or kept[-1] <= 0:
+        return 0.5
+    k = min(len(kept) - 1, int(np.searchsorted(kept, fraction * kept[-1])))
+    return float(min(0.99, max(0.01, densities[design][order][k])))
+
+
+# --- FEM meshes ----------------------------------------------------------------------------
+
+def fem_mesh(nodes, tets, folder):
+    """A Fem.FemMesh of the tets (read from a .vtu written into `folder`)."""
+    import Fem
+    path = vtu.write_tets(os.path.join(folder, "mesh.vtu"), nodes, tets)
+    mesh = Fem.FemMesh()
+    mesh.read(path)
+    return mesh
+
+
+def _object(doc, study, link, kind, name, label, make=None):
+    """The object the study links as `link`, created (doc.addObject(kind) or make()) when
+    missing or of another kind, and labelled."""
+    obj = getattr(study, link, None)
+    if obj is None or obj.TypeId != kind:
+        obj = make() if make else doc.addObject(kind, study.Name + "_" + name)
+        setattr(study, link, obj)
+    obj.Label = label
+    return obj
+
+
+def show_domains(study, nodes, tets, domain):
+    """The study's DomainMeshes: one FEM mesh per domain (design first), coloured as the
+    domain, the design one half transparent. Existing ones are updated, extra ones removed."""
+    doc = study.Document
+    old = [o for o in study.DomainMeshes if o is not None]
+    made = []
+    folder = tempfile.mkdtemp(prefix="topopt-domains-")
+    try:
+        for i, d in enumerate(np.unique(domain)):
+            obj = old[i] if i < len(old) else doc.addObject("Fem::FemMeshObject", "%s_Domain%d" % (study.Name, d))
+            obj.Label = "%s mesh: %s" % (study.Label, "design" if d == 0 else "non-design %d" % d)
+            obj.FemMesh = fem_mesh(nodes, tets[domain == d], folder)
+            made.append(obj)
+            _style_domain(obj, int(d))
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    study.DomainMeshes = made
+    for obj in old[len(made):]:
+        doc.removeObject(obj.Name)
+    return made
+
+
+def _style_domain(obj, d):
+    vo = obj.ViewObject
+    if vo is None:
+        return
+    vo.ShapeColor = domain_colour(d)
+    vo.Transparency = 70 if d == 0 else 0  # the non-design solids show through the design domain
+    if "LineWidth" in vo.PropertiesList:
+        vo.LineWidth = 1.0
+    # the design domain with its elements' edges; the non-design solids (finely meshed around
+    # bores, where black edges would hide their colour) as coloured faces
+    mode = "Faces & Wireframe" if d == 0 else "Faces"
+    if mode in vo.getEnumerationsOfProperty("DisplayMode"):
+        vo.DisplayMode = mode
+
+
+# --- the result shape ----------------------------------------------------------------------
+
+def facet_domains(points, triangles, nodes, tets, domain, tags=None):
+    """#Q: for each triangle of the result shape, the non-design solid it lies on (k > 0) or 0.
+    `tags` (#Q, the core's surface_tags): -k marks a face of non-design solid k inside the
+    part. Elsewhere: non-design solids are kept whole and their points are never moved, so a
+    triangle whose three corners are nodes of non-design tets lies on that solid."""
+    nd = {}
+    for k in range(4):
+        for node, d in zip(tets[domain > 0, k], domain[domain > 0]):
+            nd.setdefault(nodes[node].tobytes(), int(d))
+    point_domain = np.array([nd.get(np.asarray(p, dtype=np.float64).tobytes(), 0) for p in points], dtype=np.int64)
+    corner = point_domain[np.asarray(triangles, dtype=np.int64)]
+    on_nd = (corner > 0).all(axis=1)
+    out = np.where(on_nd, corner[:, 0], 0)
+    if tags is not None:
+        tags = np.asarray(tags, dtype=np.int64)
+        out = np.where(tags < 0, -tags, out)
+    return out
+
+
+def colour_result(feature, facet_domain):
+    """Colours the result shape's faces: the design part RESULT_COLOUR, each non-design solid
+    its domain colour. Kept in the feature (FaceColors), so the colours come back on reopen."""
+    if "FaceColors" not in feature.PropertiesList:
+        feature.addProperty("App::PropertyColorList", "FaceColors", "TopOpt",
+                            "Colour of each face: non-design solids apart from the design")
+        feature.setEditorMode("FaceColors", 2)
+    feature.FaceColors = [RESULT_COLOUR if d == 0 else domain_colour(d) for d in facet_domain]
+
+
+def style_result(feature):
+    """With the GUI: the result shape smoothly shaded and coloured by its FaceColors. Call it
+    after the document's recompute (which redraws the mesh without its colours)."""
+    vo = feature.ViewObject
+    if vo is not None:
+        vo.CreaseAngle = 40.0  # smooth shading across the smoothed surface, sharp edges kept
+        vo.Coloring = False
+        vo.Coloring = True  # re-reads FaceColors
+
+
+# --- FEM result and fields -----------------------------------------------------------------
+
+def _fem_result(study, mesh_obj, nodes, displacement, von_mises_nodes):
+    import ObjectsFem
+    doc = study.Document
+    res = _object(doc, study, "FemResult", "Fem::FemResultObjectPython", "FemResult",
+                  "%s last iterate" % study.Label,
+                  lambda: ObjectsFem.makeResultMechanical(doc, study.Name + "_FemResult"))
+    res.Mesh = mesh_obj
+    res.NodeNumbers = list(range(1, len(nodes) + 1))
+    res.DisplacementVectors = [FreeCAD.Vector(*map(float, u)) for u in displacement]
+    res.DisplacementLengths = [float(x) for x in np.linalg.norm(displacement, axis=1)]
+    res.vonMises = [float(x) for x in von_mises_nodes]
+    from femresult import resulttools
+    resulttools.fill_femresult_stats(res)
+    return res
+
+
+def _fields(study, path, threshold):
+    import ObjectsFem
+    doc = study.Document
+    pipe = _object(doc, study, "Fields", "Fem::FemPostPipeline", "Fields", "%s fields" % study.Label)
+    pipe.read(path)
+    clip = study.DensityView
+    if clip is None or clip not in pipe.Filter:
+        clip = ObjectsFem.makePostVtkFilterClipScalar(doc, pipe)
+        study.DensityView = clip
+    clip.Label = "%s density" % study.Label
+    quiet.recompute(doc)
+    clip.Scalars = DENSITY
+    clip.Value = float(threshold)
+    clip.InsideOut = False
+    return pipe, clip
+
+
+def set_density_cut(study, threshold):
+    """Shows in DensityView the material whose density reaches `threshold`."""
+    clip = study.DensityView
+    if clip is not None:
+        clip.Value = float(threshold)
+
+
+def update_fem_objects(study, result, threshold):
+    """The run's FEM objects (AnalysisMesh, FemResult, Fields, DensityView) made or refreshed
+    from the worker's result dict (nodes, tets, domain, densities, and the last iterate's
+    displacement #V x 3 and von_mises #T). Returns the FEM result object."""
+    doc = study.Document
+    nodes = np.asarray(result["nodes"], dtype=np.float64)
+    tets = np.asarray(result["tets"], dtype=np.int64)
+    domain = np.asarray(result["domain"], dtype=np.int64)
+    densities = np.asarray(result["densities"], dtype=np.float64)
+    displacement = np.asarray(result.get("displacement", np.zeros((len(nodes), 3))), dtype=np.float64)
+    von_mises = np.asarray(result.get("von_mises", np.zeros(len(tets))), dtype=np.float64)
+    vol = tet_volumes(nodes, tets)
+    node_density = nodal_average(tets, densities, len(nodes), vol)
+    node_density[np.unique(tets[domain > 0])] = 1.0  # as the core does: non-design solids stay whole
+    folder = tempfile.mkdtemp(prefix="topopt-fields-")
+    try:
+        path = vtu.write_tets(os.path.join(folder, "fields.vtu"), nodes, tets,
+                              [(DENSITY, node_density), (DISPLACEMENT, displacement)],
+                              [(VON_MISES, von_mises), (DOMAIN, domain)])
+        import Fem
+        mesh = Fem.FemMesh()
+        mesh.read(path)
+        mesh_obj = _object(doc, study, "AnalysisMesh", "Fem::FemMeshObjectPython", "AnalysisMesh",
+                           "%s analysis mesh" % study.Label, lambda: _make_mesh_result(doc, study))
+        mesh_obj.FemMesh = mesh
+        res = _fem_result(study, mesh_obj, nodes, displacement, nodal_average(tets, von_mises, len(nodes), vol))
+        pipe, clip = _fields(study, path, threshold)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    _style_fem_objects(study)
+    return res
+
+
+def _make_mesh_result(doc, study):
+    import ObjectsFem
+    return ObjectsFem.makeMeshResult(doc, study.Name + "_AnalysisMesh")
+
+
+def _style_fem_objects(study):
+    """With the GUI: the FEM objects hidden except the density view (coloured by Density, shown
+    as a surface), which the user turns on next to the result shape."""
+    for name in ("AnalysisMesh", "FemResult", "Fields"):
+        obj = getattr(study, name, None)
+        if obj is not None and obj.ViewObject is not None:
+            obj.ViewObject.Visibility = False
+    clip = study.DensityView
+    if clip is not None and clip.ViewObject is not None:
+        style_density_view(clip)
+        clip.ViewObject.Visibility = False
+
+
+def style_density_view(clip):
+    """With the GUI: the density view as a surface coloured by Density (FEM's colour bar)."""
+    vo = clip.ViewObject
+    if vo is None:
+        return
+    if DENSITY not in vo.getEnumerationsOfProperty("Field"):
+        vo.DisplayMode = "Outline"  # FEM's view lists a filter's fields again when its display mode changes
+    vo.DisplayMode = "Surface"
+    if DENSITY in vo.getEnumerationsOfProperty("Field"):
+        vo.Field = DENSITY
