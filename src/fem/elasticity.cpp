@@ -30,8 +30,6 @@
 namespace topopt::fem {
 namespace {
 
-using SpMat = SparseLower;
-
 /// Local entry p of the 78 upper-triangle entries (i <= j) of a 12 by 12 element matrix.
 struct LocalPair {
   int i, j;
@@ -99,7 +97,7 @@ struct Elasticity::Impl {
   std::vector<double> prescribed;  // 3#V: prescribed value (0 where free)
   bool nonzero_prescribed = false;
 
-  SpMat K;                                // free-free, lower triangle
+  SparseLower K;                          // free-free, lower triangle
   std::vector<int> slot;                  // #T * 78: index into K's values, or -1
   std::vector<std::vector<int>> colours;  // element ids per colour
 
@@ -197,7 +195,7 @@ void Elasticity::Impl::build_pattern() {
   }
   const long nnz = static_cast<long>(inner.size());
   std::vector<double> zeros(nnz, 0.0);
-  K = Eigen::Map<const SpMat>(nf, nf, nnz, outer.data(), inner.data(), zeros.data());
+  K = Eigen::Map<const SparseLower>(nf, nf, nnz, outer.data(), inner.data(), zeros.data());
   K.makeCompressed();
   // Slots of the element entries.
   slot.assign(kPairs * nt, -1);

@@ -263,14 +263,14 @@ void add_element(MshContents& c, long type, int entity, const std::vector<int>& 
     int tag = ph.empty() ? entity : ph.front();
     c.tet_dom.push_back(std::max(0, tag - 1));
   } else if ((type == 2 || type == 9) && !ph.empty()) {
-    int face = 0, nd = 0;
+    int face = 0, nd_face = 0;
     for (int p : ph)
       if (p > kNonDesignFaceTag)
-        nd = p - kNonDesignFaceTag;
+        nd_face = p - kNonDesignFaceTag;
       else
         face = p;
     c.tris.push_back({v[0], v[1], v[2]});
-    c.tri_tags.emplace_back(face, nd);
+    c.tri_tags.emplace_back(face, nd_face);
   }
 }
 
