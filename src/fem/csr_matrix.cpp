@@ -9,44 +9,6 @@
 
 namespace topopt::fem {
 
-template <class Value>
-void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
-  const std::vector<int>& ptr = M.ptr;
-  const std::vector<int>& col = M.col;
-  if (M.blocks.empty()) {
-    parallel_for(
-        M.rows, threads,
-        [&](long b, long e) {
-          for (long i = b; i < e; ++i) {
-            double s = 0;
-            for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
-            y[i] = s;
-          }
-        },
-        4096);
-    return;
-  }
-  const long nb = static_cast<long>(M.blocks.size()) - 1;
-  parallel_for(
-      nb, threads,
-      [&](long bb, long be) {
-        for (long blk = bb; blk < be; ++blk) {
-          const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
-          const int* c = &col[ptr[r0]];
-          for (int r = 0; r < nr; ++r) {
-            const Value* v = &val[ptr[r0 + r]];
-            double acc = 0;
-            for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
-            y[r0 + r] = acc;
-          }
-        }
-      },
-      1024);
-}
-
-template void sparse_product<double>(const CsrMatrix&, const double*, const double*, double*, int);
-template void sparse_product<float>(const CsrMatrix&, const float*, const double*, double*, int);
-
 void CsrMatrix::multiply(const double* x, double* y, int threads) const {
   sparse_product(*this, val.data(), x, y, threads);
 }

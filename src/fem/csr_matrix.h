@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "common/parallel.h"
+
 #include "fem/pcg.h"
 
 namespace topopt::fem {
@@ -30,9 +32,41 @@ struct CsrMatrix {
 
 /// y = M x with M's pattern and the values `val` (M.nonzeros() of them: M.val itself, or a
 /// single-precision copy: the products are memory-bound, and 4-byte values cut the bytes read
-/// by a third). x: M.cols, y: M.rows. Instantiated for double and float.
+/// by a third). x: M.cols, y: M.rows.
 template <class Value>
-void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads);
+void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
+  const std::vector<int>& ptr = M.ptr;
+  const std::vector<int>& col = M.col;
+  if (M.blocks.empty()) {
+    parallel_for(
+        M.rows, threads,
+        [&](long b, long e) {
+          for (long i = b; i < e; ++i) {
+            double s = 0;
+            for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
+            y[i] = s;
+          }
+        },
+        4096);
+    return;
+  }
+  const long nb = static_cast<long>(M.blocks.size()) - 1;
+  parallel_for(
+      nb, threads,
+      [&](long bb, long be) {
+        for (long blk = bb; blk < be; ++blk) {
+          const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
+          const int* c = &col[ptr[r0]];
+          for (int r = 0; r < nr; ++r) {
+            const Value* v = &val[ptr[r0 + r]];
+            double acc = 0;
+            for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
+            y[r0 + r] = acc;
+          }
+        }
+      },
+      1024);
+}
 
 /// C = A B (A.cols == B.rows), on `threads` threads. With row blocks in A, the rows of a block
 /// are formed together and C inherits A's blocks.
