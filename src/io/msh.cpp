@@ -171,10 +171,11 @@ class Tokens {
     pos_ = end - text_.c_str();
     return v;
   }
-  /// Skips to the line after `marker`.
-  void skip_section(const std::string& end_marker) {
+  /// Skips to the line after `end_marker`; `name` says which section in a message (the
+  /// marker of a section we do not know came from the file and is not repeated).
+  void skip_section(const std::string& end_marker, const std::string& name) {
     size_t e = text_.find(end_marker, pos_);
-    if (e == std::string::npos) fail("missing " + end_marker);
+    if (e == std::string::npos) fail(name + " has no end line");
     pos_ = e + end_marker.size();
   }
   [[noreturn]] void fail(const std::string& what) const {
@@ -211,9 +212,13 @@ void read_format(Tokens& in) {
   std::string version = in.word();
   long binary = in.integer();
   in.integer();
-  if (version.rfind("4", 0) != 0) in.fail("MSH version " + version + " is not supported; save as 4.1");
+  if (version.rfind("4", 0) != 0) {
+    const bool looks_like_a_version =
+        version.size() <= 8 && version.find_first_not_of("0123456789.") == std::string::npos;
+    in.fail("MSH version " + (looks_like_a_version ? version + " " : std::string()) + "is not supported; save as 4.1");
+  }
   if (binary) in.fail("binary MSH is not supported; save as ASCII");
-  in.skip_section("$EndMeshFormat");
+  in.skip_section("$EndMeshFormat", "$MeshFormat");
 }
 
 /// $Entities: the physical tags of every point, curve, surface and volume entity.
@@ -230,7 +235,7 @@ void read_entities(Tokens& in, MshContents& c) {
       long nb = in.integer();  // bounding entities
       for (long k = 0; k < nb; ++k) in.integer();
     }
-  in.skip_section("$EndEntities");
+  in.skip_section("$EndEntities", "$Entities");
 }
 
 /// $Nodes: coordinates by node tag (parametric coordinates skipped).
@@ -252,7 +257,7 @@ void read_nodes(Tokens& in, MshContents& c) {
       c.nodes.push_back(x);
     }
   }
-  in.skip_section("$EndNodes");
+  in.skip_section("$EndNodes", "$Nodes");
 }
 
 /// One element of $Elements: a (linear or quadratic) tet gets its block's domain, a tagged
@@ -294,7 +299,7 @@ void read_elements(Tokens& in, MshContents& c) {
       add_element(c, type, entity, ph, v);
     }
   }
-  in.skip_section("$EndElements");
+  in.skip_section("$EndElements", "$Elements");
 }
 
 /// The index of the node with `tag`; throws Error(Io) if the file does not define it.
@@ -365,9 +370,10 @@ TetMesh read_msh(const std::string& path) {
     } else if (sec == "$Elements") {
       read_elements(in, c);
     } else if (!sec.empty() && sec[0] == '$') {
-      in.skip_section("$End" + sec.substr(1));
+      in.skip_section("$End" + sec.substr(1), "a section this reader skips");
     } else {
-      in.fail("unexpected '" + sec + "'");
+      // the text itself is not repeated: the file may be anything readable (mesh.file)
+      in.fail("text outside a $Section");
     }
   }
   if (!saw_format) in.fail("no $MeshFormat section");

@@ -104,6 +104,24 @@ TEST(Msh, MalformedFilesAreReportedWithTheLine) {
   fs::remove(p);
 }
 
+TEST(Msh, ErrorsNeverRepeatTheFilesText) {
+  // mesh.file may name any readable file: its content must not come back in a message
+  fs::path p = temp("plain.txt");
+  for (const std::string text : {"root:x:0:0:secret-token\n", "$SecretSection-token\nmore\n",
+                                 "$MeshFormat\nsecret-token 0 8\n$EndMeshFormat\n"}) {
+    std::ofstream(p) << text;
+    try {
+      read_msh(p.string());
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Io);
+      EXPECT_EQ(std::string(e.what()).find("token"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("MSH"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove(p);
+}
+
 TEST(Vtu, IsWellFormedXmlWithTheFields) {
   TetMesh m = sample();
   fs::path p = temp("r.vtu");
