@@ -10,7 +10,6 @@
 #include <unordered_map>
 #include <vector>
 
-#include "common/adjacency.h"
 #include "common/error.h"
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
@@ -261,15 +260,30 @@ class Front {
 
 double tet_rho(const std::vector<Vec3>& P, int a, int b, int c, int d) { return radius_ratio(P[a], P[b], P[c], P[d]); }
 
-/// The tets around each node (row v: the tets of node v, in tet order). Removed tets (first
-/// index < 0) are left out.
-Adjacency node_stars(size_t nodes, const std::vector<std::array<int, 4>>& tets) {
-  return group_pairs(static_cast<int>(nodes), [&tets](auto emit) {
+/// The tets around each node as one flat array (CSR): tets of node v are
+/// items[start[v] .. start[v + 1]). Removed tets (first index < 0) are left out.
+struct NodeStars {
+  std::vector<int> start, items;
+  NodeStars(size_t nodes, const std::vector<std::array<int, 4>>& tets) : start(nodes + 1, 0) {
+    for (const auto& t : tets)
+      if (t[0] >= 0)
+        for (int x : t) ++start[x + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    items.resize(start.back());
+    std::vector<int> fill(start.begin(), start.end() - 1);
     for (size_t t = 0; t < tets.size(); ++t)
       if (tets[t][0] >= 0)
-        for (int x : tets[t]) emit(x, static_cast<int>(t));
-  });
-}
+        for (int x : tets[t]) items[fill[x]++] = static_cast<int>(t);
+  }
+  const int* begin(int v) const { return items.data() + start[v]; }
+  const int* end(int v) const { return items.data() + start[v + 1]; }
+  struct Range {
+    const int *b, *e;
+    const int* begin() const { return b; }
+    const int* end() const { return e; }
+  };
+  Range of(int v) const { return {begin(v), end(v)}; }
+};
 
 /// Flips among the new tets (the input's tets and boundary are never touched: a face is only
 /// flipped when two new tets share it, an edge only when exactly three new tets close a ring
@@ -289,7 +303,7 @@ long flip_bad_tets(const std::vector<Vec3>& P, std::vector<std::array<int, 4>>& 
   for (int sweep = 0; sweep < 4; ++sweep) {
     long here = 0;
     // node stars (CSR): the tets around an edge or a face are found by filtering a star
-    const Adjacency stars = node_stars(P.size(), tets);
+    const NodeStars stars(P.size(), tets);
     auto has = [&](int t, int x) {
       const auto& v = tets[t];
       return v[0] == x || v[1] == x || v[2] == x || v[3] == x;
@@ -467,14 +481,14 @@ double compass_maximise(Vec3& x, double step, int iterations, F&& f) {
 /// position that maximises the worst radius ratio around each (steps of a tenth of the local
 /// edge length, halved when no direction helps); every tet stays positive.
 void compass_search_at_bad_tets(std::vector<Vec3>& P, const std::vector<std::array<int, 4>>& tets,
-                                const Adjacency& stars, int first_new, double bad) {
+                                const NodeStars& stars, int first_new, double bad) {
   std::vector<char> seen(P.size(), 0);
   for (size_t t = 0; t < tets.size(); ++t) {
     if (tet_rho(P, tets[t][0], tets[t][1], tets[t][2], tets[t][3]) >= bad) continue;
     for (int v : tets[t]) {
       if (v < first_new || seen[v]) continue;
       seen[v] = 1;
-      const Adjacency::Row ts = stars.row(v);
+      const NodeStars::Range ts = stars.of(v);
       auto worst_around = [&]() {
         double w = 1;
         for (int q : ts) {
@@ -511,7 +525,7 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<std::array<int, 
   long done = 0;
   auto rho = [&](const std::array<int, 4>& t) { return tet_rho(P, t[0], t[1], t[2], t[3]); };
   for (int sweep = 0; sweep < 3; ++sweep) {
-    const Adjacency stars = node_stars(P.size(), tets);
+    const NodeStars stars(P.size(), tets);
     std::vector<char> locked(P.size(), 0), gone(tets.size(), 0);
     std::vector<std::array<int, 4>> added;
     const size_t n0 = tets.size();
@@ -835,7 +849,7 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     if (round > 0) {
       // the new tets around the stuck front's nodes, widened by one ring of nodes every third
       // round, go back to the front
-      const Adjacency stars = node_stars(P.size(), tets);
+      const NodeStars stars(P.size(), tets);
       std::vector<char> in_region(P.size(), 0);
       std::vector<int> region;
       for (size_t id = 0; id < front.capacity(); ++id)
@@ -1204,10 +1218,10 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     // node smoothing of the new nodes: move to the neighbours' centroid when that improves the
     // worst radius ratio around the node and keeps every tet positive
     if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
-      const Adjacency stars = node_stars(P.size(), tets);
+      const NodeStars stars(P.size(), tets);
       for (int it = 0; it < params.smoothing_iterations; ++it)
         for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
-          const Adjacency::Row ts = stars.row(v);
+          const NodeStars::Range ts = stars.of(v);
           Vec3 sum = Vec3::Zero();
           int n = 0;
           double worst = 1;
@@ -1240,7 +1254,7 @@ VolumeFillResult fill(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const 
     if (insert_points_at_slivers(P, tets, params.sliver_below) == 0) break;
     if (params.flip_below > 0) {
       flip_bad_tets(P, tets, params.sliver_below);
-      compass_search_at_bad_tets(P, tets, node_stars(P.size(), tets), first_new, params.sliver_below);
+      compass_search_at_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.sliver_below);
     }
   }
   // Output: the input nodes as they were, then only the new nodes some tet uses (tets removed
