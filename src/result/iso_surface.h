@@ -34,17 +34,9 @@ struct TriSurface {
 };
 
 /// Marching tetrahedra at `threshold` on the node densities (#V). Returns the closed
-/// boundary of the kept region: iso-triangles in design tets, Ω's boundary triangles (or
-/// their kept parts) with their face tags, non-design tets' boundary triangles on Ω.
+/// boundary of the kept region (common/closed_surface.h checks it): iso-triangles in design
+/// tets, Ω's boundary triangles (or their kept parts) with their face tags, non-design tets'
+/// boundary triangles on Ω, and the void side of faces between design and non-design tets.
 TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold);
-
-/// Checks of a triangle surface: every edge used by exactly two triangles in opposite
-/// directions (closed, manifold, consistently oriented).
-struct SurfaceCheck {
-  long open_edges = 0, overshared_edges = 0, misoriented_edges = 0;
-  double volume = 0;  ///< enclosed volume (divergence theorem), > 0 when oriented outwards
-  bool closed_manifold() const { return open_edges == 0 && overshared_edges == 0 && misoriented_edges == 0; }
-};
-SurfaceCheck check_surface(const MatX3d& V, const MatX3i& F);
 
 }  // namespace topopt::result

@@ -34,6 +34,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/closed_surface.h"
 #include "common/error.h"
 #include "common/parallel.h"
 #include "mesh/core/predicates.h"
@@ -1142,17 +1143,7 @@ MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh,
   return out;
 }
 
-long open_edges(const MatX3i& T) {
-  std::map<std::pair<int, int>, int> directed;
-  for (long t = 0; t < T.rows(); ++t)
-    for (int k = 0; k < 3; ++k) ++directed[{T(t, k), T(t, (k + 1) % 3)}];
-  long open = 0;
-  for (const auto& [e, n] : directed) {
-    auto rev = directed.find({e.second, e.first});
-    if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
-  }
-  return open;
-}
+long open_edges(const MatX3i& T) { return check_surface(T).unpaired_edges; }
 
 std::vector<long> open_edges_per_solid(const brep::TopologyIndex& topo, const SurfaceMesh& mesh) {
   std::vector<long> result;

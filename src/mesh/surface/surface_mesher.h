@@ -176,8 +176,9 @@ class ModelSurface {
   std::vector<std::string> reasons_;
 };
 
-/// The number of edges of the triangles T (#T by 3) not used exactly twice in opposite
-/// directions (0 for a closed, consistently oriented surface).
+/// The number of directed edges of the triangles T (#T by 3) not used exactly once each way
+/// (0 for a closed, consistently oriented surface): check_surface(T).unpaired_edges of
+/// common/closed_surface.h, under the name the 14 steps use.
 long open_edges(const MatX3i& T);
 
 /// Per solid of `topo`: the number of mesh edges not used exactly twice in opposite directions
