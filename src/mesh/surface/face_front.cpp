@@ -495,7 +495,7 @@ void delaunay_flips(MatX3i& T, const std::vector<double>& xy, const std::unorder
 /// worst quality there does not drop. `iterations` sweeps.
 void smooth_new_nodes(const MatX3i& T, std::vector<double>& xy, int first, int iterations) {
   const int ntot = static_cast<int>(xy.size() / 2);
-  const brep::Adjacency star = triangle_stars(T, T.rows(), ntot);
+  const TriangleStars star = triangle_stars(T, T.rows(), ntot);
   auto worst = [&](int n) {  // the worst quality around n, -1 if a triangle is inverted
     double w = 1e300;
     for (const int* t = star.begin(n); t != star.end(n); ++t) {

@@ -8,47 +8,43 @@ namespace topopt::mesh {
 
 // ============================================================================ PointSizeField
 
-PointSizeField::PointSizeField(std::vector<std::array<double, 3>> pts, double h, double grade)
-    : pts_(std::move(pts)), grade_(grade) {
-  if (pts_.empty()) return;
+namespace {
+
+/// (h − the smallest size) / grade: beyond it from every point the field is h.
+double reach_of(const std::vector<std::array<double, 3>>& pts, double h, double grade) {
+  if (pts.empty()) return 0;
   double smin = h;
-  lo_[0] = hi_[0] = pts_[0][0], lo_[1] = hi_[1] = pts_[0][1];
-  for (const auto& p : pts_) {
-    smin = std::min(smin, p[2]);
-    lo_[0] = std::min(lo_[0], p[0]), hi_[0] = std::max(hi_[0], p[0]);
-    lo_[1] = std::min(lo_[1], p[1]), hi_[1] = std::max(hi_[1], p[1]);
+  for (const auto& p : pts) smin = std::min(smin, p[2]);
+  return (h - smin) / grade;
+}
+
+}  // namespace
+
+PointSizeField::PointSizeField(std::vector<std::array<double, 3>> pts, double h, double grade)
+    : pts_(std::move(pts)), grade_(grade), reach_(reach_of(pts_, h, grade)), grid_(index(pts_, reach_)) {}
+
+// The points in a grid with cells of half the reach (at most 512 across the points' box).
+SpatialGrid<2> PointSizeField::index(const std::vector<std::array<double, 3>>& pts, double reach) {
+  double lo[2] = {0, 0}, hi[2] = {0, 0};
+  if (!pts.empty()) lo[0] = hi[0] = pts[0][0], lo[1] = hi[1] = pts[0][1];
+  for (const auto& p : pts) {
+    lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]);
+    lo[1] = std::min(lo[1], p[1]), hi[1] = std::max(hi[1], p[1]);
   }
-  reach_ = (h - smin) / grade_;
-  cell_ = std::max({reach_ / 2, (hi_[0] - lo_[0]) / 512, (hi_[1] - lo_[1]) / 512, 1e-300});
-  nx_ = static_cast<long>((hi_[0] - lo_[0]) / cell_) + 1, ny_ = static_cast<long>((hi_[1] - lo_[1]) / cell_) + 1;
-  start_.assign(nx_ * ny_ + 1, 0);
-  for (const auto& p : pts_) ++start_[cell(p.data()) + 1];
-  for (size_t i = 1; i < start_.size(); ++i) start_[i] += start_[i - 1];
-  items_.resize(pts_.size());
-  std::vector<long> fill(start_.begin(), start_.end() - 1);
-  for (size_t i = 0; i < pts_.size(); ++i) items_[fill[cell(pts_[i].data())]++] = static_cast<int>(i);
+  SpatialGrid<2> grid(lo, std::max({reach / 2, (hi[0] - lo[0]) / 512, (hi[1] - lo[1]) / 512, 1e-300}));
+  for (size_t i = 0; i < pts.size(); ++i) grid.insert(static_cast<int>(i), pts[i].data(), pts[i].data());
+  return grid;
 }
 
 double PointSizeField::size_at(const double* q, double h) const {
   if (pts_.empty()) return h;
   double s = h;
-  const long i0 = std::max(0L, static_cast<long>(std::floor((q[0] - reach_ - lo_[0]) / cell_)));
-  const long i1 = std::min(nx_ - 1, static_cast<long>(std::floor((q[0] + reach_ - lo_[0]) / cell_)));
-  const long j0 = std::max(0L, static_cast<long>(std::floor((q[1] - reach_ - lo_[1]) / cell_)));
-  const long j1 = std::min(ny_ - 1, static_cast<long>(std::floor((q[1] + reach_ - lo_[1]) / cell_)));
-  for (long i = i0; i <= i1; ++i)
-    for (long j = j0; j <= j1; ++j) {
-      const long c = i * ny_ + j;
-      for (long k = start_[c]; k < start_[c + 1]; ++k) {
-        const auto& p = pts_[items_[k]];
-        s = std::min(s, p[2] + grade_ * std::hypot(q[0] - p[0], q[1] - p[1]));
-      }
-    }
+  const double lo[2] = {q[0] - reach_, q[1] - reach_}, hi[2] = {q[0] + reach_, q[1] + reach_};
+  grid_.for_each(lo, hi, [&](int i) {
+    const auto& p = pts_[i];
+    s = std::min(s, p[2] + grade_ * std::hypot(q[0] - p[0], q[1] - p[1]));
+  });
   return s;
-}
-
-long PointSizeField::cell(const double* p) const {
-  return static_cast<long>((p[0] - lo_[0]) / cell_) * ny_ + static_cast<long>((p[1] - lo_[1]) / cell_);
 }
 
 // ============================================================================ SizeRaster

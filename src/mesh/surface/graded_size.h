@@ -7,10 +7,13 @@
 #include <array>
 #include <vector>
 
+#include "mesh/core/spatial_grid.h"
+
 namespace topopt::mesh {
 
-/// The exact field min(h, s_i + grade·|q − p_i|), the points looked up in a uniform grid whose
-/// cells cover the reach of a point (where s_i + grade·d reaches the largest size h).
+/// The exact field min(h, s_i + grade·|q − p_i|), the points looked up in a SpatialGrid
+/// (mesh/core/spatial_grid.h) whose cells are half the reach of a point (where s_i + grade·d
+/// reaches the largest size h), so a query visits about 5 x 5 cells.
 class PointSizeField {
  public:
   /// pts: (u, v, s) per point, s > 0; h: the size with no point near (the field's cap);
@@ -21,12 +24,10 @@ class PointSizeField {
   double size_at(const double* q, double h) const;
 
  private:
-  long cell(const double* p) const;
+  static SpatialGrid<2> index(const std::vector<std::array<double, 3>>& pts, double reach);
   std::vector<std::array<double, 3>> pts_;
-  double grade_, reach_ = 0, cell_ = 1, lo_[2] = {0, 0}, hi_[2] = {0, 0};
-  long nx_ = 0, ny_ = 0;
-  std::vector<long> start_;
-  std::vector<int> items_;
+  double grade_, reach_;
+  SpatialGrid<2> grid_;
 };
 
 /// The same field on a grid: min(cap, s_i + grade·distance) by a chamfer transform (two

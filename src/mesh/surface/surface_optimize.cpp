@@ -53,7 +53,7 @@ bool faces_out(const MatX3d& X, const MatX3d& N, int a, int b, int c) {
 }
 
 /// The nodes sharing a triangle with v (sorted, once each).
-void neighbours(const MatX3i& T, const brep::Adjacency& star, int v, std::vector<int>& out) {
+void neighbours(const MatX3i& T, const TriangleStars& star, int v, std::vector<int>& out) {
   out.clear();
   for (const int* t = star.begin(v); t != star.end(v); ++t)
     for (int j = 0; j < 3; ++j)
@@ -177,7 +177,7 @@ bool SurfaceOptimizer::try_flip(uint64_t key, int t0, int t1) {
 
 long SurfaceOptimizer::smooth_nodes() {
   long moves = 0;
-  const brep::Adjacency star = triangle_stars(T_, nt_, n_);
+  const TriangleStars star = triangle_stars(T_, nt_, n_);
   std::vector<int> nbr;
   for (long i = fixed_; i < n_; ++i)
     if (star.size(static_cast<int>(i)) > 0) moves += smooth_node(i, star, nbr);
@@ -186,7 +186,7 @@ long SurfaceOptimizer::smooth_nodes() {
 
 // Node i towards the centre of its neighbours, kept at the first of the steps 1, 1/2, 1/4
 // where its star stays valid and gets better.
-bool SurfaceOptimizer::smooth_node(long i, const brep::Adjacency& star, std::vector<int>& nbr) {
+bool SurfaceOptimizer::smooth_node(long i, const TriangleStars& star, std::vector<int>& nbr) {
   const int* s0 = star.begin(static_cast<int>(i));
   const int* s1 = star.end(static_cast<int>(i));
   neighbours(T_, star, static_cast<int>(i), nbr);
@@ -261,7 +261,7 @@ double SurfaceOptimizer::compass_node(int i, const int* begin, const int* end, b
 // lift a triangle that leans on a boundary segment, the compass search can.
 long SurfaceOptimizer::compass_search_nodes() {
   long moves = 0;
-  const brep::Adjacency star = triangle_stars(T_, nt_, n_);
+  const TriangleStars star = triangle_stars(T_, nt_, n_);
   for (long t = 0; t < nt_; ++t) {
     if (triangle_angle(t) >= 40) continue;
     for (int k = 0; k < 3; ++k) {
@@ -278,7 +278,7 @@ long SurfaceOptimizer::compass_search_nodes() {
 // ------------------------------------------------------------------ collapses
 
 long SurfaceOptimizer::collapse_edges() {
-  const brep::Adjacency star = triangle_stars(T_, nt_, n_, dead_);
+  const TriangleStars star = triangle_stars(T_, nt_, n_, dead_);
   busy_.assign(n_, 0);
   std::vector<int> around;
   long done = 0;
@@ -293,7 +293,7 @@ long SurfaceOptimizer::collapse_edges() {
 // meet); below kBadAngle each of its edges, then each movable corner onto each of its
 // neighbours, nearest first (a node squeezed against a boundary segment makes a flat cap that
 // no move or flip can open). Stops at the first kept.
-bool SurfaceOptimizer::collapse_around(int t0, const brep::Adjacency& star, std::vector<int>& around) {
+bool SurfaceOptimizer::collapse_around(int t0, const TriangleStars& star, std::vector<int>& around) {
   double l[3];
   for (int k = 0; k < 3; ++k) l[k] = (X_.row(T_(t0, k)) - X_.row(T_(t0, (k + 1) % 3))).norm();
   int order[3] = {0, 1, 2};
@@ -321,7 +321,7 @@ bool SurfaceOptimizer::collapse_around(int t0, const brep::Adjacency& star, std:
 // middle when both may move), kept only if every triangle stays valid in the parameters and
 // the smallest angle of the region rises by a clear gain: 1° (or a quarter of the angle where
 // it is tiny: a node of a sliver face's corner fan, 0.86° -> 1.73°).
-bool SurfaceOptimizer::try_collapse(int a, int b, const brep::Adjacency& star) {
+bool SurfaceOptimizer::try_collapse(int a, int b, const TriangleStars& star) {
   // b goes: a node that may move and is not an apex's neighbour if there is one; an apex's
   // neighbour may go too (its locked edges pass to a), unless the edge ab itself is locked
   if (keep_node_[b] || (pinned_[b] && !pinned_[a] && !keep_node_[a])) std::swap(a, b);
@@ -361,7 +361,7 @@ bool SurfaceOptimizer::try_collapse(int a, int b, const brep::Adjacency& star) {
 // Whether b may go onto a: b may move, neither is busy in this sweep, a locked edge ab keeps
 // an apex's neighbour b, and the link condition holds (a and b share exactly the two apexes
 // of the edge's triangles). Leaves their neighbours in collapse_.na and .nb.
-bool SurfaceOptimizer::collapse_allowed(int a, int b, const brep::Adjacency& star) {
+bool SurfaceOptimizer::collapse_allowed(int a, int b, const TriangleStars& star) {
   if (keep_node_[b] || busy_[a] || busy_[b] || a == b) return false;
   if (pinned_[b] && locked_.count(ekey(a, b))) return false;
   std::vector<int>&na = collapse_.na, &nb = collapse_.nb;

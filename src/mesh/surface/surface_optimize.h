@@ -30,10 +30,7 @@
 #include <vector>
 
 #include "common/types.h"
-
-namespace topopt::brep {
-struct Adjacency;
-}
+#include "mesh/surface/triangle_stars.h"
 
 namespace topopt::mesh {
 
@@ -103,11 +100,11 @@ class SurfaceOptimizer {
   double worst_of(const int* begin, const int* end) const;
   EdgeTriangles edge_triangles() const;
   bool try_flip(uint64_t key, int t0, int t1);
-  bool smooth_node(long i, const brep::Adjacency& star, std::vector<int>& nbr);
+  bool smooth_node(long i, const TriangleStars& star, std::vector<int>& nbr);
   double compass_node(int i, const int* begin, const int* end, bool& moved);
-  bool collapse_around(int t0, const brep::Adjacency& star, std::vector<int>& around);
-  bool try_collapse(int a, int b, const brep::Adjacency& star);
-  bool collapse_allowed(int a, int b, const brep::Adjacency& star);
+  bool collapse_around(int t0, const TriangleStars& star, std::vector<int>& around);
+  bool try_collapse(int a, int b, const TriangleStars& star);
+  bool collapse_allowed(int a, int b, const TriangleStars& star);
   double place_survivor(int a, const Eigen::RowVector2d& pa, const Eigen::RowVector2d& pb);
   void undo_collapse(int a, const NodeState& old_a);
   void commit_collapse(int a, int b);

@@ -3,8 +3,8 @@
 
 namespace topopt::mesh {
 
-brep::Adjacency triangle_stars(const MatX3i& T, long nt, long nodes, const std::vector<char>& dead) {
-  brep::Adjacency star;
+TriangleStars triangle_stars(const MatX3i& T, long nt, long nodes, const std::vector<char>& dead) {
+  TriangleStars star;
   star.offset.assign(nodes + 1, 0);
   auto alive = [&](long t) { return dead.empty() || !dead[t]; };
   for (long t = 0; t < nt; ++t)
