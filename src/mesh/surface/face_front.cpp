@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "mesh/core/predicates.h"
+#include "mesh/core/spatial_grid.h"
 #include "mesh/surface/triangle_stars.h"
 
 namespace topopt::mesh {
@@ -35,13 +36,13 @@ double quality(const double* a, const double* b, const double* c) {
 // ============================================================================ the container
 
 /// The face front: directed edges (unmeshed region on the left), their lookup by (a, b), the
-/// nodes that can still take triangles, and uniform grids over both for the searches.
+/// nodes that can still take triangles, and a spatial grid over each (mesh/core/spatial_grid.h)
+/// for the searches.
 class FaceFront {
  public:
-  FaceFront(std::vector<double>& xy, double cell, const double* lo) : xy_(xy), cell_(cell) {
-    lo_[0] = lo[0];
-    lo_[1] = lo[1];
-  }
+  /// xy: the nodes' (u, v), which add_node extends; cell: the grids' finest cells; lo: their
+  /// origin.
+  FaceFront(std::vector<double>& xy, double cell, const double* lo) : xy_(xy), nodes_(lo, cell), edges_(lo, cell) {}
   const double* p(int n) const { return &xy_[2 * n]; }
   int add_node(const double* q) {
     xy_.push_back(q[0]);
@@ -49,12 +50,12 @@ class FaceFront {
     const int n = static_cast<int>(xy_.size() / 2) - 1;
     degree_.push_back(0);
     pending_.push_back(0);
-    node_cells_[cell_of(q)].push_back(n);
+    nodes_.insert(n, q, q);
     return n;
   }
   void register_existing(int n) {
     if (static_cast<int>(degree_.size()) <= n) degree_.resize(n + 1, 0), pending_.resize(n + 1, 0);
-    node_cells_[cell_of(p(n))].push_back(n);
+    nodes_.insert(n, p(n), p(n));
   }
   void set_pending(int n) { pending_[n] = 1; }
   void clear_pending(int n) { pending_[n] = 0; }
@@ -74,13 +75,10 @@ class FaceFront {
     lookup_[edge_key(a, b)] = id;
     ++degree_[a];
     ++degree_[b];
-    // in every cell its bounding box overlaps, so searches need not widen by the longest edge
-    const long i0 = cell_index(std::min(p(a)[0], p(b)[0]) - lo_[0]),
-               i1 = cell_index(std::max(p(a)[0], p(b)[0]) - lo_[0]);
-    const long j0 = cell_index(std::min(p(a)[1], p(b)[1]) - lo_[1]),
-               j1 = cell_index(std::max(p(a)[1], p(b)[1]) - lo_[1]);
-    for (long i = i0; i <= i1; ++i)
-      for (long j = j0; j <= j1; ++j) edge_cells_[cell_key(i, j)].push_back(id);
+    // by its bounding box, so searches need not widen by the longest edge
+    const double lo[2] = {std::min(p(a)[0], p(b)[0]), std::min(p(a)[1], p(b)[1])};
+    const double hi[2] = {std::max(p(a)[0], p(b)[0]), std::max(p(a)[1], p(b)[1])};
+    edges_.insert(id, lo, hi);
     ++alive_count_;
     return id;
   }
@@ -98,52 +96,32 @@ class FaceFront {
   int fails(int id) const { return fails_[id]; }
   long alive_count() const { return alive_count_; }
 
-  /// Calls fn(node) for nodes in grid cells within distance r of q (a superset).
+  /// Calls fn(node) for the nodes (active or not) in the box of half-side r around q and
+  /// maybe a few more (a superset).
   template <class Fn>
   void nodes_near(const double* q, double r, Fn&& fn) const {
-    visit(node_cells_, q, r, fn);
+    const double lo[2] = {q[0] - r, q[1] - r}, hi[2] = {q[0] + r, q[1] + r};
+    nodes_.for_each(lo, hi, fn);
   }
-  /// Calls fn(edge) for alive edges that pass through cells within r of q (an edge may come
-  /// more than once).
+  /// Calls fn(edge) once for each alive edge whose box meets the box of half-side r around q,
+  /// and maybe a few more (a superset); dead edges met leave the grid.
   template <class Fn>
-  void edges_near(const double* q, double r, Fn&& fn) const {
-    visit(edge_cells_, q, r, [&](int e) {
-      if (alive_[e]) fn(e);
-    });
+  void edges_near(const double* q, double r, Fn&& fn) {
+    const double lo[2] = {q[0] - r, q[1] - r}, hi[2] = {q[0] + r, q[1] + r};
+    found_.clear();
+    edges_.query(lo, hi, found_, [&](int e) { return alive_[e] != 0; });
+    for (int e : found_) fn(e);
   }
 
  private:
-  using Cells = std::unordered_map<uint64_t, std::vector<int>>;
-  uint64_t cell_key(long i, long j) const { return edge_key(static_cast<int>(i), static_cast<int>(j)); }
-  long cell_index(double x) const { return static_cast<long>(std::floor(x / cell_)); }
-  uint64_t cell_of(const double* q) const { return cell_key(cell_index(q[0] - lo_[0]), cell_index(q[1] - lo_[1])); }
-  template <class Fn>
-  void visit(const Cells& cells, const double* q, double r, Fn&& fn) const {
-    const long i0 = static_cast<long>(std::floor((q[0] - r - lo_[0]) / cell_)),
-               i1 = static_cast<long>(std::floor((q[0] + r - lo_[0]) / cell_));
-    const long j0 = static_cast<long>(std::floor((q[1] - r - lo_[1]) / cell_)),
-               j1 = static_cast<long>(std::floor((q[1] + r - lo_[1]) / cell_));
-    if ((i1 - i0 + 1) * (j1 - j0 + 1) > static_cast<long>(4 * cells.size() + 16)) {
-      for (const auto& kv : cells)
-        for (int x : kv.second) fn(x);
-      return;
-    }
-    for (long i = i0; i <= i1; ++i)
-      for (long j = j0; j <= j1; ++j) {
-        auto it = cells.find(cell_key(i, j));
-        if (it != cells.end())
-          for (int x : it->second) fn(x);
-      }
-  }
-
   std::vector<double>& xy_;
-  double cell_, lo_[2];
+  SpatialGrid<2> nodes_, edges_;
+  std::vector<int> found_;  ///< edges_near's answer
   std::vector<int> ea_, eb_, fails_;
   std::vector<char> alive_;
   std::vector<int> degree_;
   std::vector<char> pending_;
   std::unordered_map<uint64_t, int> lookup_;
-  Cells node_cells_, edge_cells_;
   long alive_count_ = 0;
 };
 
@@ -389,7 +367,7 @@ class FaceFill {
   }
 
   // Whether a new side (b, c) or (c, a) of edge e's triangle with apex c meets a front edge.
-  bool new_sides_cross(int e, int c, bool new_bc, bool new_ca, const Reach& g) const {
+  bool new_sides_cross(int e, int c, bool new_bc, bool new_ca, const Reach& g) {
     const int a = front_.a(e), b = front_.b(e);
     bool cross = false;
     front_.edges_near(g.mid, g.R + g.d, [&](int f) {

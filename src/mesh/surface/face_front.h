@@ -8,12 +8,13 @@
 //
 // The engine in three parts (DESIGN.md), in face_front.cpp: the container `FaceFront`
 // (directed edges with the unmeshed region on their left, the nodes that may still take
-// triangles, uniform grids over both for the searches; named apart from the 3D front of
-// mesh/volume), the geometry of candidates (`Reach`: the ideal apex from the size field, the
-// search radius and quality bound of the pass), and the driver `FaceFill`: take the shortest
-// front edge, gather candidates, accept the first valid triangle, update the front; edges that
-// fail are retried later with a wider search and a lower quality bound. fill_face() below runs
-// it, then Delaunay flips and smoothing of the new nodes.
+// triangles, and for the searches a spatial grid over each, mesh/core/spatial_grid.h; named
+// apart from the 3D front of mesh/volume), the geometry of candidates (`Reach`: the ideal apex
+// from the size field, the search radius and quality bound of the pass), and the driver
+// `FaceFill`: take the shortest front edge, gather candidates, accept the first valid
+// triangle, update the front; edges that fail are retried later with a wider search and a
+// lower quality bound. fill_face() below runs it, then Delaunay flips and smoothing of the new
+// nodes.
 #pragma once
 #include <functional>
 #include <vector>

@@ -82,7 +82,7 @@ SurfaceOptimizer::SurfaceOptimizer(MatX2d& P, MatX3i& T, MatX3d& X, int fixed, c
   dead_.assign(nt_, 0);
 }
 
-void SurfaceOptimizer::evaluate(long i) {
+inline void SurfaceOptimizer::evaluate(long i) {
   double x[3], du[3], dv[3];
   eval_(P_.row(i).data(), x, du, dv);
   X_.row(i) << x[0], x[1], x[2];
@@ -92,19 +92,19 @@ void SurfaceOptimizer::evaluate(long i) {
   N_.row(i) = nn.norm() > 0 ? Eigen::RowVector3d(nn.normalized()) : Eigen::RowVector3d::Zero();
 }
 
-SurfaceOptimizer::NodeState SurfaceOptimizer::save(long i) const {
+inline SurfaceOptimizer::NodeState SurfaceOptimizer::save(long i) const {
   return NodeState{P_.row(i), X_.row(i), N_.row(i), Xu_[i], Xv_[i]};
 }
 
-void SurfaceOptimizer::restore(long i, const NodeState& s) {
+inline void SurfaceOptimizer::restore(long i, const NodeState& s) {
   P_.row(i) = s.p, X_.row(i) = s.x, N_.row(i) = s.n, Xu_[i] = s.u, Xv_[i] = s.v;
 }
 
-double SurfaceOptimizer::triangle_angle(long t) const { return min_angle(X_, T_(t, 0), T_(t, 1), T_(t, 2)); }
+inline double SurfaceOptimizer::triangle_angle(long t) const { return min_angle(X_, T_(t, 0), T_(t, 1), T_(t, 2)); }
 
 // The smallest angle of the triangles [begin, end) on the surface; -1 if one is not
 // counter-clockwise in the parameters or does not face out.
-double SurfaceOptimizer::worst_of(const int* begin, const int* end) const {
+inline double SurfaceOptimizer::worst_of(const int* begin, const int* end) const {
   double w = 180;
   for (const int* q = begin; q != end; ++q) {
     if (!ccw(P_, T_(*q, 0), T_(*q, 1), T_(*q, 2)) || !faces_out(X_, N_, T_(*q, 0), T_(*q, 1), T_(*q, 2))) return -1.0;
