@@ -15,8 +15,8 @@ namespace {
 
 /// Value of the level-set function at a node: never exactly 0 (a node on the threshold
 /// counts as inside), so every crossing lies strictly inside an edge.
-inline double level(const VecXd& nd, int node, double threshold) {
-  double v = nd[node] - threshold;
+inline double level(const VecXd& node_density, int node, double threshold) {
+  double v = node_density[node] - threshold;
   return v == 0 ? 1e-12 : v;
 }
 
@@ -107,26 +107,26 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
   return out;
 }
 
-double kept_design_volume(const TetMesh& mesh, const VecXd& nd, double threshold) {
+double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold) {
   double total = 0;
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (mesh.domain.size() == mesh.T.rows() && mesh.domain[t] != 0) continue;
     std::array<Eigen::Vector3d, 4> p;
     std::array<double, 4> f;
-    for (int a = 0; a < 4; ++a) p[a] = mesh.V.row(mesh.T(t, a)), f[a] = level(nd, mesh.T(t, a), threshold);
+    for (int a = 0; a < 4; ++a) p[a] = mesh.V.row(mesh.T(t, a)), f[a] = level(node_density, mesh.T(t, a), threshold);
     total += kept_volume(p, f);
   }
   return total;
 }
 
-double threshold_for_volume(const TetMesh& mesh, const VecXd& nd, double volume_fraction) {
+double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, double volume_fraction) {
   if (!(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1");
-  const double target = volume_fraction * kept_design_volume(mesh, nd, -1.0);
+  const double target = volume_fraction * kept_design_volume(mesh, node_density, -1.0);
   double lo = 0, hi = 1;
   for (int k = 0; k < 50; ++k) {
     double mid = 0.5 * (lo + hi);
-    (kept_design_volume(mesh, nd, mid) > target ? lo : hi) = mid;
+    (kept_design_volume(mesh, node_density, mid) > target ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -138,8 +138,8 @@ namespace {
 /// face (TriSurface's fields).
 class IsoSurfaceBuilder {
  public:
-  IsoSurfaceBuilder(const TetMesh& mesh, const VecXd& nd, double threshold)
-      : mesh_(mesh), nd_(nd), threshold_(threshold), tagged_(mesh.domain.size() == mesh.T.rows()) {}
+  IsoSurfaceBuilder(const TetMesh& mesh, const VecXd& node_density, double threshold)
+      : mesh_(mesh), node_density_(node_density), threshold_(threshold), tagged_(mesh.domain.size() == mesh.T.rows()) {}
 
   /// Iso-triangles inside every design tet the level crosses, oriented out of the kept side.
   void cut_design_tets() {
@@ -190,7 +190,7 @@ class IsoSurfaceBuilder {
   };
 
   bool is_design(long t) const { return !tagged_ || mesh_.domain[t] == 0; }
-  double f(int node) const { return level(nd_, node, threshold_); }
+  double f(int node) const { return level(node_density_, node, threshold_); }
 
   int node_point(int n) {
     auto [it, fresh] = node_point_.emplace(n, static_cast<int>(pts_.size()));
@@ -323,7 +323,7 @@ class IsoSurfaceBuilder {
   }
 
   const TetMesh& mesh_;
-  const VecXd& nd_;
+  const VecXd& node_density_;
   const double threshold_;
   const bool tagged_;
   std::vector<Eigen::Vector3d> pts_;
@@ -336,8 +336,8 @@ class IsoSurfaceBuilder {
 
 }  // namespace
 
-TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double threshold) {
-  IsoSurfaceBuilder b(mesh, nd, threshold);
+TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold) {
+  IsoSurfaceBuilder b(mesh, node_density, threshold);
   b.cut_design_tets();
   b.add_boundary_and_interfaces();
   return b.finish();
