@@ -5,11 +5,11 @@
 #include <iostream>
 
 #include "cli/commands.h"
-#include "common/closed_surface.h"
 #include "common/error.h"
 #include "io/job.h"
 #include "pipeline/optimize_job.h"
 #include "pipeline/solve_job.h"
+#include "result/iso_surface.h"
 
 namespace topopt::cli {
 
@@ -45,7 +45,7 @@ int cmd_optimize(const Args& args) {
   std::cout << "mesh: " << mesh.V.rows() << " nodes, " << mesh.T.rows() << " tets (" << t_mesh << " s)\n";
   pipeline::OptimizeResult r = pipeline::optimize_job(job, mesh, progress);
   const auto& last = r.simp.history.back();
-  const SurfaceCheck check = check_surface(r.surface.V, r.surface.F);
+  result::SurfaceCheck check = result::check_surface(r.surface.V, r.surface.F);
   std::cout << std::setprecision(6) << "simp: " << r.simp.status << ", compliance " << last.compliance
             << " N*mm, volume fraction " << last.volume_fraction << " (" << r.seconds_simp << " s)\n"
             << "surface: threshold " << r.threshold << ", " << r.surface.F.rows() << " triangles, "

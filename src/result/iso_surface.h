@@ -3,9 +3,15 @@
 // a closed, manifold, outward-oriented triangle mesh made of iso-triangles inside design
 // tets and the kept parts of Ω's boundary faces.
 #pragma once
+#include "common/closed_surface.h"
 #include "common/types.h"
 
 namespace topopt::result {
+
+/// The result shape's check (closed, manifold, outward, its volume) is the code base's one
+/// closed-surface check, common/closed_surface.h, under the names result/ has always offered.
+using topopt::check_surface;
+using topopt::SurfaceCheck;
 
 /// #V node densities: the volume-weighted mean of the densities of the tets around a node;
 /// nodes of non-design tets get 1 so the non-design solids are kept whole. density: #T.

@@ -6,7 +6,6 @@
 
 #include <cmath>
 
-#include "common/closed_surface.h"
 #include "common/error.h"
 #include "mesh/core/structured_box.h"
 #include "result/smoothing.h"
