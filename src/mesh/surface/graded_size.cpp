@@ -23,7 +23,8 @@ double reach_of(const std::vector<std::array<double, 3>>& pts, double h, double 
 PointSizeField::PointSizeField(std::vector<std::array<double, 3>> pts, double h, double grade)
     : pts_(std::move(pts)), grade_(grade), reach_(reach_of(pts_, h, grade)), grid_(index(pts_, reach_)) {}
 
-// The points in a grid with cells of half the reach (at most 512 across the points' box).
+// The points in a grid with cells as large as the reach (at most 512 across the points' box),
+// so that a query visits 3 x 3 cells.
 SpatialGrid<2> PointSizeField::index(const std::vector<std::array<double, 3>>& pts, double reach) {
   double lo[2] = {0, 0}, hi[2] = {0, 0};
   if (!pts.empty()) lo[0] = hi[0] = pts[0][0], lo[1] = hi[1] = pts[0][1];
@@ -31,7 +32,7 @@ SpatialGrid<2> PointSizeField::index(const std::vector<std::array<double, 3>>& p
     lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]);
     lo[1] = std::min(lo[1], p[1]), hi[1] = std::max(hi[1], p[1]);
   }
-  SpatialGrid<2> grid(lo, std::max({reach / 2, (hi[0] - lo[0]) / 512, (hi[1] - lo[1]) / 512, 1e-300}));
+  SpatialGrid<2> grid(lo, std::max({reach, (hi[0] - lo[0]) / 512, (hi[1] - lo[1]) / 512, 1e-300}));
   for (size_t i = 0; i < pts.size(); ++i) grid.insert(static_cast<int>(i), pts[i].data(), pts[i].data());
   return grid;
 }

@@ -12,8 +12,8 @@
 namespace topopt::mesh {
 
 /// The exact field min(h, s_i + grade·|q − p_i|), the points looked up in a SpatialGrid
-/// (mesh/core/spatial_grid.h) whose cells are half the reach of a point (where s_i + grade·d
-/// reaches the largest size h), so a query visits about 5 x 5 cells.
+/// (mesh/core/spatial_grid.h) whose cells are as large as the reach of a point (where
+/// s_i + grade·d reaches the largest size h), so a query visits at most 3 x 3 cells.
 class PointSizeField {
  public:
   /// pts: (u, v, s) per point, s > 0; h: the size with no point near (the field's cap);
