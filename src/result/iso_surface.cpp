@@ -13,16 +13,10 @@
 namespace topopt::result {
 namespace {
 
-/// Faces of a positive tet, opposite vertex i, oriented outwards.
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-using Hash3 = FaceKeyHash;
-inline FaceKey sorted3(int a, int b, int c) { return face_key(a, b, c); }
-
 /// Value of the level-set function at a node: never exactly 0 (a node on the threshold
 /// counts as inside), so every crossing lies strictly inside an edge.
-inline double level(const VecXd& nd, int node, double threshold) {
-  double v = nd[node] - threshold;
+inline double level(const VecXd& node_density, int node, double threshold) {
+  double v = node_density[node] - threshold;
   return v == 0 ? 1e-12 : v;
 }
 
@@ -67,6 +61,32 @@ bool even_permutation(int a, int b, int c, int d) {
   return inv % 2 == 0;
 }
 
+/// Indexed by Ω's face number (0..the largest in mesh.face): (n, d) of the face's plane
+/// n·x = d when all its boundary triangles (mesh.F) lie in one plane, else (0, 0, 0, 0).
+std::vector<Eigen::Vector4d> planar_faces(const TetMesh& mesh) {
+  const int max_face = mesh.face.size() ? mesh.face.maxCoeff() : 0;
+  std::vector<Eigen::Vector4d> plane(max_face + 1, Eigen::Vector4d::Zero());
+  std::vector<char> bad(max_face + 1, 0), seen(max_face + 1, 0);
+  for (long k = 0; k < mesh.F.rows(); ++k) {
+    const int f = mesh.face.size() ? mesh.face[k] : 0;
+    if (f <= 0) continue;
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(k, 0)), b = mesh.V.row(mesh.F(k, 1)), c = mesh.V.row(mesh.F(k, 2));
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (!seen[f]) {
+      seen[f] = 1;
+      plane[f] << n, n.dot(a);
+    } else if (!bad[f]) {
+      const Eigen::Vector3d n0 = plane[f].head<3>();
+      if (n.dot(n0) < 1 - 1e-9 || std::abs(n0.dot(a) - plane[f][3]) > 1e-7 * (1 + std::abs(plane[f][3]))) bad[f] = 1;
+    }
+  }
+  for (int f = 0; f <= max_face; ++f)
+    if (bad[f]) plane[f].setZero();
+  return plane;
+}
+
 }  // namespace
 
 VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
@@ -75,11 +95,8 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
   std::vector<char> design_node(nv, 0);
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (mesh.domain.size() == mesh.T.rows() && mesh.domain[t] != 0) continue;
-    Eigen::Vector3d p0 = mesh.V.row(mesh.T(t, 0));
-    double v = std::abs((Eigen::Vector3d(mesh.V.row(mesh.T(t, 1))) - p0)
-                            .dot((Eigen::Vector3d(mesh.V.row(mesh.T(t, 2))) - p0)
-                                     .cross(Eigen::Vector3d(mesh.V.row(mesh.T(t, 3))) - p0))) /
-               6.0;
+    const double v = tet_volume(mesh.V.row(mesh.T(t, 0)), mesh.V.row(mesh.T(t, 1)), mesh.V.row(mesh.T(t, 2)),
+                                mesh.V.row(mesh.T(t, 3)));
     for (int a = 0; a < 4; ++a) {
       sum[mesh.T(t, a)] += v * density[t];
       wsum[mesh.T(t, a)] += v;
@@ -90,86 +107,138 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
   return out;
 }
 
-double kept_design_volume(const TetMesh& mesh, const VecXd& nd, double threshold) {
+double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold) {
   double total = 0;
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (mesh.domain.size() == mesh.T.rows() && mesh.domain[t] != 0) continue;
     std::array<Eigen::Vector3d, 4> p;
     std::array<double, 4> f;
-    for (int a = 0; a < 4; ++a) p[a] = mesh.V.row(mesh.T(t, a)), f[a] = level(nd, mesh.T(t, a), threshold);
+    for (int a = 0; a < 4; ++a) p[a] = mesh.V.row(mesh.T(t, a)), f[a] = level(node_density, mesh.T(t, a), threshold);
     total += kept_volume(p, f);
   }
   return total;
 }
 
-double threshold_for_volume(const TetMesh& mesh, const VecXd& nd, double volume_fraction) {
+double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, double volume_fraction) {
   if (!(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1");
-  const double target = volume_fraction * kept_design_volume(mesh, nd, -1.0);
+  const double target = volume_fraction * kept_design_volume(mesh, node_density, -1.0);
   double lo = 0, hi = 1;
   for (int k = 0; k < 50; ++k) {
     double mid = 0.5 * (lo + hi);
-    (kept_design_volume(mesh, nd, mid) > target ? lo : hi) = mid;
+    (kept_design_volume(mesh, node_density, mid) > target ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
 
-TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double threshold) {
-  const long nt = mesh.T.rows();
-  const bool tagged = mesh.domain.size() == nt;
-  auto is_design = [&](long t) { return !tagged || mesh.domain[t] == 0; };
-  TriSurface s;
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<int> lock, pface;
-  std::vector<std::array<int, 3>> tris;
-  std::vector<int> tags;
-  std::unordered_map<int, int> node_point;        // mesh node -> point
-  std::map<std::pair<int, int>, int> edge_point;  // sorted mesh edge -> point
-  auto node_pt = [&](int n) {
-    auto [it, fresh] = node_point.emplace(n, static_cast<int>(pts.size()));
-    if (fresh) pts.push_back(mesh.V.row(n)), lock.push_back(0), pface.push_back(0);
-    return it->second;
-  };
-  auto edge_pt = [&](int a, int b) {
-    auto key = std::minmax(a, b);
-    auto [it, fresh] = edge_point.emplace(std::make_pair(key.first, key.second), static_cast<int>(pts.size()));
-    if (fresh) {
-      double fa = level(nd, a, threshold), fb = level(nd, b, threshold);
-      double w = fa / (fa - fb);
-      pts.push_back(Eigen::Vector3d(mesh.V.row(a)) +
-                    w * (Eigen::Vector3d(mesh.V.row(b)) - Eigen::Vector3d(mesh.V.row(a))));
-      lock.push_back(0), pface.push_back(0);
+namespace {
+
+/// Builds the result surface piece by piece: its points (mesh nodes and level crossings on mesh
+/// edges, each made once), its triangles with their tags, and each point's lock and cut-line
+/// face (TriSurface's fields).
+class IsoSurfaceBuilder {
+ public:
+  IsoSurfaceBuilder(const TetMesh& mesh, const VecXd& node_density, double threshold)
+      : mesh_(mesh), node_density_(node_density), threshold_(threshold), tagged_(mesh.domain.size() == mesh.T.rows()) {}
+
+  /// Iso-triangles inside every design tet the level crosses, oriented out of the kept side.
+  void cut_design_tets() {
+    for (long t = 0; t < mesh_.T.rows(); ++t)
+      if (is_design(t)) cut_tet(t);
+  }
+
+  /// The faces of the mesh's boundary (Ω's: kept parts of design tets' faces, non-design tets'
+  /// faces whole) and the void side of the faces between design and non-design tets.
+  void add_boundary_and_interfaces() {
+    const FaceSides sides = face_sides();
+    const std::unordered_map<FaceKey, int, FaceKeyHash> tag_of = boundary_tags();
+    for (const auto& [key, owner] : sides.boundary) {
+      const auto ft = tag_of.find(key);
+      const int tag = ft != tag_of.end() && ft->second != 0 ? ft->second : kUntagged;
+      add_boundary_face(owner.first, owner.second, tag);
     }
-    return it->second;
-  };
-  auto emit = [&](int a, int b, int c, int tag) {
-    tris.push_back({a, b, c});
-    tags.push_back(tag);
+    for (const auto& [t, i] : sides.interfaces) {
+      const int* o = kTetFace[i];
+      clip(mesh_.T(t, o[0]), mesh_.T(t, o[1]), mesh_.T(t, o[2]), false, -mesh_.domain[t], 2);
+    }
+  }
+
+  /// The surface built so far (a boundary face the mesh did not tag gets tag 0).
+  TriSurface finish() {
+    TriSurface s;
+    s.V.resize(pts_.size(), 3);
+    for (size_t i = 0; i < pts_.size(); ++i) s.V.row(i) = pts_[i];
+    s.F.resize(tris_.size(), 3);
+    for (size_t i = 0; i < tris_.size(); ++i) s.F.row(i) << tris_[i][0], tris_[i][1], tris_[i][2];
+    s.tag = Eigen::Map<VecXi>(tags_.data(), tags_.size());
+    s.lock = Eigen::Map<VecXi>(lock_.data(), lock_.size());
+    s.point_face = Eigen::Map<VecXi>(pface_.data(), pface_.size());
+    for (int k = 0; k < s.tag.size(); ++k)
+      if (s.tag[k] == kUntagged) s.tag[k] = 0;
+    s.face_plane = planar_faces(mesh_);
+    return s;
+  }
+
+ private:
+  /// The tag of a boundary face the mesh did not tag (still Ω's boundary) until finish().
+  static constexpr int kUntagged = 1 << 29;
+  /// Faces of the mesh used by one tet (key -> (tet, local face)), and the faces between a
+  /// design and a non-design tet, as (non-design tet, local face).
+  struct FaceSides {
+    std::unordered_map<FaceKey, std::pair<long, int>, FaceKeyHash> boundary;
+    std::vector<std::array<long, 2>> interfaces;
   };
 
-  // 1. iso-triangles inside design tets
-  for (long t = 0; t < nt; ++t) {
-    if (!is_design(t)) continue;
+  bool is_design(long t) const { return !tagged_ || mesh_.domain[t] == 0; }
+  double f(int node) const { return level(node_density_, node, threshold_); }
+
+  int node_point(int n) {
+    auto [it, fresh] = node_point_.emplace(n, static_cast<int>(pts_.size()));
+    if (fresh) pts_.push_back(mesh_.V.row(n)), lock_.push_back(0), pface_.push_back(0);
+    return it->second;
+  }
+  // The point where the level crosses the mesh edge ab (made once per edge).
+  int edge_point(int a, int b) {
+    auto key = std::minmax(a, b);
+    auto [it, fresh] = edge_point_.emplace(std::make_pair(key.first, key.second), static_cast<int>(pts_.size()));
+    if (fresh) {
+      const double fa = f(a), fb = f(b);
+      const double w = fa / (fa - fb);
+      pts_.push_back(Eigen::Vector3d(mesh_.V.row(a)) +
+                     w * (Eigen::Vector3d(mesh_.V.row(b)) - Eigen::Vector3d(mesh_.V.row(a))));
+      lock_.push_back(0), pface_.push_back(0);
+    }
+    return it->second;
+  }
+  void emit(int a, int b, int c, int tag) {
+    tris_.push_back({a, b, c});
+    tags_.push_back(tag);
+  }
+
+  // Marching tetrahedra in tet t: one triangle around a lone vertex on its side, two across
+  // a tet cut between two pairs.
+  void cut_tet(long t) {
     int v[4];
-    double f[4];
+    double fv[4];
     int np = 0;
-    for (int a = 0; a < 4; ++a) v[a] = mesh.T(t, a), f[a] = level(nd, v[a], threshold), np += f[a] > 0;
-    if (np == 0 || np == 4) continue;
+    for (int a = 0; a < 4; ++a) v[a] = mesh_.T(t, a), fv[a] = f(v[a]), np += fv[a] > 0;
+    if (np == 0 || np == 4) return;
     if (np == 1 || np == 3) {
       int i = 0;
-      while ((f[i] > 0) != (np == 1)) ++i;  // the lone vertex
-      const int* o = kFace[i];
-      int p0 = edge_pt(v[i], v[o[0]]), p1 = edge_pt(v[i], v[o[1]]), p2 = edge_pt(v[i], v[o[2]]);
+      while ((fv[i] > 0) != (np == 1)) ++i;  // the lone vertex
+      const int* o = kTetFace[i];
+      const int p0 = edge_point(v[i], v[o[0]]), p1 = edge_point(v[i], v[o[1]]), p2 = edge_point(v[i], v[o[2]]);
       if (np == 1)
         emit(p0, p1, p2, 0);
       else
         emit(p0, p2, p1, 0);
-      continue;
+      return;
     }
     int pos[2], neg[2], kp = 0, kn = 0;
-    for (int a = 0; a < 4; ++a) (f[a] > 0 ? pos[kp++] : neg[kn++]) = a;
-    int a = pos[0], b = pos[1], c = neg[0], d = neg[1];
-    int pac = edge_pt(v[a], v[c]), pad = edge_pt(v[a], v[d]), pbd = edge_pt(v[b], v[d]), pbc = edge_pt(v[b], v[c]);
+    for (int a = 0; a < 4; ++a) (fv[a] > 0 ? pos[kp++] : neg[kn++]) = a;
+    const int a = pos[0], b = pos[1], c = neg[0], d = neg[1];
+    const int pac = edge_point(v[a], v[c]), pad = edge_point(v[a], v[d]), pbd = edge_point(v[b], v[d]),
+              pbc = edge_point(v[b], v[c]);
     if (even_permutation(a, b, c, d)) {
       emit(pac, pad, pbd, 0), emit(pac, pbd, pbc, 0);
     } else {
@@ -177,138 +246,101 @@ TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& nd, double thre
     }
   }
 
-  // 2. faces: Ω's boundary (kept parts) and non-design/design interfaces (void parts)
-  // Clips the oriented triangle (x, y, z) to where keep(f) holds and emits it.
-  auto clip = [&](int x, int y, int z, bool keep_positive, int tag, int lock_level) {
-    int v[3] = {x, y, z};
+  FaceSides face_sides() const {
+    FaceSides s;
+    const long nt = mesh_.T.rows();
+    s.boundary.reserve(2 * nt);
+    for (long t = 0; t < nt; ++t)
+      for (int i = 0; i < 4; ++i) {
+        auto key = face_key(mesh_.T(t, kTetFace[i][0]), mesh_.T(t, kTetFace[i][1]), mesh_.T(t, kTetFace[i][2]));
+        auto [it, fresh] = s.boundary.emplace(key, std::make_pair(t, i));
+        if (fresh) continue;
+        const long u = it->second.first;
+        const int ui = it->second.second;
+        if (is_design(t) != is_design(u))
+          s.interfaces.push_back(is_design(t) ? std::array<long, 2>{u, ui} : std::array<long, 2>{t, i});
+        s.boundary.erase(it);
+      }
+    return s;
+  }
+
+  // Ω's face tags of the boundary triangles (mesh.F), by key.
+  std::unordered_map<FaceKey, int, FaceKeyHash> boundary_tags() const {
+    std::unordered_map<FaceKey, int, FaceKeyHash> tag;
+    for (long k = 0; k < mesh_.F.rows(); ++k)
+      tag[face_key(mesh_.F(k, 0), mesh_.F(k, 1), mesh_.F(k, 2))] = mesh_.face.size() ? mesh_.face[k] : 0;
+    return tag;
+  }
+
+  // Face i of tet t on Ω's boundary: clipped to the kept side in a design tet; whole on a
+  // non-design solid, split where the cut of a neighbouring design face meets its edges (no
+  // T-junctions), fanned from its centre.
+  void add_boundary_face(long t, int i, int tag) {
+    const int* o = kTetFace[i];
+    const int v[3] = {mesh_.T(t, o[0]), mesh_.T(t, o[1]), mesh_.T(t, o[2])};
+    if (is_design(t)) return clip(v[0], v[1], v[2], true, tag, 1);
+    std::vector<int> poly;
+    for (int k = 0; k < 3; ++k) {
+      const int a = v[k], b = v[(k + 1) % 3];
+      poly.push_back(node_point(a));
+      if ((f(a) > 0) != (f(b) > 0)) poly.push_back(edge_point(a, b));
+    }
+    for (int p : poly) lock_[p] = 2;
+    if (poly.size() == 3) return emit(poly[0], poly[1], poly[2], tag);
+    const int centre = static_cast<int>(pts_.size());
+    pts_.push_back(
+        (Eigen::Vector3d(mesh_.V.row(v[0])) + Eigen::Vector3d(mesh_.V.row(v[1])) + Eigen::Vector3d(mesh_.V.row(v[2]))) /
+        3);
+    lock_.push_back(2), pface_.push_back(0);
+    for (size_t k = 0; k < poly.size(); ++k) emit(centre, poly[k], poly[(k + 1) % poly.size()], tag);
+  }
+
+  // Clips the oriented triangle (x, y, z) to where the level is positive (keep_positive) or
+  // negative, and emits the kept polygon fanned from its first point; its points get at least
+  // `lock_level`, and on Ω's face `tag` (lock 1) the crossings record that face (-1 when on two).
+  void clip(int x, int y, int z, bool keep_positive, int tag, int lock_level) {
+    const int v[3] = {x, y, z};
     bool in[3];
     int nin = 0;
     for (int k = 0; k < 3; ++k) {
-      double f = level(nd, v[k], threshold);
-      in[k] = keep_positive ? f > 0 : f < 0;
+      in[k] = keep_positive ? f(v[k]) > 0 : f(v[k]) < 0;
       nin += in[k];
     }
     if (nin == 0) return;
     std::vector<int> poly;
     for (int k = 0; k < 3; ++k) {
-      int a = v[k], b = v[(k + 1) % 3];
-      if (in[k]) poly.push_back(node_pt(a));
+      const int a = v[k], b = v[(k + 1) % 3];
+      if (in[k]) poly.push_back(node_point(a));
       if (in[k] != in[(k + 1) % 3]) {
-        int e = edge_pt(a, b);
+        const int e = edge_point(a, b);
         poly.push_back(e);
-        if (lock_level == 1 && tag > 0 && lock[e] < 2)  // a point of the cut line; on two faces: fixed
-          pface[e] = (pface[e] == 0 || pface[e] == tag) ? tag : -1;
+        if (lock_level == 1 && tag > 0 && lock_[e] < 2)  // a point of the cut line; on two faces: fixed
+          pface_[e] = (pface_[e] == 0 || pface_[e] == tag) ? tag : -1;
       }
     }
-    for (int p : poly) lock[p] = std::max(lock[p], lock_level);
+    for (int p : poly) lock_[p] = std::max(lock_[p], lock_level);
     for (size_t k = 1; k + 1 < poly.size(); ++k) emit(poly[0], poly[k], poly[k + 1], tag);
-  };
-  std::unordered_map<std::array<int, 3>, std::pair<long, int>, Hash3> face_owner;  // face -> (tet, local)
-  face_owner.reserve(2 * nt);
-  std::vector<std::array<long, 2>> interfaces;  // (non-design tet, local face)
-  for (long t = 0; t < nt; ++t)
-    for (int i = 0; i < 4; ++i) {
-      auto key = sorted3(mesh.T(t, kFace[i][0]), mesh.T(t, kFace[i][1]), mesh.T(t, kFace[i][2]));
-      auto [it, fresh] = face_owner.emplace(key, std::make_pair(t, i));
-      if (fresh) continue;
-      long u = it->second.first;
-      int ui = it->second.second;
-      if (is_design(t) != is_design(u))
-        interfaces.push_back(is_design(t) ? std::array<long, 2>{u, ui} : std::array<long, 2>{t, i});
-      face_owner.erase(it);
-    }
-  // what is left in face_owner is the boundary of the mesh; Ω's face tags from mesh.F
-  std::unordered_map<std::array<int, 3>, int, Hash3> face_tag;
-  for (long k = 0; k < mesh.F.rows(); ++k)
-    face_tag[sorted3(mesh.F(k, 0), mesh.F(k, 1), mesh.F(k, 2))] = mesh.face.size() ? mesh.face[k] : 0;
-  for (const auto& [key, owner] : face_owner) {
-    long t = owner.first;
-    const int* o = kFace[owner.second];
-    int x = mesh.T(t, o[0]), y = mesh.T(t, o[1]), z = mesh.T(t, o[2]);
-    auto ft = face_tag.find(key);
-    int tag = ft != face_tag.end() ? ft->second : 0;
-    if (tag == 0) tag = 1 << 29;  // a boundary face the mesh did not tag: still Ω's boundary
-    if (is_design(t)) {
-      clip(x, y, z, true, tag, 1);
-      continue;
-    }
-    // Ω's boundary on a non-design solid: kept whole, split where the cut of a neighbouring
-    // design face meets its edges (no T-junctions), fanned from its centre.
-    int v[3] = {x, y, z};
-    std::vector<int> poly;
-    for (int k = 0; k < 3; ++k) {
-      int a = v[k], b = v[(k + 1) % 3];
-      poly.push_back(node_pt(a));
-      if ((level(nd, a, threshold) > 0) != (level(nd, b, threshold) > 0)) poly.push_back(edge_pt(a, b));
-    }
-    for (int p : poly) lock[p] = 2;
-    if (poly.size() == 3) {
-      emit(poly[0], poly[1], poly[2], tag);
-      continue;
-    }
-    int centre = static_cast<int>(pts.size());
-    pts.push_back((Eigen::Vector3d(mesh.V.row(x)) + Eigen::Vector3d(mesh.V.row(y)) + Eigen::Vector3d(mesh.V.row(z))) /
-                  3);
-    lock.push_back(2), pface.push_back(0);
-    for (size_t k = 0; k < poly.size(); ++k) emit(centre, poly[k], poly[(k + 1) % poly.size()], tag);
   }
-  for (const auto& [t, i] : interfaces) {
-    const int* o = kFace[i];
-    clip(mesh.T(t, o[0]), mesh.T(t, o[1]), mesh.T(t, o[2]), false, -mesh.domain[t], 2);
-  }
-  s.V.resize(pts.size(), 3);
-  for (size_t i = 0; i < pts.size(); ++i) s.V.row(i) = pts[i];
-  s.F.resize(tris.size(), 3);
-  for (size_t i = 0; i < tris.size(); ++i) s.F.row(i) << tris[i][0], tris[i][1], tris[i][2];
-  s.tag = Eigen::Map<VecXi>(tags.data(), tags.size());
-  s.lock = Eigen::Map<VecXi>(lock.data(), lock.size());
-  s.point_face = Eigen::Map<VecXi>(pface.data(), pface.size());
-  for (int k = 0; k < s.tag.size(); ++k)
-    if (s.tag[k] == (1 << 29)) s.tag[k] = 0;
-  // planes of planar Ω faces
-  int max_face = mesh.face.size() ? mesh.face.maxCoeff() : 0;
-  s.face_plane.assign(max_face + 1, Eigen::Vector4d::Zero());
-  std::vector<char> bad(max_face + 1, 0), seen(max_face + 1, 0);
-  for (long k = 0; k < mesh.F.rows(); ++k) {
-    int f = mesh.face.size() ? mesh.face[k] : 0;
-    if (f <= 0) continue;
-    Eigen::Vector3d a = mesh.V.row(mesh.F(k, 0)), b = mesh.V.row(mesh.F(k, 1)), c = mesh.V.row(mesh.F(k, 2));
-    Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() == 0) continue;
-    n.normalize();
-    if (!seen[f]) {
-      seen[f] = 1;
-      s.face_plane[f] << n, n.dot(a);
-    } else if (!bad[f]) {
-      Eigen::Vector3d n0 = s.face_plane[f].head<3>();
-      if (n.dot(n0) < 1 - 1e-9 || std::abs(n0.dot(a) - s.face_plane[f][3]) > 1e-7 * (1 + std::abs(s.face_plane[f][3])))
-        bad[f] = 1;
-    }
-  }
-  for (int f = 0; f <= max_face; ++f)
-    if (bad[f]) s.face_plane[f].setZero();
-  return s;
-}
 
-SurfaceCheck check_surface(const MatX3d& V, const MatX3i& F) {
-  SurfaceCheck c;
-  std::map<std::pair<int, int>, int> directed;
-  for (long t = 0; t < F.rows(); ++t)
-    for (int k = 0; k < 3; ++k) directed[{F(t, k), F(t, (k + 1) % 3)}]++;
-  for (const auto& [e, n] : directed) {
-    auto back = directed.find({e.second, e.first});
-    int m = back == directed.end() ? 0 : back->second;
-    if (n > 1) c.overshared_edges++;
-    if (m == 0)
-      c.open_edges++;
-    else if (n != m)
-      c.misoriented_edges++;
-  }
-  for (long t = 0; t < F.rows(); ++t) {
-    Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), d = V.row(F(t, 2));
-    c.volume += a.dot(b.cross(d)) / 6.0;
-  }
-  return c;
+  const TetMesh& mesh_;
+  const VecXd& node_density_;
+  const double threshold_;
+  const bool tagged_;
+  std::vector<Eigen::Vector3d> pts_;
+  std::vector<int> lock_, pface_;
+  std::vector<std::array<int, 3>> tris_;
+  std::vector<int> tags_;
+  std::unordered_map<int, int> node_point_;        // mesh node -> point
+  std::map<std::pair<int, int>, int> edge_point_;  // sorted mesh edge -> point
+};
+
+}  // namespace
+
+TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold) {
+  IsoSurfaceBuilder b(mesh, node_density, threshold);
+  b.cut_design_tets();
+  b.add_boundary_and_interfaces();
+  return b.finish();
 }
 
 }  // namespace topopt::result

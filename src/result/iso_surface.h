@@ -3,9 +3,15 @@
 // a closed, manifold, outward-oriented triangle mesh made of iso-triangles inside design
 // tets and the kept parts of Ω's boundary faces.
 #pragma once
+#include "common/closed_surface.h"
 #include "common/types.h"
 
 namespace topopt::result {
+
+/// The result shape's check (closed, manifold, outward, its volume) is the code base's one
+/// closed-surface check, common/closed_surface.h, under the names result/ has always offered.
+using topopt::check_surface;
+using topopt::SurfaceCheck;
 
 /// #V node densities: the volume-weighted mean of the densities of the tets around a node;
 /// nodes of non-design tets get 1 so the non-design solids are kept whole. density: #T.
@@ -34,17 +40,9 @@ struct TriSurface {
 };
 
 /// Marching tetrahedra at `threshold` on the node densities (#V). Returns the closed
-/// boundary of the kept region: iso-triangles in design tets, Ω's boundary triangles (or
-/// their kept parts) with their face tags, non-design tets' boundary triangles on Ω.
+/// boundary of the kept region (common/closed_surface.h checks it): iso-triangles in design
+/// tets, Ω's boundary triangles (or their kept parts) with their face tags, non-design tets'
+/// boundary triangles on Ω, and the void side of faces between design and non-design tets.
 TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold);
-
-/// Checks of a triangle surface: every edge used by exactly two triangles in opposite
-/// directions (closed, manifold, consistently oriented).
-struct SurfaceCheck {
-  long open_edges = 0, overshared_edges = 0, misoriented_edges = 0;
-  double volume = 0;  ///< enclosed volume (divergence theorem), > 0 when oriented outwards
-  bool closed_manifold() const { return open_edges == 0 && overshared_edges == 0 && misoriented_edges == 0; }
-};
-SurfaceCheck check_surface(const MatX3d& V, const MatX3i& F);
 
 }  // namespace topopt::result

@@ -6,12 +6,15 @@
 // the exact predicates; pre-placed triangles, boundary segments and isolated entities are
 // never changed.
 //
-// The engine in three parts (DESIGN.md): the front (directed edges with the unmeshed region
-// on their left, a uniform grid for the searches), the geometry of candidates (ideal point
-// from the size field, nearby front nodes), and fill_face() below: take the shortest front
-// edge, try candidates, accept the best valid triangle, update the front; edges that fail are
-// retried later with a wider search and a lower quality bound. Then Delaunay flips and
-// smoothing of the new nodes.
+// The engine in three parts (DESIGN.md), in face_front.cpp: the container `FaceFront`
+// (directed edges with the unmeshed region on their left, the nodes that may still take
+// triangles, and for the searches a spatial grid over each, mesh/core/spatial_grid.h; named
+// apart from the 3D front of mesh/volume), the geometry of candidates (`Reach`: the ideal apex
+// from the size field, the search radius and quality bound of the pass), and the driver
+// `FaceFill`: take the shortest front edge, gather candidates, accept the first valid
+// triangle, update the front; edges that fail are retried later with a wider search and a
+// lower quality bound. fill_face() below runs it, then Delaunay flips and smoothing of the new
+// nodes.
 #pragma once
 #include <functional>
 #include <vector>

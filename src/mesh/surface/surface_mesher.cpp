@@ -34,23 +34,20 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/closed_surface.h"
 #include "common/error.h"
 #include "common/parallel.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/ray_cast.h"
+#include "mesh/surface/graded_size.h"
 #include "mesh/surface/surface_optimize.h"
 
 namespace topopt::mesh {
-namespace {
 
-/// What the faces need to know about a face's parametrisation: a per-direction scale making
-/// lengths in (su·u, sv·v) approximate lengths on the surface, and the largest curvature.
-struct Scales {
-  double su = 1, sv = 1, kmax = 0;
-};
-
-Scales face_geometry(const TopoDS_Face& f) {
-  Scales g;
+// A per-direction scale making lengths in (su·u, sv·v) approximate lengths on the surface (the
+// mean of |Xu| and |Xv| over 5 x 5 samples), and the largest curvature there.
+ModelSurface::FaceGeometry ModelSurface::face_geometry(const TopoDS_Face& f) {
+  FaceGeometry g;
   double u0, u1, v0, v1;
   BRepTools::UVBounds(f, u0, u1, v0, v1);
   BRepAdaptor_Surface s(f, Standard_True);
@@ -75,133 +72,7 @@ Scales face_geometry(const TopoDS_Face& f) {
   return g;
 }
 
-/// Size field near fine boundary pieces of a face: min(h, s_i + grade·|q − p_i|) over the
-/// points (u, v, s_i), looked up in a uniform grid whose cells cover the reach of a point.
-class PointGrid {
- public:
-  PointGrid(std::vector<std::array<double, 3>> pts, double h, double grade) : pts_(std::move(pts)), grade_(grade) {
-    if (pts_.empty()) return;
-    double smin = h;
-    lo_[0] = hi_[0] = pts_[0][0], lo_[1] = hi_[1] = pts_[0][1];
-    for (const auto& p : pts_) {
-      smin = std::min(smin, p[2]);
-      lo_[0] = std::min(lo_[0], p[0]), hi_[0] = std::max(hi_[0], p[0]);
-      lo_[1] = std::min(lo_[1], p[1]), hi_[1] = std::max(hi_[1], p[1]);
-    }
-    reach_ = (h - smin) / grade_;
-    cell_ = std::max({reach_ / 2, (hi_[0] - lo_[0]) / 512, (hi_[1] - lo_[1]) / 512, 1e-300});
-    nx_ = static_cast<long>((hi_[0] - lo_[0]) / cell_) + 1, ny_ = static_cast<long>((hi_[1] - lo_[1]) / cell_) + 1;
-    start_.assign(nx_ * ny_ + 1, 0);
-    for (const auto& p : pts_) ++start_[cell(p.data()) + 1];
-    for (size_t i = 1; i < start_.size(); ++i) start_[i] += start_[i - 1];
-    items_.resize(pts_.size());
-    std::vector<long> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < pts_.size(); ++i) items_[fill[cell(pts_[i].data())]++] = static_cast<int>(i);
-  }
-  double size_at(const double* q, double h) const {
-    if (pts_.empty()) return h;
-    double s = h;
-    const long i0 = std::max(0L, static_cast<long>(std::floor((q[0] - reach_ - lo_[0]) / cell_)));
-    const long i1 = std::min(nx_ - 1, static_cast<long>(std::floor((q[0] + reach_ - lo_[0]) / cell_)));
-    const long j0 = std::max(0L, static_cast<long>(std::floor((q[1] - reach_ - lo_[1]) / cell_)));
-    const long j1 = std::min(ny_ - 1, static_cast<long>(std::floor((q[1] + reach_ - lo_[1]) / cell_)));
-    for (long i = i0; i <= i1; ++i)
-      for (long j = j0; j <= j1; ++j) {
-        const long c = i * ny_ + j;
-        for (long k = start_[c]; k < start_[c + 1]; ++k) {
-          const auto& p = pts_[items_[k]];
-          s = std::min(s, p[2] + grade_ * std::hypot(q[0] - p[0], q[1] - p[1]));
-        }
-      }
-    return s;
-  }
-
- private:
-  long cell(const double* p) const {
-    return static_cast<long>((p[0] - lo_[0]) / cell_) * ny_ + static_cast<long>((p[1] - lo_[1]) / cell_);
-  }
-  std::vector<std::array<double, 3>> pts_;
-  double grade_, reach_ = 0, cell_ = 1, lo_[2] = {0, 0}, hi_[2] = {0, 0};
-  long nx_ = 0, ny_ = 0;
-  std::vector<long> start_;
-  std::vector<int> items_;
-};
-
-/// A size field over a face's scaled parameters on a grid: min(cap, s_i + grade·distance) over
-/// the points (u, v, s_i), by a chamfer transform (two sweeps, 8 neighbours), read
-/// bilinearly. Cells of half the smallest size, at most 512 a side; cap outside the grid.
-class SizeRaster {
- public:
-  SizeRaster(const std::vector<std::array<double, 3>>& pts, double cap, double grade) : cap_(cap) {
-    if (pts.empty()) return;
-    double smin = cap, lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-    for (const auto& p : pts) {
-      smin = std::min(smin, p[2]);
-      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    }
-    const double reach = (cap - smin) / grade;  // beyond it every point's size has grown to cap
-    for (int k = 0; k < 2; ++k) lo_[k] = lo[k] - reach, hi[k] += reach;
-    cell_ = std::max({0.5 * smin, (hi[0] - lo_[0]) / 511, (hi[1] - lo_[1]) / 511, 1e-12});
-    nx_ = static_cast<long>((hi[0] - lo_[0]) / cell_) + 2, ny_ = static_cast<long>((hi[1] - lo_[1]) / cell_) + 2;
-    v_.assign(nx_ * ny_, static_cast<float>(cap));
-    auto at = [&](long i, long j) -> float& { return v_[i * ny_ + j]; };
-    for (const auto& p : pts) {  // the cells around each point, exactly
-      const long ci = static_cast<long>((p[0] - lo_[0]) / cell_), cj = static_cast<long>((p[1] - lo_[1]) / cell_);
-      for (long i = std::max(0L, ci - 1); i <= std::min(nx_ - 1, ci + 2); ++i)
-        for (long j = std::max(0L, cj - 1); j <= std::min(ny_ - 1, cj + 2); ++j) {
-          const double d = std::hypot(lo_[0] + i * cell_ - p[0], lo_[1] + j * cell_ - p[1]);
-          at(i, j) = std::min(at(i, j), static_cast<float>(p[2] + grade * d));
-        }
-    }
-    const float a = static_cast<float>(grade * cell_), b = static_cast<float>(grade * cell_ * std::sqrt(2.0));
-    for (long i = 0; i < nx_; ++i)
-      for (long j = 0; j < ny_; ++j) {
-        float& x = at(i, j);
-        if (i > 0)
-          x = std::min({x, at(i - 1, j) + a, j > 0 ? at(i - 1, j - 1) + b : x, j + 1 < ny_ ? at(i - 1, j + 1) + b : x});
-        if (j > 0) x = std::min(x, at(i, j - 1) + a);
-      }
-    for (long i = nx_ - 1; i >= 0; --i)
-      for (long j = ny_ - 1; j >= 0; --j) {
-        float& x = at(i, j);
-        if (i + 1 < nx_)
-          x = std::min({x, at(i + 1, j) + a, j + 1 < ny_ ? at(i + 1, j + 1) + b : x, j > 0 ? at(i + 1, j - 1) + b : x});
-        if (j + 1 < ny_) x = std::min(x, at(i, j + 1) + a);
-      }
-  }
-  /// min(h, the field at q)
-  double size_at(const double* q, double h) const {
-    if (v_.empty()) return h;
-    const double x = (q[0] - lo_[0]) / cell_, y = (q[1] - lo_[1]) / cell_;
-    if (!(x >= 0 && y >= 0 && x < nx_ - 1 && y < ny_ - 1)) return std::min(h, cap_);
-    const long i = static_cast<long>(x), j = static_cast<long>(y);
-    const double fx = x - i, fy = y - j;
-    const double s = (1 - fx) * ((1 - fy) * v_[i * ny_ + j] + fy * v_[i * ny_ + j + 1]) +
-                     fx * ((1 - fy) * v_[(i + 1) * ny_ + j] + fy * v_[(i + 1) * ny_ + j + 1]);
-    return std::min(h, s);
-  }
-
- private:
-  double cap_, cell_ = 1, lo_[2] = {0, 0};
-  long nx_ = 0, ny_ = 0;
-  std::vector<float> v_;
-};
-
-/// Boundary nodes of a face whose spacing (mean length of their segments) is below 0.7 h:
-/// (u, v, spacing), the sources of the face's graded size field.
-std::vector<std::array<double, 3>> fine_points(const std::vector<std::array<double, 2>>& uv,
-                                               const std::vector<std::array<int, 2>>& segs, double h) {
-  std::vector<double> spacing(uv.size(), 0.0);
-  std::vector<int> count(uv.size(), 0);
-  for (const auto& sg : segs) {
-    const double l = std::hypot(uv[sg[1]][0] - uv[sg[0]][0], uv[sg[1]][1] - uv[sg[0]][1]);
-    for (int k : sg) spacing[k] += l, ++count[k];
-  }
-  std::vector<std::array<double, 3>> fine;
-  for (size_t i = 0; i < uv.size(); ++i)
-    if (count[i] && spacing[i] / count[i] < 0.7 * h) fine.push_back({uv[i][0], uv[i][1], spacing[i] / count[i]});
-  return fine;
-}
+namespace {
 
 /// At most this many pieces on a collapsed edge: the fan around a cone apex or a sphere pole
 /// has about as many triangles, so their angles there stay near 360° / 12 or more.
@@ -272,6 +143,14 @@ double sqdist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
   return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
+/// Distance from P to the segment AB in the plane.
+double point_segment_distance(const std::array<double, 2>& P, const std::array<double, 2>& A,
+                              const std::array<double, 2>& B) {
+  const double dx = B[0] - A[0], dy = B[1] - A[1], l2 = dx * dx + dy * dy;
+  const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
+  return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
+}
+
 }  // namespace
 
 int wall_layers_option(double value) {
@@ -302,30 +181,40 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
   face_given_.assign(nf, 0);
   face_alias_.assign(nf, {-1, 0});
   face_tris_.resize(nf);
+  size_faces();
+  measure_thickness();
+  sample_edges();
+  thin_edge_sizes();
+  initial_vertex_sizes();
+}
 
-  // ---- per face: parameter scaling and the size its curvature allows
+// Per face: the parameter scaling and the size its curvature allows.
+void ModelSurface::size_faces() {
+  const int nf = topo_.num_faces();
   geo_.resize(nf);
   face_size_.assign(nf, h_);
   for (int f = 0; f < nf; ++f) {
-    const Scales g = face_geometry(TopoDS::Face(topo.faces(f + 1)));
-    geo_[f] = {g.su, g.sv, g.kmax};
-    if (g.kmax > 0) face_size_[f] = std::clamp(params.max_angle / g.kmax, hmin_, h_);
+    geo_[f] = face_geometry(TopoDS::Face(topo_.faces(f + 1)));
+    if (geo_[f].kmax > 0) face_size_[f] = std::clamp(params_.max_angle / geo_[f].kmax, hmin_, h_);
   }
-  measure_thickness();
-  // ---- each edge sampled finely once: parameters, arc length, and the size allowed there
-  // (its faces' sizes, its own local curvature, the wall thickness nearby)
+}
+
+// Each edge sampled finely once: parameters, arc length, and the size allowed there (its
+// faces' sizes, its own local curvature).
+void ModelSurface::sample_edges() {
+  const int ne = topo_.num_edges();
   std::vector<double> edge_size(ne, h_);
-  for (int f = 0; f < nf; ++f)
-    for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e)
+  for (int f = 0; f < topo_.num_faces(); ++f)
+    for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f); ++e)
       edge_size[*e] = std::min(edge_size[*e], face_size_[f]);
   samples_.resize(ne);
   for (int e = 0; e < ne; ++e) {
-    if (topo.edge_degenerate[e]) continue;
-    const TopoDS_Edge E = TopoDS::Edge(topo.edges(e + 1).Oriented(TopAbs_FORWARD));
+    if (topo_.edge_degenerate[e]) continue;
+    const TopoDS_Edge E = TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD));
     TopoDS_Vertex va, vb;
     TopExp::Vertices(E, va, vb);
     EdgeSamples& S = samples_[e];
-    S.va = topo.vertices.FindIndex(va) - 1, S.vb = topo.vertices.FindIndex(vb) - 1;
+    S.va = topo_.vertices.FindIndex(va) - 1, S.vb = topo_.vertices.FindIndex(vb) - 1;
     BRepAdaptor_Curve c(E);
     BRepLProp_CLProps props(c, 2, 1e-9);
     const double t0 = c.FirstParameter(), t1 = c.LastParameter();
@@ -339,31 +228,36 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
       prev = p;
       props.SetParameter(t);
       double k = props.IsTangentDefined() ? std::abs(props.Curvature()) : 0.0;
-      S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin_, params.max_angle / k)) : edge_size[e]);
+      S.size.push_back(k > 0 ? std::min(edge_size[e], std::max(hmin_, params_.max_angle / k)) : edge_size[e]);
     }
   }
-  // the wall thickness of the faces along each edge, read through the edge's parameter curves
-  for (int f = 0; f < nf; ++f) {
-    if (thin_uv_[f].empty()) continue;
-    const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
-    const TopoDS_Face F = TopoDS::Face(topo.faces(f + 1).Oriented(TopAbs_FORWARD));
-    for (const int* e = topo.face_edges.begin(f); e != topo.face_edges.end(f); ++e) {
-      if (topo.edge_degenerate[*e]) continue;
+}
+
+// The wall thickness of the faces along each edge, read through the edge's parameter curves.
+void ModelSurface::thin_edge_sizes() {
+  for (int f = 0; f < topo_.num_faces(); ++f) {
+    if (thin_size_[f].empty()) continue;
+    const TopoDS_Face F = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
+    for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f); ++e) {
+      if (topo_.edge_degenerate[*e]) continue;
       double pf, pl;
-      const Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(TopoDS::Edge(topo.edges(*e + 1)), F, pf, pl);
+      const Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(TopoDS::Edge(topo_.edges(*e + 1)), F, pf, pl);
       if (pc.IsNull()) continue;
       EdgeSamples& S = samples_[*e];
       for (size_t i = 0; i < S.t.size(); ++i) {
         const gp_Pnt2d w = pc->Value(S.t[i]);
         const double q[2] = {w.X() * geo_[f].su, w.Y() * geo_[f].sv};
-        S.size[i] = thin.size_at(q, S.size[i]);
+        S.size[i] = thin_size_[f].size_at(q, S.size[i]);
       }
     }
   }
-  // Vertex sizes: no larger than the sizes along their edges nor their short edges' lengths,
-  // then limited by the gradation across edges.
-  vsize_.assign(nv, h_);
-  for (int e = 0; e < ne; ++e) {
+}
+
+// Vertex sizes: no larger than the sizes along their edges nor their short edges' lengths,
+// then limited by the gradation across edges.
+void ModelSurface::initial_vertex_sizes() {
+  vsize_.assign(topo_.num_vertices(), h_);
+  for (int e = 0; e < topo_.num_edges(); ++e) {
     const EdgeSamples& S = samples_[e];
     if (S.va < 0) continue;
     const double len = S.s.back();
@@ -380,51 +274,21 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
 // the model itself keeps no triangulation): points spread over each triangle about a face
 // size apart cast a ray inward, and the nearest triangle it meets gives the thickness there.
 // Each point thinner than two face sizes becomes a fine point in the face's scaled parameters,
-// which a SizeRaster spreads at the gradation rate over the face's fill and its edges.
+// which the face's SizeRaster (thin_size_, built once here) spreads at the gradation rate over
+// the face's fill and its edges.
 void ModelSurface::measure_thickness() {
   const int nf = topo_.num_faces();
-  thin_uv_.assign(nf, {});
+  thin_size_.assign(nf, SizeRaster());
   wall_points_.clear();
   if (nf == 0 || params_.wall_layers <= 0) return;
-  BRepBuilderAPI_Copy copier(topo_.shape, Standard_True, Standard_False);
-  const TopoDS_Shape copy = copier.Shape();
-  BRepMesh_IncrementalMesh(copy, 0.2 * h_, Standard_False, 0.5, Standard_True);
-  std::vector<std::array<double, 3>> xyz;
-  std::vector<std::array<double, 2>> uv;
-  std::vector<std::array<int, 3>> tri;
-  std::vector<int> tri_face;
-  for (int f = 0; f < nf; ++f) {
-    const TopoDS_Shape& original = topo_.faces(f + 1);
-    const TopTools_ListOfShape& mod = copier.Modified(original);
-    if (mod.IsEmpty()) continue;
-    const TopoDS_Face face = TopoDS::Face(mod.First());
-    TopLoc_Location loc;
-    const Handle(Poly_Triangulation) pt = BRep_Tool::Triangulation(face, loc);
-    if (pt.IsNull()) continue;
-    const int base = static_cast<int>(xyz.size());
-    for (int i = 1; i <= pt->NbNodes(); ++i) {
-      const gp_Pnt q = pt->Node(i).Transformed(loc.Transformation());
-      xyz.push_back({q.X(), q.Y(), q.Z()});
-      const gp_Pnt2d w = pt->HasUVNodes() ? pt->UVNode(i) : gp_Pnt2d(0, 0);
-      uv.push_back({w.X() * geo_[f].su, w.Y() * geo_[f].sv});
-    }
-    const bool reversed = face.Orientation() == TopAbs_REVERSED;
-    for (int i = 1; i <= pt->NbTriangles(); ++i) {
-      int a, b, c;
-      pt->Triangle(i).Get(a, b, c);
-      if (reversed) std::swap(b, c);
-      tri.push_back({base + a - 1, base + b - 1, base + c - 1});
-      tri_face.push_back(pt->HasUVNodes() ? f : -1);
-    }
-  }
-  if (tri.empty()) return;
-  MatX3d V(static_cast<long>(xyz.size()), 3);
-  for (size_t i = 0; i < xyz.size(); ++i) V.row(static_cast<long>(i)) << xyz[i][0], xyz[i][1], xyz[i][2];
-  MatX3i F(static_cast<long>(tri.size()), 3);
-  for (size_t t = 0; t < tri.size(); ++t) F.row(static_cast<long>(t)) << tri[t][0], tri[t][1], tri[t][2];
+  const Tessellation tess = coarse_tessellation();
+  if (tess.F.rows() == 0) return;
+  const MatX3d& V = tess.V;
+  const MatX3i& F = tess.F;
   const TriangleRays rays(V, F);
+  std::vector<std::vector<std::array<double, 3>>> thin_uv(nf);  // per face: (scaled u, v, size)
   for (long t = 0; t < F.rows(); ++t) {
-    const int f = tri_face[t];
+    const int f = tess.face[t];
     if (f < 0) continue;
     const double hf = face_size_[f];
     const Eigen::Vector3d a = V.row(F(t, 0)), b = V.row(F(t, 1)), c = V.row(F(t, 2));
@@ -446,10 +310,51 @@ void ModelSurface::measure_thickness() {
         if (size >= hf) continue;
         const Eigen::Vector3d mid = x + 0.5 * thick * d;
         wall_points_.push_back({mid[0], mid[1], mid[2], size});
-        const auto &ua = uv[F(t, 0)], &ub = uv[F(t, 1)], &uc = uv[F(t, 2)];
-        thin_uv_[f].push_back({wa * ua[0] + wb * ub[0] + wc * uc[0], wa * ua[1] + wb * ub[1] + wc * uc[1], size});
+        const auto &ua = tess.uv[F(t, 0)], &ub = tess.uv[F(t, 1)], &uc = tess.uv[F(t, 2)];
+        thin_uv[f].push_back({wa * ua[0] + wb * ub[0] + wc * uc[0], wa * ua[1] + wb * ub[1] + wc * uc[1], size});
       }
   }
+  for (int f = 0; f < nf; ++f)
+    if (!thin_uv[f].empty()) thin_size_[f] = SizeRaster(thin_uv[f], face_size_[f], grade_);
+}
+
+// OCCT's BRepMesh of a copy of the model at 0.2 sizes, outward, with each node's scaled
+// parameters on its face and each triangle's face (-1 where the face has no parameters).
+ModelSurface::Tessellation ModelSurface::coarse_tessellation() const {
+  BRepBuilderAPI_Copy copier(topo_.shape, Standard_True, Standard_False);
+  const TopoDS_Shape copy = copier.Shape();
+  BRepMesh_IncrementalMesh(copy, 0.2 * h_, Standard_False, 0.5, Standard_True);
+  std::vector<std::array<double, 3>> xyz;
+  std::vector<std::array<int, 3>> tri;
+  Tessellation out;
+  for (int f = 0; f < topo_.num_faces(); ++f) {
+    const TopTools_ListOfShape& mod = copier.Modified(topo_.faces(f + 1));
+    if (mod.IsEmpty()) continue;
+    const TopoDS_Face face = TopoDS::Face(mod.First());
+    TopLoc_Location loc;
+    const Handle(Poly_Triangulation) pt = BRep_Tool::Triangulation(face, loc);
+    if (pt.IsNull()) continue;
+    const int base = static_cast<int>(xyz.size());
+    for (int i = 1; i <= pt->NbNodes(); ++i) {
+      const gp_Pnt q = pt->Node(i).Transformed(loc.Transformation());
+      xyz.push_back({q.X(), q.Y(), q.Z()});
+      const gp_Pnt2d w = pt->HasUVNodes() ? pt->UVNode(i) : gp_Pnt2d(0, 0);
+      out.uv.push_back({w.X() * geo_[f].su, w.Y() * geo_[f].sv});
+    }
+    const bool reversed = face.Orientation() == TopAbs_REVERSED;
+    for (int i = 1; i <= pt->NbTriangles(); ++i) {
+      int a, b, c;
+      pt->Triangle(i).Get(a, b, c);
+      if (reversed) std::swap(b, c);
+      tri.push_back({base + a - 1, base + b - 1, base + c - 1});
+      out.face.push_back(pt->HasUVNodes() ? f : -1);
+    }
+  }
+  out.V.resize(static_cast<long>(xyz.size()), 3);
+  for (size_t i = 0; i < xyz.size(); ++i) out.V.row(static_cast<long>(i)) << xyz[i][0], xyz[i][1], xyz[i][2];
+  out.F.resize(static_cast<long>(tri.size()), 3);
+  for (size_t t = 0; t < tri.size(); ++t) out.F.row(static_cast<long>(t)) << tri[t][0], tri[t][1], tri[t][2];
+  return out;
 }
 
 int ModelSurface::new_node(double x, double y, double z) {
@@ -525,7 +430,7 @@ void ModelSurface::refresh_alias(int e) {
 // growing from both vertices at the gradation rate, at equal steps of ∫ ds / size between the
 // vertices and the fixed nodes (step 5: nodes transferred from the other model are kept).
 // Returns (parameter, node) from the first vertex to the last; node -1 where one is to be made.
-std::vector<std::pair<double, int>> ModelSurface::division(int e) const {
+ModelSurface::Division ModelSurface::division(int e) const {
   const EdgeSamples& S = samples_[e];
   const int m = static_cast<int>(S.t.size()) - 1;
   const double len = S.s.back();
@@ -579,12 +484,12 @@ std::vector<std::pair<double, int>> ModelSurface::division(int e) const {
   return out;
 }
 
-void ModelSurface::discretise(int e) {
+void ModelSurface::discretise(int e, const Division& d) {
   BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
   std::vector<double>& par = edge_param_[e];
   std::vector<int>& ids = edge_node_[e];
   par.clear(), ids.clear();
-  for (const auto& [t, node] : division(e)) {
+  for (const auto& [t, node] : d) {
     par.push_back(t);
     if (node >= 0) {
       ids.push_back(node);
@@ -600,12 +505,15 @@ void ModelSurface::discretise(int e) {
 // the edges meeting it at a vertex then start from that length instead of the full size (a
 // 2 mm side at size 1.28 gets two pieces of 1 mm; the side meeting it at a right angle
 // started at 1.25 mm, a corner triangle of 39°; now ~1 mm, 45°). One pass, then graded again.
-void ModelSurface::match_vertex_sizes() {
+// Returns the division of every free edge it made, with the vertex sizes it was made at.
+std::vector<ModelSurface::EdgeDivision> ModelSurface::match_vertex_sizes() {
+  std::vector<EdgeDivision> made(topo_.num_edges());
   bool changed = false;
   for (int e = 0; e < topo_.num_edges(); ++e) {
     if (topo_.edge_degenerate[e] || edge_kind_[e] != EdgeKind::Free) continue;
     const EdgeSamples& S = samples_[e];
-    const std::vector<std::pair<double, int>> d = division(e);
+    made[e] = {division(e), vsize_[S.va], vsize_[S.vb]};
+    const Division& d = made[e].at;
     // one segment: its length is already below the vertex sizes; many: the rounding is spread
     if (d.size() < 3 || d.size() > 4) continue;
     BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
@@ -615,6 +523,7 @@ void ModelSurface::match_vertex_sizes() {
       if (l < 0.85 * vsize_[v]) vsize_[v] = std::max(l, hmin_), changed = true;
   }
   if (changed) grade_vertex_sizes();
+  return made;
 }
 
 // Vertex sizes limited by the gradation across edges (relaxed to a fixed point).
@@ -689,43 +598,87 @@ ModelSurface::Loops ModelSurface::face_loops(int f) const {
 }
 
 void ModelSurface::mesh_edges(const Progress& progress) {
-  const int ne = topo_.num_edges(), nf = topo_.num_faces();
   for (int v = 0; v < topo_.num_vertices(); ++v)
     if (vertex_node_[v] < 0) throw Error(ErrorCode::Internal, "mesh_edges: a vertex has no node yet");
-  match_vertex_sizes();
-  for (int e = 0; e < ne; ++e)
-    if (!topo_.edge_degenerate[e] && edge_kind_[e] == EdgeKind::Free) discretise(e);
-  for (int e = 0; e < ne; ++e)
+  const std::vector<EdgeDivision> made = match_vertex_sizes();
+  for (int e = 0; e < topo_.num_edges(); ++e) {
+    if (topo_.edge_degenerate[e] || edge_kind_[e] != EdgeKind::Free) continue;
+    // the division match_vertex_sizes made serves unless its vertices' sizes changed since
+    // (a division depends on nothing else that changes here)
+    const EdgeSamples& S = samples_[e];
+    const EdgeDivision& d = made[e];
+    discretise(e, d.size_a == vsize_[S.va] && d.size_b == vsize_[S.vb] ? d.at : division(e));
+  }
+  for (int e = 0; e < topo_.num_edges(); ++e)
     if (edge_kind_[e] == EdgeKind::Alias) refresh_alias(e);
+  split_by_proximity(progress);
+}
 
-  // ---- proximity: where two boundary segments of a face cross in its parameters or come
-  // closer than a third of their length (thin strips, nearly tangent edges), the polygon the
-  // front starts from would cross itself or leave no room; those pieces of their edges are
-  // split at their middle, locally, until no face has such a pair (or the floor is reached).
-  // Given edges are never split; a piece of an aliased edge is split on the edge it copies.
-  // Each round looks again only at the faces one of whose edges was split.
-  const double floor_len = hmin_ / 8;
-  // (edge, piece) of the edge a piece's splits go to: itself, or the free edge an alias copies
-  auto free_piece = [&](int e, int piece) {
-    if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return std::pair<int, int>{-1, -1};
-    if (edge_kind_[e] == EdgeKind::Alias) {
-      const auto [rep, reversed] = alias_of_[e];
-      if (edge_kind_[rep] != EdgeKind::Free) return std::pair<int, int>{-1, -1};
-      if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
-      e = rep;
+// Proximity: where two boundary segments of a face cross in its parameters or come closer
+// than a third of their length (thin strips, nearly tangent edges), the polygon the front
+// starts from would cross itself or leave no room; those pieces of their edges are split at
+// their middle, locally, until no face has such a pair (or the floor is reached). Pieces longer
+// than the face's size field there are split too. Given edges are never split; a piece of an
+// aliased edge is split on the edge it copies. Each round looks again only at the faces one of
+// whose edges was split.
+void ModelSurface::split_by_proximity(const Progress& progress) {
+  const int nf = topo_.num_faces();
+  const SharpCorners corners = sharp_corners();
+  std::vector<char> stale(nf, 1);
+  for (int round = 0; round < 10; ++round) {
+    PieceSplits splits{std::vector<std::vector<int>>(topo_.num_edges()), false};
+    for (int f = 0; f < nf; ++f) {
+      if (!stale[f] || face_given_[f]) continue;
+      progress.check_cancel("surface meshing");
+      stale[f] = 0;
+      const Loops L = face_loops(f);
+      const SegmentBoxes boxes(L);
+      mark_long_pieces(f, L, boxes, corners, splits);
+      mark_close_pieces(L, boxes, corners, splits);
     }
-    return std::pair<int, int>{e, piece};
-  };
-  // The two pieces at a corner of a face sharper than kNeedleAngle (measured on the pieces
-  // themselves, in the face's scaled parameters, where the face lies left of its loops) are
-  // not split, in any face, unless they cross another piece: one needle triangle takes the
-  // corner's angle (NIST 1's 11° slots, arcs tangent to a line). The pieces beyond are split
-  // by the rules below like any others, which grades them away from the corner. At a corner
-  // below kCuspAngle the pieces near it are only split where they cross: that close to a
-  // cusp, splitting makes ever thinner triangles, while longer chords open the corner up.
-  std::vector<std::array<char, 2>> needle_end(ne, {0, 0});  // first / last piece of each edge
-  std::unordered_set<int> cusp;                             // nodes of corners below kCuspAngle
-  for (int f = 0; f < nf; ++f) {
+    if (!splits.any) break;
+    split_pieces(splits.pieces, stale);
+  }
+}
+
+ModelSurface::SegmentBoxes::SegmentBoxes(const Loops& L) {
+  const size_t ns = L.segs.size();
+  order.resize(ns), xlo.resize(ns), xhi.resize(ns), ylo.resize(ns), yhi.resize(ns), len.resize(ns);
+  for (size_t i = 0; i < ns; ++i) {
+    const auto& A = L.uv[L.segs[i][0]];
+    const auto& B = L.uv[L.segs[i][1]];
+    len[i] = std::hypot(B[0] - A[0], B[1] - A[1]);
+    xlo[i] = std::min(A[0], B[0]), xhi[i] = std::max(A[0], B[0]);
+    ylo[i] = std::min(A[1], B[1]), yhi[i] = std::max(A[1], B[1]);
+    order[i] = static_cast<int>(i);
+  }
+  std::sort(order.begin(), order.end(), [&](int p, int q) { return xlo[p] < xlo[q]; });
+}
+
+// (edge, piece) of the edge a piece's splits go to: itself, or the free edge an alias copies;
+// (-1, -1) when it may not be split (a given edge, or an alias of one).
+std::pair<int, int> ModelSurface::free_piece(int e, int piece) const {
+  if (piece < 0 || edge_kind_[e] == EdgeKind::Given) return {-1, -1};
+  if (edge_kind_[e] == EdgeKind::Alias) {
+    const auto [rep, reversed] = alias_of_[e];
+    if (edge_kind_[rep] != EdgeKind::Free) return {-1, -1};
+    if (reversed) piece = static_cast<int>(edge_node_[e].size()) - 2 - piece;
+    e = rep;
+  }
+  return {e, piece};
+}
+
+// The two pieces at a corner of a face sharper than kNeedleAngle (measured on the pieces
+// themselves, in the face's scaled parameters, where the face lies left of its loops) are
+// not split, in any face, unless they cross another piece: one needle triangle takes the
+// corner's angle (NIST 1's 11° slots, arcs tangent to a line). The pieces beyond are split
+// by the rules below like any others, which grades them away from the corner. At a corner
+// below kCuspAngle the pieces near it are only split where they cross: that close to a
+// cusp, splitting makes ever thinner triangles, while longer chords open the corner up.
+ModelSurface::SharpCorners ModelSurface::sharp_corners() const {
+  SharpCorners sc;
+  sc.needle_end.assign(topo_.num_edges(), {0, 0});
+  for (int f = 0; f < topo_.num_faces(); ++f) {
     if (face_given_[f]) continue;
     const Loops L = face_loops(f);
     std::unordered_map<int, int> in, out;  // local node -> the piece ending / starting there
@@ -744,133 +697,121 @@ void ModelSurface::mesh_edges(const Progress& progress) {
       const double corner = M_PI - turn;
       if (corner >= kNeedleAngle) continue;
       if (corner < kCuspAngle) {
-        cusp.insert(L.global[node]);
+        sc.cusp.insert(L.global[node]);
         continue;
       }
       for (int sgm : {a, b}) {
         const auto [e, piece] = free_piece(L.seg_edge[sgm], L.seg_piece[sgm]);
         if (e < 0) continue;
-        if (piece == 0) needle_end[e][0] = 1;
-        if (piece + 2 == static_cast<int>(edge_node_[e].size())) needle_end[e][1] = 1;
+        if (piece == 0) sc.needle_end[e][0] = 1;
+        if (piece + 2 == static_cast<int>(edge_node_[e].size())) sc.needle_end[e][1] = 1;
       }
     }
   }
-  auto is_needle = [&](int e, int piece) {
-    return (piece == 0 && needle_end[e][0]) ||
-           (piece + 2 == static_cast<int>(edge_node_[e].size()) && needle_end[e][1]);
+  return sc;
+}
+
+// Marks segment s of the loops L for a split at its middle (on the edge free_piece names),
+// unless it is a needle corner's piece (and does not cross) or already at the floor length.
+void ModelSurface::mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners,
+                              PieceSplits& splits) const {
+  const auto [e, piece] = free_piece(L.seg_edge[s], L.seg_piece[s]);
+  if (e < 0) return;
+  const bool needle = (piece == 0 && corners.needle_end[e][0]) ||
+                      (piece + 2 == static_cast<int>(edge_node_[e].size()) && corners.needle_end[e][1]);
+  if (!crossing && needle) return;
+  const auto& ids = edge_node_[e];
+  const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
+  if (l3 > hmin_ / 8) splits.pieces[e].push_back(piece), splits.any = true;
+}
+
+// Pieces longer than 1.5 times the face's size field at their middle (finer features nearby
+// in the face, e.g. a small hole close to a long straight edge).
+void ModelSurface::mark_long_pieces(int f, const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
+                                    PieceSplits& splits) const {
+  const PointSizeField fine(fine_points(L.uv, L.segs, face_size_[f]), face_size_[f], grade_);
+  for (size_t i = 0; i < L.segs.size(); ++i) {
+    const auto& A = L.uv[L.segs[i][0]];
+    const auto& B = L.uv[L.segs[i][1]];
+    const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
+    if (boxes.len[i] > 1.5 * thin_size_[f].size_at(mid, fine.size_at(mid, face_size_[f])))
+      mark_piece(L, static_cast<int>(i), false, corners, splits);
+  }
+}
+
+// Pairs of pieces of a face that cross or come closer than a third of the longer: the longer
+// one leaves no room (both when they cross), unless both end at a cusp nearby.
+void ModelSurface::mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
+                                     PieceSplits& splits) const {
+  const size_t ns = L.segs.size();
+  const std::vector<double>& len = boxes.len;
+  for (size_t oi = 0; oi < ns; ++oi) {
+    const int i = boxes.order[oi];
+    for (size_t oj = oi + 1; oj < ns; ++oj) {
+      const int j = boxes.order[oj];
+      const double gap = std::max(len[i], len[j]) / 3;
+      if (boxes.xlo[j] > boxes.xhi[i] + gap) break;
+      if (boxes.ylo[j] > boxes.yhi[i] + gap || boxes.ylo[i] > boxes.yhi[j] + gap) continue;
+      const auto &si = L.segs[i], &sj = L.segs[j];
+      if (si[0] == sj[0] || si[0] == sj[1] || si[1] == sj[0] || si[1] == sj[1]) continue;
+      const auto &A = L.uv[si[0]], &B = L.uv[si[1]], &C = L.uv[sj[0]], &D = L.uv[sj[1]];
+      const bool cross =
+          predicates::orient2d(A.data(), B.data(), C.data()) * predicates::orient2d(A.data(), B.data(), D.data()) <=
+              0 &&
+          predicates::orient2d(C.data(), D.data(), A.data()) * predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
+      const double d = cross ? 0.0
+                             : std::min({point_segment_distance(A, C, D), point_segment_distance(B, C, D),
+                                         point_segment_distance(C, A, B), point_segment_distance(D, A, B)});
+      if (d >= gap || (!cross && near_cusp(L, i, j, corners.cusp))) continue;
+      if (cross || len[i] >= 0.7 * len[j]) mark_piece(L, i, cross, corners, splits);
+      if (cross || len[j] >= 0.7 * len[i]) mark_piece(L, j, cross, corners, splits);
+    }
+  }
+}
+
+// Segments i and j of two different edges that end at one cusp's node, both within four of
+// their lengths of it (3D).
+bool ModelSurface::near_cusp(const Loops& L, int i, int j, const std::unordered_set<int>& cusp) const {
+  const int ei = L.seg_edge[i], ej = L.seg_edge[j];
+  if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
+  auto len3 = [&](int k) { return std::sqrt(sqdist(nodes_[L.global[L.segs[k][0]]], nodes_[L.global[L.segs[k][1]]])); };
+  auto dist3 = [&](int v, int k) {  // from node v to the nearer end of segment k
+    return std::sqrt(
+        std::min(sqdist(nodes_[v], nodes_[L.global[L.segs[k][0]]]), sqdist(nodes_[v], nodes_[L.global[L.segs[k][1]]])));
   };
-  std::vector<char> stale(nf, 1);
-  for (int round = 0; round < 10; ++round) {
-    std::vector<std::vector<int>> split(ne);  // pieces of each edge to split
-    bool any = false;
-    for (int f = 0; f < nf; ++f) {
-      if (!stale[f] || face_given_[f]) continue;
-      progress.check_cancel("surface meshing");
-      stale[f] = 0;
-      const Loops L = face_loops(f);
-      const size_t ns = L.segs.size();
-      std::vector<int> order(ns);
-      std::vector<double> xlo(ns), xhi(ns), ylo(ns), yhi(ns), len(ns);
-      for (size_t i = 0; i < ns; ++i) {
-        const auto& A = L.uv[L.segs[i][0]];
-        const auto& B = L.uv[L.segs[i][1]];
-        len[i] = std::hypot(B[0] - A[0], B[1] - A[1]);
-        xlo[i] = std::min(A[0], B[0]), xhi[i] = std::max(A[0], B[0]);
-        ylo[i] = std::min(A[1], B[1]), yhi[i] = std::max(A[1], B[1]);
-        order[i] = static_cast<int>(i);
-      }
-      std::sort(order.begin(), order.end(), [&](int p, int q) { return xlo[p] < xlo[q]; });
-      auto point_seg = [&](const std::array<double, 2>& P, const std::array<double, 2>& A,
-                           const std::array<double, 2>& B) {
-        const double dx = B[0] - A[0], dy = B[1] - A[1], l2 = dx * dx + dy * dy;
-        const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
-        return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
-      };
-      auto len3 = [&](const Loops& LL, int i) {
-        return std::sqrt(sqdist(nodes_[LL.global[LL.segs[i][0]]], nodes_[LL.global[LL.segs[i][1]]]));
-      };
-      auto dist3 = [&](int v, const Loops& LL, int i) {  // from node v to the nearer end of segment i
-        return std::sqrt(std::min(sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][0]]]),
-                                  sqdist(nodes_[v], nodes_[LL.global[LL.segs[i][1]]])));
-      };
-      // segments i and j of two different edges that end at one cusp's node, both within four
-      // of their lengths of it (3D)
-      auto near_cusp = [&](int i, int j) {
-        const int ei = L.seg_edge[i], ej = L.seg_edge[j];
-        if (ei == ej || edge_node_[ei].empty() || edge_node_[ej].empty()) return false;
-        const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()},
-            vj{edge_node_[ej].front(), edge_node_[ej].back()};
-        const double reach = 4 * std::max(len3(L, i), len3(L, j));
-        for (int v : vi)
-          for (int w : vj)
-            if (v == w && cusp.count(v) && dist3(v, L, i) < reach && dist3(v, L, j) < reach) return true;
-        return false;
-      };
-      auto mark = [&](int s, bool crossing = false) {
-        auto [e, piece] = free_piece(L.seg_edge[s], L.seg_piece[s]);
-        if (e < 0 || (!crossing && is_needle(e, piece))) return;
-        const auto& ids = edge_node_[e];
-        const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
-        if (l3 > floor_len) split[e].push_back(piece), any = true;
-      };
-      // pieces longer than the face's size field there (finer features nearby in the face,
-      // e.g. a small hole close to a long straight edge) are split too
-      {
-        const PointGrid grid(fine_points(L.uv, L.segs, face_size_[f]), face_size_[f], grade_);
-        const SizeRaster thin(thin_uv_[f], face_size_[f], grade_);
-        for (size_t i = 0; i < ns; ++i) {
-          const auto& A = L.uv[L.segs[i][0]];
-          const auto& B = L.uv[L.segs[i][1]];
-          const double mid[2] = {0.5 * (A[0] + B[0]), 0.5 * (A[1] + B[1])};
-          if (len[i] > 1.5 * thin.size_at(mid, grid.size_at(mid, face_size_[f]))) mark(static_cast<int>(i));
-        }
-      }
-      for (size_t oi = 0; oi < ns; ++oi) {
-        const int i = order[oi];
-        for (size_t oj = oi + 1; oj < ns; ++oj) {
-          const int j = order[oj];
-          const double gap = std::max(len[i], len[j]) / 3;
-          if (xlo[j] > xhi[i] + gap) break;
-          if (ylo[j] > yhi[i] + gap || ylo[i] > yhi[j] + gap) continue;
-          const auto &si = L.segs[i], &sj = L.segs[j];
-          if (si[0] == sj[0] || si[0] == sj[1] || si[1] == sj[0] || si[1] == sj[1]) continue;
-          const auto &A = L.uv[si[0]], &B = L.uv[si[1]], &C = L.uv[sj[0]], &D = L.uv[sj[1]];
-          const bool cross =
-              predicates::orient2d(A.data(), B.data(), C.data()) * predicates::orient2d(A.data(), B.data(), D.data()) <=
-                  0 &&
-              predicates::orient2d(C.data(), D.data(), A.data()) * predicates::orient2d(C.data(), D.data(), B.data()) <=
-                  0;
-          const double d =
-              cross ? 0.0 : std::min({point_seg(A, C, D), point_seg(B, C, D), point_seg(C, A, B), point_seg(D, A, B)});
-          if (d >= gap || (!cross && near_cusp(i, j))) continue;
-          // the longer one is what leaves no room; both when they cross
-          if (cross || len[i] >= 0.7 * len[j]) mark(i, cross);
-          if (cross || len[j] >= 0.7 * len[i]) mark(j, cross);
-        }
-      }
+  const std::array<int, 2> vi{edge_node_[ei].front(), edge_node_[ei].back()},
+      vj{edge_node_[ej].front(), edge_node_[ej].back()};
+  const double reach = 4 * std::max(len3(i), len3(j));
+  for (int v : vi)
+    for (int w : vj)
+      if (v == w && cusp.count(v) && dist3(v, i) < reach && dist3(v, j) < reach) return true;
+  return false;
+}
+
+// Splits the marked pieces of each edge at their parameter's middle, refreshes the aliases of
+// split edges, and marks stale the faces one of whose edges changed.
+void ModelSurface::split_pieces(std::vector<std::vector<int>>& split, std::vector<char>& stale) {
+  const int ne = topo_.num_edges();
+  std::vector<char> changed(ne, 0);
+  for (int e = 0; e < ne; ++e) {
+    if (split[e].empty()) continue;
+    changed[e] = 1;
+    std::sort(split[e].begin(), split[e].end());
+    split[e].erase(std::unique(split[e].begin(), split[e].end()), split[e].end());
+    BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
+    for (auto it = split[e].rbegin(); it != split[e].rend(); ++it) {
+      const int k = *it;
+      const double t = 0.5 * (edge_param_[e][k] + edge_param_[e][k + 1]);
+      const gp_Pnt p = c.Value(t);
+      edge_param_[e].insert(edge_param_[e].begin() + k + 1, t);
+      edge_node_[e].insert(edge_node_[e].begin() + k + 1, new_node(p.X(), p.Y(), p.Z()));
     }
-    if (!any) break;
-    std::vector<char> changed(ne, 0);
-    for (int e = 0; e < ne; ++e) {
-      if (split[e].empty()) continue;
-      changed[e] = 1;
-      std::sort(split[e].begin(), split[e].end());
-      split[e].erase(std::unique(split[e].begin(), split[e].end()), split[e].end());
-      BRepAdaptor_Curve c(TopoDS::Edge(topo_.edges(e + 1).Oriented(TopAbs_FORWARD)));
-      for (auto it = split[e].rbegin(); it != split[e].rend(); ++it) {
-        const int k = *it;
-        const double t = 0.5 * (edge_param_[e][k] + edge_param_[e][k + 1]);
-        const gp_Pnt p = c.Value(t);
-        edge_param_[e].insert(edge_param_[e].begin() + k + 1, t);
-        edge_node_[e].insert(edge_node_[e].begin() + k + 1, new_node(p.X(), p.Y(), p.Z()));
-      }
-    }
-    for (int e = 0; e < ne; ++e)
-      if (edge_kind_[e] == EdgeKind::Alias && changed[alias_of_[e][0]]) refresh_alias(e), changed[e] = 1;
-    for (int f = 0; f < nf; ++f)
-      for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f) && !stale[f]; ++e)
-        stale[f] = changed[*e];
   }
+  for (int e = 0; e < ne; ++e)
+    if (edge_kind_[e] == EdgeKind::Alias && changed[alias_of_[e][0]]) refresh_alias(e), changed[e] = 1;
+  for (int f = 0; f < topo_.num_faces(); ++f)
+    for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f) && !stale[f]; ++e)
+      stale[f] = changed[*e];
 }
 
 void ModelSurface::constrain_face(int f, int a, int b) {
@@ -896,13 +837,48 @@ void ModelSurface::alias_face(int f, int src, bool reversed) { face_alias_[f] = 
 // honouring the constraint segments and nodes, then the triangles are improved on the
 // surface (constraint nodes and segments fixed).
 void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
+  const FaceInput in = face_input(f);
+  const Loops& L = in.loops;
+  FaceFrontInput front;
+  front.P.resize(static_cast<long>(L.uv.size()), 2);
+  for (size_t i = 0; i < L.uv.size(); ++i) front.P.row(static_cast<long>(i)) << L.uv[i][0], L.uv[i][1];
+  front.boundary.resize(static_cast<long>(L.segs.size()), 2);
+  for (size_t i = 0; i < L.segs.size(); ++i) front.boundary.row(static_cast<long>(i)) << L.segs[i][0], L.segs[i][1];
+  front.segments.resize(static_cast<long>(in.csegs.size()), 2);
+  for (size_t i = 0; i < in.csegs.size(); ++i)
+    front.segments.row(static_cast<long>(i)) << in.csegs[i][0], in.csegs[i][1];
+  front.isolated = in.isolated;
+  FaceFrontParams fp = params_.front;
+  // size: the face's, but near boundary and constraint pieces finer than that (split by
+  // proximity, from a finer neighbour, or from the other model) it grows from their length
+  // at the gradation rate, and inside thin walls from half their thickness
+  const double hf = face_size_[f];
+  std::vector<std::array<int, 2>> all_segs = L.segs;
+  all_segs.insert(all_segs.end(), in.csegs.begin(), in.csegs.end());
+  const PointSizeField fine(fine_points(L.uv, all_segs, hf), hf, grade_);
+  const SizeRaster& thin = thin_size_[f];
+  fp.size = [hf, &fine, &thin](const double* q) { return thin.size_at(q, fine.size_at(q, hf)); };
+  FaceFrontResult r;
+  try {
+    r = fill_face(front, fp, prog);
+  } catch (const Error& err) {
+    if (err.code() == ErrorCode::Cancelled) throw;
+    out.error = err.what();
+    return;
+  }
+  improve_on_surface(f, in, r, out);
+}
+
+// Face f's loops in its scaled parameters, then its constraint segments and nodes in the same
+// local numbering: a boundary node takes its local copy (the one nearest the segment's other
+// end on a seam), any other node its parameters by projection onto the surface (appended to
+// the loops' nodes).
+ModelSurface::FaceInput ModelSurface::face_input(int f) const {
   const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
   const FaceGeometry& g = geo_[f];
-  Loops loops = face_loops(f);
-  std::vector<std::array<double, 2>>& uv = loops.uv;
-  std::vector<int> global = std::move(loops.global);
-  // constraint nodes: a boundary node takes its local copy (the one nearest the segment's
-  // other end on a seam), any other node its parameters by projection onto the surface
+  FaceInput in{face_loops(f), {}, {}};
+  std::vector<std::array<double, 2>>& uv = in.loops.uv;
+  std::vector<int>& global = in.loops.global;
   std::unordered_map<int, std::vector<int>> locals;
   for (size_t l = 0; l < global.size(); ++l) locals[global[l]].push_back(static_cast<int>(l));
   ShapeAnalysis_Surface sas(BRep_Tool::Surface(fwd));
@@ -939,7 +915,6 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
           best = l;
     return best;
   };
-  std::vector<std::array<int, 2>> csegs;
   for (const auto& s : constraint_[f]) {
     const bool a_unique = locals.count(s[0]) && locals[s[0]].size() == 1;
     int a, b;
@@ -950,42 +925,20 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
       b = local_of(s[1], -1);
       a = local_of(s[0], b);
     }
-    csegs.push_back({a, b});
+    in.csegs.push_back({a, b});
   }
-  std::vector<int> isolated;
   for (int n : face_extra_nodes_[f])
-    if (!locals.count(n)) isolated.push_back(local_of(n, -1));
+    if (!locals.count(n)) in.isolated.push_back(local_of(n, -1));
+  return in;
+}
 
-  FaceFrontInput in;
-  in.P.resize(static_cast<long>(uv.size()), 2);
-  for (size_t i = 0; i < uv.size(); ++i) in.P.row(static_cast<long>(i)) << uv[i][0], uv[i][1];
-  in.boundary.resize(static_cast<long>(loops.segs.size()), 2);
-  for (size_t i = 0; i < loops.segs.size(); ++i)
-    in.boundary.row(static_cast<long>(i)) << loops.segs[i][0], loops.segs[i][1];
-  in.segments.resize(static_cast<long>(csegs.size()), 2);
-  for (size_t i = 0; i < csegs.size(); ++i) in.segments.row(static_cast<long>(i)) << csegs[i][0], csegs[i][1];
-  in.isolated = isolated;
-  FaceFrontParams fp = params_.front;
-  // size: the face's, but near boundary and constraint pieces finer than that (split by
-  // proximity, from a finer neighbour, or from the other model) it grows from their length
-  // at the gradation rate
-  const double hf = face_size_[f];
-  std::vector<std::array<int, 2>> all_segs = loops.segs;
-  all_segs.insert(all_segs.end(), csegs.begin(), csegs.end());
-  const PointGrid grid(fine_points(uv, all_segs, hf), hf, grade_);
-  const SizeRaster thin(thin_uv_[f], hf, grade_);  // and inside thin walls, half their thickness
-  fp.size = [hf, &grid, &thin](const double* q) { return thin.size_at(q, grid.size_at(q, hf)); };
-  FaceFrontResult r;
-  try {
-    r = fill_face(in, fp, prog);
-  } catch (const Error& err) {
-    if (err.code() == ErrorCode::Cancelled) throw;
-    out.error = err.what();
-    return;
-  }
-  // local optimisation judged on the surface; triangles collapsed on an apex keep their edges
+// Local optimisation of the front's triangles r judged on the surface; the face's input
+// nodes stay, constraint segments are locked, and triangles collapsed on an apex keep their
+// edges. Leaves the face's mesh in `out`.
+void ModelSurface::improve_on_surface(int f, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const {
+  const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
   BRepAdaptor_Surface s(fwd, Standard_False);
-  const double su = g.su, sv = g.sv;
+  const double su = geo_[f].su, sv = geo_[f].sv;
   SurfaceEval eval = [&s, su, sv](const double* q, double* x, double* du, double* dv) {
     gp_Pnt p;
     gp_Vec a, b;
@@ -994,7 +947,8 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
     du[0] = a.X() / su, du[1] = a.Y() / su, du[2] = a.Z() / su;
     dv[0] = b.X() / sv, dv[1] = b.Y() / sv, dv[2] = b.Z() / sv;
   };
-  std::vector<std::array<int, 2>> locked = csegs;
+  const std::vector<int>& global = in.loops.global;
+  std::vector<std::array<int, 2>> locked = in.csegs;
   const long nin = static_cast<long>(global.size());
   for (long t = 0; t < r.T.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
@@ -1002,7 +956,7 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
       if (a < nin && b < nin && global[a] == global[b]) locked.push_back({a, c}), locked.push_back({b, c});
     }
   optimize_on_surface(r.P, r.T, out.X, static_cast<int>(nin), eval, locked, params_.optimize_rounds);
-  out.global = std::move(global);
+  out.global = global;
   out.T = std::move(r.T);
 }
 
@@ -1023,58 +977,65 @@ void ModelSurface::mesh_faces(const Progress& progress) {
                  [&](int f, const Progress& prog) { mesh_face(f, prog, face_out[f]); });
   for (int f = 0; f < nf; ++f) {
     if (face_given_[f] || face_alias_[f][0] >= 0) continue;
-    FaceOut& fo = face_out[f];
-    if (!fo.error.empty()) {
-      failed_.push_back(f + 1);
-      reasons_.push_back(fo.error);
-      continue;
-    }
-    const long nin = static_cast<long>(fo.global.size());
-    // the face's own nodes that its triangles use (the optimiser's collapses leave some unused)
-    std::vector<int> to_global(fo.X.rows(), -1);
-    for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];
-    for (long t = 0; t < fo.T.rows(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int i = fo.T(t, k);
-        if (to_global[i] < 0) to_global[i] = new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
-      }
-    const bool flip = topo_.faces(f + 1).Orientation() == TopAbs_REVERSED;
-    auto& tris = face_tris_[f];
-    tris.clear();
-    for (long t = 0; t < fo.T.rows(); ++t) {
-      std::array<int, 3> tri{to_global[fo.T(t, 0)], to_global[fo.T(t, 1)], to_global[fo.T(t, 2)]};
-      if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;  // collapsed on an apex
-      if (flip) std::swap(tri[1], tri[2]);
-      tris.push_back(tri);
-    }
-    fo = FaceOut();
+    take_face_mesh(f, face_out[f]);
+    face_out[f] = FaceOut();
   }
-  // aliased faces (solids that touch): the source's triangles, after checking that their
-  // boundary is this face's boundary
-  for (int f = 0; f < nf; ++f) {
-    const auto [src, reversed] = face_alias_[f];
-    if (src < 0) continue;
-    std::vector<std::array<int, 3>> tris = face_tris_[src];
-    if (reversed)
-      for (auto& t : tris) std::swap(t[1], t[2]);
-    std::set<std::pair<int, int>> mine, theirs;
-    const Loops L = face_loops(f);
-    for (const auto& s : L.segs) mine.insert(std::minmax(L.global[s[0]], L.global[s[1]]));
-    std::map<std::pair<int, int>, int> uses;
-    for (const auto& t : tris)
-      for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
-    for (const auto& [e, n] : uses)
-      if (n == 1) theirs.insert(e);
-    if (tris.empty() || mine != theirs) {
-      failed_.push_back(f + 1);
-      std::ostringstream m;
-      m << "Face" << f + 1 << " lies on Face" << src + 1
-        << " but their boundaries differ (only identical touching faces are supported)";
-      reasons_.push_back(m.str());
-      continue;
-    }
-    face_tris_[f] = std::move(tris);
+  for (int f = 0; f < nf; ++f)
+    if (face_alias_[f][0] >= 0) copy_aliased_face(f);
+}
+
+// A filled face's mesh into the pool: its own nodes that its triangles use become pool nodes
+// (the optimiser's collapses leave some unused), its triangles turn out of the solid that holds
+// the face, those collapsed on an apex are dropped. A face that failed is listed with its reason.
+void ModelSurface::take_face_mesh(int f, const FaceOut& fo) {
+  if (!fo.error.empty()) {
+    failed_.push_back(f + 1);
+    reasons_.push_back(fo.error);
+    return;
   }
+  const long nin = static_cast<long>(fo.global.size());
+  std::vector<int> to_global(fo.X.rows(), -1);
+  for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];
+  for (long t = 0; t < fo.T.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int i = fo.T(t, k);
+      if (to_global[i] < 0) to_global[i] = new_node(fo.X(i, 0), fo.X(i, 1), fo.X(i, 2));
+    }
+  const bool flip = topo_.faces(f + 1).Orientation() == TopAbs_REVERSED;
+  auto& tris = face_tris_[f];
+  tris.clear();
+  for (long t = 0; t < fo.T.rows(); ++t) {
+    std::array<int, 3> tri{to_global[fo.T(t, 0)], to_global[fo.T(t, 1)], to_global[fo.T(t, 2)]};
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) continue;  // collapsed on an apex
+    if (flip) std::swap(tri[1], tri[2]);
+    tris.push_back(tri);
+  }
+}
+
+// An aliased face (solids that touch): the source's triangles, after checking that their
+// boundary is this face's boundary.
+void ModelSurface::copy_aliased_face(int f) {
+  const auto [src, reversed] = face_alias_[f];
+  std::vector<std::array<int, 3>> tris = face_tris_[src];
+  if (reversed)
+    for (auto& t : tris) std::swap(t[1], t[2]);
+  std::set<std::pair<int, int>> mine, theirs;
+  const Loops L = face_loops(f);
+  for (const auto& s : L.segs) mine.insert(std::minmax(L.global[s[0]], L.global[s[1]]));
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+  for (const auto& [e, n] : uses)
+    if (n == 1) theirs.insert(e);
+  if (tris.empty() || mine != theirs) {
+    failed_.push_back(f + 1);
+    std::ostringstream m;
+    m << "Face" << f + 1 << " lies on Face" << src + 1
+      << " but their boundaries differ (only identical touching faces are supported)";
+    reasons_.push_back(m.str());
+    return;
+  }
+  face_tris_[f] = std::move(tris);
 }
 
 std::vector<std::array<int, 3>> ModelSurface::solid_triangles(int s) const {
@@ -1142,17 +1103,7 @@ MatX3i solid_triangles(const brep::TopologyIndex& topo, const SurfaceMesh& mesh,
   return out;
 }
 
-long open_edges(const MatX3i& T) {
-  std::map<std::pair<int, int>, int> directed;
-  for (long t = 0; t < T.rows(); ++t)
-    for (int k = 0; k < 3; ++k) ++directed[{T(t, k), T(t, (k + 1) % 3)}];
-  long open = 0;
-  for (const auto& [e, n] : directed) {
-    auto rev = directed.find({e.second, e.first});
-    if (n != 1 || rev == directed.end() || rev->second != 1) ++open;
-  }
-  return open;
-}
+long open_edges(const MatX3i& T) { return check_surface(T).unpaired_edges; }
 
 std::vector<long> open_edges_per_solid(const brep::TopologyIndex& topo, const SurfaceMesh& mesh) {
   std::vector<long> result;

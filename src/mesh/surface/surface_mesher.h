@@ -14,6 +14,7 @@
 #pragma once
 #include <array>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -21,6 +22,9 @@
 #include "common/progress.h"
 #include "common/types.h"
 #include "mesh/surface/face_front.h"
+#include "mesh/surface/graded_size.h"
+
+class TopoDS_Face;
 
 namespace topopt::mesh {
 
@@ -121,13 +125,17 @@ class ModelSurface {
 
  private:
   enum class EdgeKind { Free, Given, Alias };
+  /// A per-direction scale making lengths in (su·u, sv·v) approximate lengths on the face,
+  /// and its largest curvature.
   struct FaceGeometry {
     double su = 1, sv = 1, kmax = 0;
   };
+  /// An edge sampled finely: parameters, arc length and the size allowed at each sample.
   struct EdgeSamples {
     std::vector<double> t, s, size;
     int va = -1, vb = -1;
   };
+  /// A face's boundary in its scaled parameters (see face_loops).
   struct Loops {
     std::vector<std::array<double, 2>> uv;
     std::vector<int> global;
@@ -135,20 +143,83 @@ class ModelSurface {
     std::vector<int> seg_edge;
     std::vector<int> seg_piece;
   };
-  std::vector<std::pair<double, int>> division(int e) const;
-  void discretise(int e);
-  void match_vertex_sizes();
-  void grade_vertex_sizes();
-  void measure_thickness();
-  void refresh_alias(int e);
-  Loops face_loops(int f) const;
+  /// Where an edge's nodes go: (parameter, node; -1 where one is to be made), first vertex to last.
+  using Division = std::vector<std::pair<double, int>>;
+  /// A division and the sizes of the edge's first and last vertex it was made at.
+  struct EdgeDivision {
+    Division at;
+    double size_a = -1, size_b = -1;
+  };
+  /// A coarse tessellation of the model: points, outward triangles, each point's scaled
+  /// parameters on its face, each triangle's face (-1: a face without parameters).
+  struct Tessellation {
+    MatX3d V;
+    MatX3i F;
+    std::vector<std::array<double, 2>> uv;
+    std::vector<int> face;
+  };
+  /// Face corners that proximity splits leave alone: per edge, whether its first / last piece
+  /// is at a needle corner; the nodes of cusps.
+  struct SharpCorners {
+    std::vector<std::array<char, 2>> needle_end;
+    std::unordered_set<int> cusp;
+  };
+  /// Pieces to split in one proximity round: per edge, the pieces (may repeat); any marked.
+  struct PieceSplits {
+    std::vector<std::vector<int>> pieces;
+    bool any = false;
+  };
+  /// A face's boundary segments with their lengths and boxes, ordered by their lowest u.
+  struct SegmentBoxes {
+    explicit SegmentBoxes(const Loops& L);
+    std::vector<double> len, xlo, xhi, ylo, yhi;
+    std::vector<int> order;
+  };
+  /// What the front starts from on a face: its loops (nodes extended by the projected
+  /// constraint nodes), constraint segments and isolated nodes, in the loops' local numbering.
+  struct FaceInput {
+    Loops loops;
+    std::vector<std::array<int, 2>> csegs;
+    std::vector<int> isolated;
+  };
   struct FaceOut {
     std::vector<int> global;  ///< the face's input nodes' pool numbers (the first rows of X)
     MatX3d X;                 ///< every node of the face's mesh
     MatX3i T;
     std::string error;
   };
+
+  // construction: sizes of faces, edges and vertices
+  static FaceGeometry face_geometry(const TopoDS_Face& f);
+  void size_faces();
+  void measure_thickness();
+  Tessellation coarse_tessellation() const;
+  void sample_edges();
+  void thin_edge_sizes();
+  void initial_vertex_sizes();
+  void grade_vertex_sizes();
+  // edges
+  Division division(int e) const;
+  void discretise(int e, const Division& d);
+  std::vector<EdgeDivision> match_vertex_sizes();
+  void refresh_alias(int e);
+  void split_by_proximity(const Progress& progress);
+  std::pair<int, int> free_piece(int e, int piece) const;
+  SharpCorners sharp_corners() const;
+  void mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners, PieceSplits& splits) const;
+  void mark_long_pieces(int f, const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
+                        PieceSplits& splits) const;
+  void mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
+                         PieceSplits& splits) const;
+  bool near_cusp(const Loops& L, int i, int j, const std::unordered_set<int>& cusp) const;
+  void split_pieces(std::vector<std::vector<int>>& split, std::vector<char>& stale);
+  // faces
+  Loops face_loops(int f) const;
   void mesh_face(int f, const Progress& progress, FaceOut& out) const;
+  FaceInput face_input(int f) const;
+  void improve_on_surface(int f, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const;
+  void take_face_mesh(int f, const FaceOut& fo);
+  void copy_aliased_face(int f);
   int new_node(double x, double y, double z);
 
   const brep::TopologyIndex& topo_;
@@ -159,8 +230,8 @@ class ModelSurface {
   std::vector<double> face_size_;
   std::vector<EdgeSamples> samples_;
   std::vector<double> vsize_;
-  std::vector<std::vector<std::array<double, 3>>> thin_uv_;  ///< per face: (scaled u, v, size)
-  std::vector<std::array<double, 4>> wall_points_;           ///< see wall_points()
+  std::vector<SizeRaster> thin_size_;               ///< per face: the size inside thin walls
+  std::vector<std::array<double, 4>> wall_points_;  ///< see wall_points()
   std::vector<int> vertex_node_;
   std::vector<EdgeKind> edge_kind_;
   std::vector<std::array<int, 2>> alias_of_;                ///< (rep, reversed) per aliased edge
@@ -176,8 +247,9 @@ class ModelSurface {
   std::vector<std::string> reasons_;
 };
 
-/// The number of edges of the triangles T (#T by 3) not used exactly twice in opposite
-/// directions (0 for a closed, consistently oriented surface).
+/// The number of directed edges of the triangles T (#T by 3) not used exactly once each way
+/// (0 for a closed, consistently oriented surface): check_surface(T).unpaired_edges of
+/// common/closed_surface.h, under the name the 14 steps use.
 long open_edges(const MatX3i& T);
 
 /// Per solid of `topo`: the number of mesh edges not used exactly twice in opposite directions
