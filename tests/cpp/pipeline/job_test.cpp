@@ -73,9 +73,9 @@ TEST(Job, OptimizationSectionIsTypedOnce) {
   EXPECT_EQ(p.law.penalty, 3.5);
   EXPECT_EQ(p.filter.kind, simp::FilterKind::Cone);
   EXPECT_EQ(p.filter.radius, 4);
-  EXPECT_TRUE(p.heaviside);
-  EXPECT_EQ(p.beta_max, 16);
-  EXPECT_EQ(p.beta_every, 10);
+  EXPECT_TRUE(p.projection.enabled);
+  EXPECT_EQ(p.projection.beta_max, 16);
+  EXPECT_EQ(p.projection.max_iterations_per_beta, 10);
   EXPECT_EQ(p.update, simp::UpdateKind::MMA);
   EXPECT_EQ(p.solver.kind, fem::SolverKind::Direct);
   EXPECT_EQ(p.solver.tolerance, 1e-6);
