@@ -68,7 +68,7 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
 
 std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
   std::vector<char> anchors(mesh.V.rows(), 0);
-  for (int dof : fem::make_supports(mesh, job.supports).dofs) anchors[dof / 3] = 1;
+  for (int dof : fem::make_supports(mesh, job.supports).dofs) anchors[dof / 3] = result::kAnchorSupport;
   std::vector<fem::LoadCase> cases = job.load_cases;
   for (auto& lc : cases)
     lc.items.erase(std::remove_if(lc.items.begin(), lc.items.end(),
@@ -76,7 +76,7 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
                    lc.items.end());
   const Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, cases);
   for (long i = 0; i < loads.rows(); ++i)
-    if (loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] = 1;
+    if (loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] |= result::kAnchorLoad;
   return anchors;
 }
 

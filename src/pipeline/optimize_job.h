@@ -33,8 +33,9 @@ struct OptimizeResult {
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {});
 
-/// The nodes where a support or a force or pressure acts (#V, 1 there): what the design must
-/// connect. Gravity acts everywhere and does not count.
+/// The nodes where a support (result::kAnchorSupport) or a force or pressure
+/// (result::kAnchorLoad) acts: #V flags, what the design must connect. Gravity acts
+/// everywhere and does not count.
 std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 
 /// The result shape of element densities (#T) at a threshold (< 0: the one that keeps

@@ -72,13 +72,14 @@ std::string mm3(double v) {
 struct Pieces {
   std::vector<double> volume;
   std::vector<std::set<int>> nondesign;
-  std::vector<char> anchored;
+  std::vector<char> touch;    // kAnchorSupport | kAnchorLoad of the anchor nodes in it
+  std::vector<char> main;     // carries the loads (see measure_pieces)
   std::vector<Point> centre;  // volume-weighted
 };
 
 Pieces measure_pieces(const TetMesh& mesh, const VecXi& label, int count, const std::vector<char>& anchors) {
   Pieces p{std::vector<double>(count, 0), std::vector<std::set<int>>(count), std::vector<char>(count, 0),
-           std::vector<Point>(count, Point::Zero())};
+           std::vector<char>(count, 0), std::vector<Point>(count, Point::Zero())};
   for (long t = 0; t < mesh.T.rows(); ++t) {
     const int c = label[t];
     if (c < 0) continue;
@@ -87,12 +88,16 @@ Pieces measure_pieces(const TetMesh& mesh, const VecXi& label, int count, const 
     p.centre[c] += v * tet_centre(mesh, t);
     if (mesh.domain[t] != 0) p.nondesign[c].insert(mesh.domain[t]);
     if (!anchors.empty())
-      for (int k = 0; k < 4; ++k) p.anchored[c] |= anchors[mesh.T(t, k)];
+      for (int k = 0; k < 4; ++k) p.touch[c] |= anchors[mesh.T(t, k)];
   }
   for (int c = 0; c < count; ++c) p.centre[c] /= std::max(p.volume[c], 1e-300);
-  // without anchors (or none reached) the largest piece stands for the part that carries the loads
-  if (count > 0 && std::none_of(p.anchored.begin(), p.anchored.end(), [](char a) { return a; }))
-    p.anchored[std::max_element(p.volume.begin(), p.volume.end()) - p.volume.begin()] = 1;
+  // the pieces that carry loads to supports; failing those, the ones with either; failing
+  // those (no anchors given), the largest piece
+  const char both = kAnchorSupport | kAnchorLoad;
+  const bool any_both = std::any_of(p.touch.begin(), p.touch.end(), [&](char a) { return (a & both) == both; });
+  for (int c = 0; c < count; ++c) p.main[c] = any_both ? (p.touch[c] & both) == both : p.touch[c] != 0;
+  if (count > 0 && std::none_of(p.main.begin(), p.main.end(), [](char a) { return a; }))
+    p.main[std::max_element(p.volume.begin(), p.volume.end()) - p.volume.begin()] = 1;
   return p;
 }
 
@@ -118,41 +123,50 @@ void remove_piece(const TetMesh& mesh, const VecXi& label, int c, std::vector<ch
   }
 }
 
-/// Takes the pieces no anchor reaches out of the design (out, solid), or names their
-/// non-design solids; warns when the anchored material itself is in several pieces.
-void remove_pieces(const TetMesh& mesh, const MatX4i& nb, bool have_anchors, const std::vector<char>& anchors,
-                   std::vector<char>& solid, VecXd& out, HygieneReport& report) {
+/// Why piece c is apart, in words.
+std::string apart_because(char touch, bool have_anchors) {
+  if (touch & kAnchorLoad) return "carries a load that does not reach the supports";
+  if (touch & kAnchorSupport) return "holds a support but no load";
+  return have_anchors ? "touches no support and no load" : "lies apart from the largest piece";
+}
+
+/// Takes the pieces that carry no load to a support out of the design (out, solid) when they
+/// are design material with no load on it, or names their non-design solids; warns when the
+/// material carrying loads is itself in several pieces.
+void remove_pieces(const TetMesh& mesh, const MatX4i& nb, const std::vector<char>& anchors, std::vector<char>& solid,
+                   VecXd& out, HygieneReport& report) {
   int count = 0;
   const VecXi label = tet_components(nb, solid, count);
   const Pieces p = measure_pieces(mesh, label, count, anchors);
   report.pieces = count;
-  std::vector<std::string> anchored_names;
-  const std::string reach = have_anchors ? "touches no support and no load" : "lies apart from the largest piece";
+  std::vector<std::string> main_names;
   for (int c = 0; c < count; ++c) {
     const std::vector<int> nd(p.nondesign[c].begin(), p.nondesign[c].end());
-    if (p.anchored[c]) {
+    if (p.main[c]) {
       ++report.anchored_pieces;
-      anchored_names.push_back(nd.empty() ? "design material only" : solids_named(nd));
+      main_names.push_back(nd.empty() ? "design material only" : solids_named(nd));
       continue;
     }
-    report.apart.push_back({p.volume[c], nd, nd.empty()});
-    if (nd.empty()) {
+    const std::string why = apart_because(p.touch[c], !anchors.empty());
+    const bool removed = nd.empty() && !(p.touch[c] & kAnchorLoad);
+    report.apart.push_back({p.volume[c], nd, removed});
+    if (removed) {
       remove_piece(mesh, label, c, solid, out);
       report.warnings.push_back("removed a loose piece of the design (" + mm3(p.volume[c]) + ", " + at(p.centre[c]) +
-                                "): it " + reach);
+                                "): it " + why);
     } else {
-      report.warnings.push_back(solids_named(nd) + " " + (nd.size() == 1 ? "is" : "are") +
-                                " not connected by the design to the supports and loads (a piece of " +
-                                mm3(p.volume[c]) + " that " + reach +
-                                "): lower the threshold or raise the volume fraction");
+      report.warnings.push_back(
+          (nd.empty() ? "a piece of the design" : solids_named(nd)) + " " + (nd.size() > 1 ? "are" : "is") +
+          " not connected by the design to the rest that carries the loads (a piece of " + mm3(p.volume[c]) + ", " +
+          at(p.centre[c]) + ", that " + why + "): lower the threshold or raise the volume fraction");
     }
   }
   if (report.anchored_pieces > 1) {
     std::string list;
-    for (size_t i = 0; i < anchored_names.size(); ++i) list += (i ? "; " : "") + anchored_names[i];
+    for (size_t i = 0; i < main_names.size(); ++i) list += (i ? "; " : "") + main_names[i];
     report.warnings.push_back("the design falls apart into " + std::to_string(report.anchored_pieces) +
-                              " pieces that each hold a support or a load (" + list +
-                              "): the loads do not all reach the supports; lower the threshold or raise the "
+                              " pieces that each hold supports or loads (" + list +
+                              "): check that every load reaches a support; lower the threshold or raise the "
                               "volume fraction");
   }
 }
@@ -317,7 +331,7 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
   const MatX4i nb = tet_neighbours(mesh.T);
   std::vector<char> solid = crisp_tets(mesh, node_densities(mesh, density), threshold);
   VecXd out = density;
-  remove_pieces(mesh, nb, !anchors.empty(), anchors, solid, out, report);
+  remove_pieces(mesh, nb, anchors, solid, out, report);
   fill_voids(mesh, nb, params, solid, out, report);
   report.min_feature = min_feature_size(mesh, nb, solid, report.min_feature_at);
   return out;

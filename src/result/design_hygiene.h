@@ -12,6 +12,9 @@
 
 namespace topopt::result {
 
+/// Anchor node flags (bits): a support acts there, a load (force or pressure) acts there.
+inline constexpr char kAnchorSupport = 1, kAnchorLoad = 2;
+
 struct HygieneParams {
   bool fill_voids = true;  ///< fill closed internal voids; false keeps them (printed lattices)
 };
@@ -57,13 +60,15 @@ VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, in
 double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std::vector<char>& solid,
                         std::array<double, 3>& at);
 
-/// Cleans element densities (#T) at the threshold of the result shape: solid pieces that
-/// touch no anchor node (anchors: #V, 1 where a support or a load acts; empty = unknown, then
-/// the largest piece is the one kept) are set to density 0 unless they hold non-design
-/// solids, which are named instead; closed voids (void tets face-connected to no boundary
-/// face of the mesh) are set to 1 when params.fill_voids. Fills `report` (warnings for every
-/// removal, every non-design solid apart from the rest and every kept void) and returns the
-/// cleaned densities (#T).
+/// Cleans element densities (#T) at the threshold of the result shape. anchors: #V flags
+/// (kAnchorSupport | kAnchorLoad) of the nodes where supports and loads act; empty when
+/// unknown. The pieces that hold both a support and a load carry the loads (failing those,
+/// the pieces holding either; failing those, the largest piece); every other piece is apart:
+/// set to density 0 when it is design material with no load on it, named otherwise (its
+/// non-design solids, or a loaded piece of the design). Closed voids (void tets
+/// face-connected to no boundary face of the mesh) are set to 1 when params.fill_voids.
+/// Fills `report` (a warning for every removal, every piece apart, several load-carrying
+/// pieces, filled or kept voids) and returns the cleaned densities (#T).
 VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
                    const HygieneParams& params, HygieneReport& report);
 

@@ -104,15 +104,35 @@ TEST(DesignHygiene, ANonDesignSolidApartFromTheSupportsIsNamedAndKept) {
   EXPECT_NEAR(rep.apart[0].volume, 200, 1e-9);
   ASSERT_EQ(rep.warnings.size(), 1u);
   EXPECT_NE(rep.warnings[0].find("non-design solid 2 is not connected"), std::string::npos) << rep.warnings[0];
+  EXPECT_NE(rep.warnings[0].find("touches no support and no load"), std::string::npos) << rep.warnings[0];
   EXPECT_EQ(clean, d);
-  // anchors at both ends: two pieces that each hold a support or load, and that is said too
+  // the support at x = 0 and the load at x = 10: the load does not reach the support
   std::vector<char> both = anchors_at_x0(m);
-  for (long v = 0; v < m.V.rows(); ++v) both[v] |= m.V(v, 0) > 10 - 1e-9;
+  for (long v = 0; v < m.V.rows(); ++v)
+    if (m.V(v, 0) > 10 - 1e-9) both[v] = kAnchorLoad;
   clean_design(m, d, 0.5, both, {}, rep);
   EXPECT_EQ(rep.anchored_pieces, 2);
   ASSERT_EQ(rep.warnings.size(), 1u);
   EXPECT_NE(rep.warnings[0].find("falls apart into 2 pieces"), std::string::npos) << rep.warnings[0];
   EXPECT_NE(rep.warnings[0].find("non-design solid 1; non-design solid 2"), std::string::npos) << rep.warnings[0];
+}
+
+TEST(DesignHygiene, APieceWithASupportButNoLoadIsApartFromTheOneCarryingTheLoad) {
+  // non-design solids 1 (supported, x = 0) and 2 (supported, x = 10); the load on solid 1's
+  // top; the design connects nothing, so solid 2 holds a support that carries nothing
+  const TetMesh m = cube({{0, 0, 0, 2, 10, 10}, {8, 0, 0, 10, 10, 10}});
+  std::vector<char> anchors(m.V.rows(), 0);
+  for (long v = 0; v < m.V.rows(); ++v) {
+    if (m.V(v, 0) < 1e-9 || m.V(v, 0) > 10 - 1e-9) anchors[v] = kAnchorSupport;
+    if (m.V(v, 2) > 10 - 1e-9 && m.V(v, 0) < 2 + 1e-9) anchors[v] |= kAnchorLoad;
+  }
+  HygieneReport rep;
+  clean_design(m, densities(m, {}), 0.5, anchors, {}, rep);
+  EXPECT_EQ(rep.anchored_pieces, 1);
+  ASSERT_EQ(rep.apart.size(), 1u);
+  EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{2});
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("holds a support but no load"), std::string::npos) << rep.warnings[0];
 }
 
 TEST(DesignHygiene, ClosedVoidsAreFilledUnlessAllowedAndOpenOnesStay) {
