@@ -133,10 +133,10 @@ std::string apart_because(char touch, bool have_anchors) {
 /// Takes the pieces that carry no load to a support out of the design (out, solid) when they
 /// are design material with no load on it, or names their non-design solids; warns when the
 /// material carrying loads is itself in several pieces.
-void remove_pieces(const TetMesh& mesh, const MatX4i& nb, const std::vector<char>& anchors, std::vector<char>& solid,
-                   VecXd& out, HygieneReport& report) {
+void remove_pieces(const TetMesh& mesh, const std::vector<char>& anchors, std::vector<char>& solid, VecXd& out,
+                   HygieneReport& report) {
   int count = 0;
-  const VecXi label = tet_components(nb, solid, count);
+  const VecXi label = node_components(mesh, solid, count);
   const Pieces p = measure_pieces(mesh, label, count, anchors);
   report.pieces = count;
   std::vector<std::string> main_names;
@@ -249,6 +249,36 @@ std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, dou
   return solid;
 }
 
+VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count) {
+  const long nt = mesh.T.rows(), nv = mesh.V.rows();
+  // the masked tets around each node (compressed rows)
+  std::vector<int> start(nv + 1, 0), around;
+  for (long t = 0; t < nt; ++t)
+    for (int k = 0; k < 4 && mask[t]; ++k) ++start[mesh.T(t, k) + 1];
+  for (long v = 0; v < nv; ++v) start[v + 1] += start[v];
+  around.resize(start[nv]);
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (long t = 0; t < nt; ++t)
+    for (int k = 0; k < 4 && mask[t]; ++k) around[fill[mesh.T(t, k)]++] = static_cast<int>(t);
+  VecXi label = VecXi::Constant(nt, -1);
+  count = 0;
+  std::vector<int> stack;
+  for (long s = 0; s < nt; ++s) {
+    if (!mask[s] || label[s] >= 0) continue;
+    label[s] = count;
+    stack.assign(1, static_cast<int>(s));
+    while (!stack.empty()) {
+      const int t = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 4; ++k)
+        for (int i = start[mesh.T(t, k)]; i < start[mesh.T(t, k) + 1]; ++i)
+          if (label[around[i]] < 0) label[around[i]] = count, stack.push_back(around[i]);
+    }
+    ++count;
+  }
+  return label;
+}
+
 VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count) {
   VecXi label = VecXi::Constant(neighbours.rows(), -1);
   count = 0;
@@ -331,7 +361,7 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
   const MatX4i nb = tet_neighbours(mesh.T);
   std::vector<char> solid = crisp_tets(mesh, node_densities(mesh, density), threshold);
   VecXd out = density;
-  remove_pieces(mesh, nb, anchors, solid, out, report);
+  remove_pieces(mesh, anchors, solid, out, report);
   fill_voids(mesh, nb, params, solid, out, report);
   report.min_feature = min_feature_size(mesh, nb, solid, report.min_feature_at);
   return out;

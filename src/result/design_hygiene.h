@@ -1,7 +1,7 @@
 // Design hygiene: what the density field hands over, cleaned before the result surface is
 // cut from it. On the tets of the crisp design (non-design tets, and design tets whose node
-// densities reach the threshold on average) it removes solid pieces that no support or load
-// reaches, names the non-design solids that end up apart from the rest, fills closed internal
+// densities reach the threshold on average) it removes solid pieces (tets sharing nodes) that
+// no support or load reaches, names the non-design solids that end up apart from the rest, fills closed internal
 // voids (unless allowed) and measures the thinnest member.
 #pragma once
 #include <array>
@@ -19,7 +19,7 @@ struct HygieneParams {
   bool fill_voids = true;  ///< fill closed internal voids; false keeps them (printed lattices)
 };
 
-/// A face-connected solid piece of the crisp design apart from the ones that carry the loads.
+/// A solid piece of the crisp design (tets sharing nodes) apart from the ones that carry the loads.
 struct DesignPiece {
   double volume = 0;           ///< mm³
   std::vector<int> nondesign;  ///< non-design solids in it (domain tags, ascending)
@@ -28,7 +28,7 @@ struct DesignPiece {
 
 /// What clean_design found and did.
 struct HygieneReport {
-  int pieces = 0;                  ///< face-connected solid pieces before cleaning
+  int pieces = 0;                  ///< solid pieces (tets sharing nodes) before cleaning
   int anchored_pieces = 0;         ///< ... of them touching a support or load node (or the largest, without anchors)
   std::vector<DesignPiece> apart;  ///< the other pieces
   int voids_filled = 0;            ///< closed internal voids filled
@@ -51,6 +51,11 @@ std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, dou
 /// Face-connected components of the tets with mask[t] set, over `neighbours` (#T by 4).
 /// Returns #T labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
 VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count);
+
+/// Components of the tets with mask[t] set that share a node (pieces touching at an edge or a
+/// corner are one: the result surface, cut from node densities, joins them). Returns #T
+/// labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
+VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count);
 
 /// The thinnest member of the solid tets (mask #T): every solid tet's centre gets its nearest
 /// point on the solid's boundary faces (the faces tried are propagated through the mesh from
