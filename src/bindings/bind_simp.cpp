@@ -123,6 +123,46 @@ surface), warnings (list of strings).)doc");
       R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
 volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
 oriented outwards.)doc");
+
+  m.def(
+      "design_report",
+      [](const MatX3d& nodes, const MatX4i& tets, const VecXi& domain, const VecXd& density, double threshold,
+         bool fill_voids) {
+        TetMesh mesh;
+        mesh.V = nodes;
+        mesh.T = tets;
+        mesh.domain = domain.size() ? domain : VecXi(VecXi::Zero(tets.rows()));
+        if (density.size() != tets.rows() || mesh.domain.size() != tets.rows())
+          throw Error(ErrorCode::InvalidParameter, "one density and one domain tag per tet expected");
+        if (!(threshold > 0 && threshold < 1))
+          throw Error(ErrorCode::InvalidParameter, "the threshold must lie strictly between 0 and 1");
+        if (tets.size() && (tets.minCoeff() < 0 || tets.maxCoeff() >= nodes.rows()))
+          throw Error(ErrorCode::InvalidParameter,
+                      "tets: node numbers must lie in 0.." + std::to_string(nodes.rows() - 1));
+        result::HygieneReport rep;
+        result::HygieneParams params;
+        params.fill_voids = fill_voids;
+        {
+          pyb::gil_scoped_release release;
+          result::clean_design(mesh, density, threshold, {}, params, rep);
+        }
+        pyb::dict d;
+        d["pieces"] = rep.pieces;
+        d["voids_filled"] = rep.voids_filled;
+        d["void_volume_filled"] = rep.void_volume_filled;
+        d["voids_kept"] = rep.voids_kept;
+        d["void_volume_kept"] = rep.void_volume_kept;
+        d["min_feature"] = rep.min_feature;
+        d["warnings"] = rep.warnings;
+        return d;
+      },
+      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold"),
+      pyb::arg("fill_voids") = true,
+      R"doc(What the design hygiene finds at a threshold (the one extract_surface cleans with): a dict with
+pieces (solid pieces before cleaning), voids_filled, void_volume_filled, voids_kept,
+void_volume_kept (mm³), min_feature (mm, thinnest member) and warnings (list of sentences: loose
+pieces removed with their volume, non-design solids apart from the largest piece, voids). For
+the workbench's threshold slider, so a re-extraction warns as the optimisation did.)doc");
 }
 
 }  // namespace topopt::py
