@@ -142,6 +142,34 @@ TEST(Job, UnknownKeysNameTheKeyAndTheNearestKnownOne) {
                  ErrorCode::InvalidParameter, {"'load_cases[0].loads[0].faces'", "whole part"});
 }
 
+TEST(Job, CrispDefaultsAndTheirKeys) {
+  // projection on and voids filled unless the job says otherwise
+  const Job plain = parse_job(R"({"optimization": {}})", "/d");
+  EXPECT_TRUE(plain.optimization.simp.projection.enabled);
+  EXPECT_TRUE(plain.optimization.hygiene.fill_voids);
+  const Job off = parse_job(R"({"optimization": {"heaviside": false, "fill_voids": false}})", "/d");
+  EXPECT_FALSE(off.optimization.simp.projection.enabled);
+  EXPECT_FALSE(off.optimization.hygiene.fill_voids);
+  const Job set = parse_job(
+      R"({"optimization": {"heaviside": {"beta_start": 2, "beta_max": 64, "factor": 1.5, "every": 25, "settle": 1e-3}}})",
+      "/d");
+  const simp::ProjectionParams& p = set.optimization.simp.projection;
+  EXPECT_TRUE(p.enabled);
+  EXPECT_EQ(p.beta_start, 2);
+  EXPECT_EQ(p.beta_max, 64);
+  EXPECT_EQ(p.beta_factor, 1.5);
+  EXPECT_EQ(p.max_iterations_per_beta, 25);
+  EXPECT_EQ(p.settle_tolerance, 1e-3);
+  expect_message(R"({"optimization": {"heaviside": {"factor": 1}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.factor'", "(1, 10]"});
+  expect_message(R"({"optimization": {"heaviside": {"beta_start": 64, "beta_max": 32}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.beta_max'", "[beta_start, 1000]"});
+  expect_message(R"({"optimization": {"heaviside": {"settle": 0}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.settle'", "(0, 1)"});
+  expect_message(R"({"optimization": {"fill_voids": "no"}})", ErrorCode::InvalidParameter,
+                 {"'optimization.fill_voids' must be true or false"});
+}
+
 TEST(Job, DuplicatedKeysAreErrors) {
   // the second "optimization" would have replaced the whole first section
   expect_message(R"({"optimization": {"volume_fraction": 0.2}, "optimization": {"penalty": 3}})",
