@@ -56,6 +56,50 @@ volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3)
 oriented outwards.)doc");
 }
 
+/// design_report: what the design hygiene finds at a threshold (the workbench's slider).
+void bind_design_report(pyb::module_& m) {
+  m.def(
+      "design_report",
+      [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
+         const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fill_voids_arg) {
+        TetMesh mesh;
+        mesh.V = points_arg(nodes_arg, "nodes", "#V");
+        mesh.T = index_arg<4>(tets_arg, "tets", mesh.V.rows(), "nodes");
+        mesh.domain = tags_arg(domain_arg, "domain", mesh.T.rows(), "tet", 0, true);
+        if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+        const double any = std::numeric_limits<double>::max();
+        const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
+        const double threshold = number_arg(threshold_arg, "threshold", 0, 1);
+        if (!(threshold > 0 && threshold < 1))
+          throw Error(ErrorCode::InvalidParameter, "the threshold must lie strictly between 0 and 1");
+        if (!pyb::isinstance<pyb::bool_>(fill_voids_arg))
+          throw Error(ErrorCode::InvalidParameter, "fill_voids must be True or False");
+        result::HygieneReport rep;
+        result::HygieneParams params;
+        params.fill_voids = fill_voids_arg.cast<bool>();
+        {
+          pyb::gil_scoped_release release;
+          result::clean_design(mesh, density, threshold, {}, params, rep);
+        }
+        pyb::dict d;
+        d["pieces"] = rep.pieces;
+        d["voids_filled"] = rep.voids_filled;
+        d["void_volume_filled"] = rep.void_volume_filled;
+        d["voids_kept"] = rep.voids_kept;
+        d["void_volume_kept"] = rep.void_volume_kept;
+        d["min_feature"] = rep.min_feature;
+        d["warnings"] = rep.warnings;
+        return d;
+      },
+      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold"),
+      pyb::arg("fill_voids") = true,
+      R"doc(What the design hygiene finds at a threshold (the one extract_surface cleans with): a dict with
+pieces (solid pieces before cleaning), voids_filled, void_volume_filled, voids_kept,
+void_volume_kept (mm³), min_feature (mm, thinnest member) and warnings (list of sentences: loose
+pieces removed with their volume, non-design solids apart from the largest piece, voids). For
+the workbench's threshold slider, so a re-extraction warns as the optimisation did.)doc");
+}
+
 }  // namespace
 
 void bind_simp(pyb::module_& m) {
@@ -142,6 +186,7 @@ boundary_faces, boundary_nondesign_faces, densities #T, history (list of dicts),
 surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp,
 surface), warnings (list of strings).)doc");
   bind_extract_surface(m);
+  bind_design_report(m);
 }
 
 }  // namespace topopt::py

@@ -303,9 +303,10 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   const auto [mesh, density] = checked_densities(r);
   ch.progress("surface", -1, "extracting the result shape");
   double used = 0;
+  result::HygieneReport hygiene;  // without supports and loads: the largest piece is kept
   const result::TriSurface s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
-                                                        volume_fraction, smooth, &used);
-  json result = {{"threshold", used}};
+                                                        volume_fraction, smooth, &used, {}, {}, &hygiene);
+  json result = {{"threshold", used}, {"warnings", hygiene.warnings}, {"min_feature", hygiene.min_feature}};
   ch.progress("write", -1, "writing the results");
   put_result_surface(result, r.output, s);
   return result;

@@ -10,6 +10,7 @@
 
 #include "fem/boundary_conditions.h"
 #include "pipeline/mesh_settings.h"
+#include "result/design_hygiene.h"
 #include "result/smoothing.h"
 #include "simp/optimizer.h"
 
@@ -20,6 +21,7 @@ struct OptimizeSettings {
   simp::SimpParams simp;  ///< the solver's tolerance 1e-5 unless given
   double threshold = -1;  ///< iso-value of the result shape; < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
+  result::HygieneParams hygiene;  ///< loose pieces out, closed voids filled (fill_voids)
 };
 
 /// The "output" section.

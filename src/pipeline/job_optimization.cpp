@@ -9,19 +9,29 @@ using nlohmann::json;
 
 namespace {
 
-/// "heaviside": false/null (off), true (defaults) or {"beta_max": 32, "every": 20}.
-void parse_heaviside(const Fields& f, simp::SimpParams& p) {
+/// "heaviside": true/null (on, the defaults), false (off) or {"beta_start": 1, "beta_max": 32,
+/// "factor": 2, "every": 40, "settle": 2e-3} (on, with those settings).
+void parse_heaviside(const Fields& f, simp::ProjectionParams& p) {
   if (!f.has("heaviside")) return;
   const json& h = f.at("heaviside");
   if (h.is_boolean()) {
-    p.heaviside = h.get<bool>();
+    p.enabled = h.get<bool>();
     return;
   }
-  const Fields sub(h, f.name("heaviside"), {"beta_max", "every"}, "{\"beta_max\": 32, \"every\": 20} (or true)");
-  p.heaviside = true;
+  const Fields sub(h, f.name("heaviside"), {"beta_max", "beta_start", "factor", "every", "settle"},
+                   "{\"beta_max\": 32, \"every\": 40} (or true, or false)");
+  p.enabled = true;
+  p.beta_start = sub.number("beta_start", p.beta_start);
+  if (!(p.beta_start >= 1 && p.beta_start <= 1000)) sub.bad("beta_start", "must lie in [1, 1000] (1 is usual)");
   p.beta_max = sub.number("beta_max", p.beta_max);
-  if (!(p.beta_max >= 1 && p.beta_max <= 1000)) sub.bad("beta_max", "must lie in [1, 1000] (32 is usual)");
-  p.beta_every = sub.integer("every", p.beta_every, 1, 10000);
+  if (!(p.beta_max >= p.beta_start && p.beta_max <= 1000))
+    sub.bad("beta_max", "must lie in [beta_start, 1000] (32 is usual)");
+  p.beta_factor = sub.number("factor", p.beta_factor);
+  if (!(p.beta_factor > 1 && p.beta_factor <= 10)) sub.bad("factor", "must lie in (1, 10] (2 is usual)");
+  p.max_iterations_per_beta = sub.integer("every", p.max_iterations_per_beta, 1, 10000);
+  p.settle_tolerance = sub.number("settle", p.settle_tolerance);
+  if (!(p.settle_tolerance > 0 && p.settle_tolerance < 1))
+    sub.bad("settle", "must lie in (0, 1) (the relative compliance change per iteration that lets beta rise)");
 }
 
 void parse_solver(const Fields& f, fem::SolverParams& s) {
@@ -54,7 +64,7 @@ OptimizeSettings parse_optimization(const json& section) {
   const Fields f(section, "optimization",
                  {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "sensitivity_filter", "heaviside",
                   "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
-                  "solver_tolerance", "smoothing_iterations"},
+                  "solver_tolerance", "smoothing_iterations", "fill_voids"},
                  "{\"volume_fraction\": 0.3}");
   OptimizeSettings s;
   simp::SimpParams& p = s.simp;
@@ -69,7 +79,7 @@ OptimizeSettings parse_optimization(const json& section) {
   p.filter.radius = f.number("filter_radius", 0);
   if (p.filter.radius < 0) f.bad("filter_radius", "must be positive (mm), or 0 for 1.5 x the mean edge length");
   p.sensitivity_filter = f.boolean("sensitivity_filter", false);
-  parse_heaviside(f, p);
+  parse_heaviside(f, p.projection);
   p.update = f.choice("update", "oc", {"oc", "mma"}, "optimality criteria or the method of moving asymptotes") == "mma"
                  ? simp::UpdateKind::MMA
                  : simp::UpdateKind::OC;
@@ -79,6 +89,7 @@ OptimizeSettings parse_optimization(const json& section) {
   if (f.has("threshold") && !(s.threshold > 0 && s.threshold < 1))
     f.bad("threshold", "must lie strictly between 0 and 1, or be null for the one that keeps the volume fraction");
   s.smooth.iterations = f.integer("smoothing_iterations", 20, 0, 1000);
+  s.hygiene.fill_voids = f.boolean("fill_voids", true);
   return s;
 }
 

@@ -1,6 +1,7 @@
 // The optimisation path of a job (see optimize_job.h).
 #include "pipeline/optimize_job.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -21,10 +22,10 @@ namespace {
 
 void write_history_csv(const std::string& path, const simp::SimpResult& simp) {
   std::ofstream f(path);
-  f << "iteration,compliance,volume_fraction,change,beta,seconds\n";
+  f << "iteration,compliance,volume_fraction,change,beta,seconds,grey\n";
   for (const auto& h : simp.history)
     f << h.iteration << "," << h.compliance << "," << h.volume_fraction << "," << h.change << "," << h.beta << ","
-      << h.seconds << "\n";
+      << h.seconds << "," << h.grey << "\n";
   if (!f) throw Error(ErrorCode::Io, "cannot write the iteration history (disk full?)");
 }
 
@@ -34,6 +35,21 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   j["converged"] = r.simp.converged;
   j["threshold"] = r.threshold;
   j["seconds"] = {{"simp", r.seconds_simp}, {"surface", r.seconds_surface}};
+  j["grey"] = r.simp.history.empty() ? 0.0 : r.simp.history.back().grey;
+  const result::HygieneReport& h = r.hygiene;
+  json apart = json::array();
+  for (const auto& p : h.apart)
+    apart.push_back({{"volume", p.volume}, {"nondesign", p.nondesign}, {"removed", p.removed}});
+  j["design"] = {{"pieces", h.pieces},
+                 {"anchored_pieces", h.anchored_pieces},
+                 {"apart", apart},
+                 {"voids_filled", h.voids_filled},
+                 {"void_volume_filled", h.void_volume_filled},
+                 {"voids_kept", h.voids_kept},
+                 {"void_volume_kept", h.void_volume_kept},
+                 {"min_feature", h.min_feature},
+                 {"min_feature_at", h.min_feature_at},
+                 {"warnings", h.warnings}};
   j["history"] = json::array();
   for (const auto& h : r.simp.history)
     j["history"].push_back({{"iteration", h.iteration},
@@ -41,6 +57,7 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
                             {"volume", h.volume_fraction},
                             {"change", h.change},
                             {"beta", h.beta},
+                            {"grey", h.grey},
                             {"seconds", h.seconds}});
   std::ofstream f(path);
   f << j.dump(2) << "\n";
@@ -49,13 +66,35 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
 
 }  // namespace
 
+std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
+  std::vector<char> anchors(mesh.V.rows(), 0);
+  for (int dof : fem::make_supports(mesh, job.supports).dofs) anchors[dof / 3] = result::kAnchorSupport;
+  std::vector<fem::LoadCase> cases = job.load_cases;
+  for (auto& lc : cases)
+    lc.items.erase(std::remove_if(lc.items.begin(), lc.items.end(),
+                                  [](const fem::LoadSpec& l) { return l.kind == fem::LoadSpec::Kind::Gravity; }),
+                   lc.items.end());
+  const Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, cases);
+  for (long i = 0; i < loads.rows(); ++i)
+    if (loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] |= result::kAnchorLoad;
+  return anchors;
+}
+
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
-                                  const result::SmoothParams& smooth, double* threshold_used) {
-  const VecXd node_density = result::node_densities(mesh, density);
-  const double t = threshold > 0 ? threshold : result::threshold_for_volume(mesh, node_density, volume_fraction);
+                                  const result::SmoothParams& smooth, double* threshold_used,
+                                  const std::vector<char>& anchors, const result::HygieneParams& hygiene,
+                                  result::HygieneReport* report, VecXd* design, const Progress& progress) {
+  const double t = threshold > 0
+                       ? threshold
+                       : result::threshold_for_volume(mesh, result::node_densities(mesh, density), volume_fraction);
   if (threshold_used) *threshold_used = t;
-  result::TriSurface s = result::extract_iso_surface(mesh, node_density, t);
+  result::HygieneReport found;
+  const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
+  for (const std::string& w : found.warnings) progress.warn(w);
+  result::TriSurface s = result::extract_iso_surface(mesh, result::node_densities(mesh, cleaned), t);
   if (smooth.iterations > 0) result::smooth_surface(s, smooth);
+  if (report) *report = std::move(found);
+  if (design) *design = cleaned;
   return s;
 }
 
@@ -78,7 +117,8 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
                           fem::gravity_of(job.load_cases));
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
-  r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold);
+  r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold,
+                             anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();
@@ -90,8 +130,10 @@ std::vector<std::string> write_optimize_outputs(const TetMesh& mesh, const Optim
   std::vector<std::string> out;
   const io::VtuField density{"density", 1,
                              std::vector<double>(r.simp.density.data(), r.simp.density.data() + r.simp.density.size())};
-  out.push_back(write_replacing((d / "density.vtu").string(),
-                                [&](const std::string& p) { io::write_vtu(p, mesh, {}, {density}); }));
+  const io::VtuField design{"design", 1, std::vector<double>(r.design.data(), r.design.data() + r.design.size())};
+  out.push_back(write_replacing((d / "density.vtu").string(), [&](const std::string& p) {
+    io::write_vtu(p, mesh, {}, {density, design});
+  }));
   out.push_back(
       write_replacing((d / "history.csv").string(), [&](const std::string& p) { write_history_csv(p, r.simp); }));
   out.push_back(

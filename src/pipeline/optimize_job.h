@@ -8,6 +8,7 @@
 
 #include "common/progress.h"
 #include "pipeline/job.h"
+#include "result/design_hygiene.h"
 #include "result/iso_surface.h"
 #include "result/smoothing.h"
 #include "simp/optimizer.h"
@@ -17,7 +18,9 @@ namespace topopt::pipeline {
 struct OptimizeResult {
   simp::SimpResult simp;
   double threshold = 0;
-  result::TriSurface surface;  ///< smoothed, closed
+  result::TriSurface surface;  ///< smoothed, closed, of the cleaned densities
+  VecXd design;                ///< #T element densities after hygiene (what the surface is cut from)
+  result::HygieneReport hygiene;
   double seconds_simp = 0, seconds_surface = 0;
 };
 
@@ -30,13 +33,25 @@ struct OptimizeResult {
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {});
 
-/// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
-/// `volume_fraction` of the design domain), smoothed. `threshold_used` (optional) gets it.
-result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
-                                  const result::SmoothParams& smooth, double* threshold_used = nullptr);
+/// The nodes where a support (result::kAnchorSupport) or a force or pressure
+/// (result::kAnchorLoad) acts: #V flags, what the design must connect. Gravity acts
+/// everywhere and does not count.
+std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 
-/// Writes DIR/density.vtu, DIR/history.csv, DIR/history.json and DIR/result.stl (each under
-/// a temporary name, then renamed). `dir` must exist (prepare_output_folder). Returns the
+/// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
+/// `volume_fraction` of the design domain, found on the densities as given), cleaned by
+/// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the
+/// largest piece) and smoothed. `threshold_used`, `report` and `design` (#T, the cleaned
+/// densities) are optional outputs; the report's warnings are also given to progress.warn.
+result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
+                                  const result::SmoothParams& smooth, double* threshold_used = nullptr,
+                                  const std::vector<char>& anchors = {}, const result::HygieneParams& hygiene = {},
+                                  result::HygieneReport* report = nullptr, VecXd* design = nullptr,
+                                  const Progress& progress = {});
+
+/// Writes DIR/density.vtu (fields "density", SIMP's, and "design", after hygiene),
+/// DIR/history.csv, DIR/history.json (with the hygiene report under "design") and
+/// DIR/result.stl (each under a temporary name, then renamed). `dir` must exist (prepare_output_folder). Returns the
 /// paths written.
 std::vector<std::string> write_optimize_outputs(const TetMesh& mesh, const OptimizeResult& r, const std::string& dir);
 

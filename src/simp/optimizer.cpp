@@ -23,6 +23,16 @@ double filter_radius(const TetMesh& mesh, const FilterParams& params) {
   return params.radius > 0 ? params.radius : 1.5 * mean_edge_length(mesh);
 }
 
+void check_params(const SimpParams& params) {
+  if (params.max_iterations < 1) throw Error(ErrorCode::InvalidParameter, "the iteration cap must be at least 1");
+  const ProjectionParams& p = params.projection;
+  if (p.enabled && !(p.beta_start >= 1 && p.beta_max >= p.beta_start && p.beta_factor > 1 &&
+                     p.max_iterations_per_beta >= 1 && p.settle_iterations >= 1 && p.eta > 0 && p.eta < 1))
+    throw Error(ErrorCode::InvalidParameter,
+                "the projection needs 1 <= beta_start <= beta_max, a factor above 1, at least one iteration per "
+                "beta and a threshold eta in (0, 1)");
+}
+
 void check_volume_fraction(double volume_fraction, const std::string& name) {
   if (!(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter,
@@ -34,6 +44,8 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
                                      const SimpParams& params, const Progress& progress,
                                      const Eigen::Matrix3Xd& gravity)
     : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
+  proj_.eta = params.projection.eta;
+  proj_.beta = params.projection.enabled ? params.projection.beta_start : 1.0;
   check_volume_fraction(params.volume_fraction);
   if (!(params.law.penalty >= 1)) throw Error(ErrorCode::InvalidParameter, "the SIMP penalty must be at least 1");
   const long nt = mesh.T.rows();
@@ -62,7 +74,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   }
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
-  if (!params.heaviside)
+  if (!params.projection.enabled)
     volume_weights_ = (params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
 }
 
@@ -71,7 +83,7 @@ ComplianceProblem::~ComplianceProblem() = default;
 void ComplianceProblem::forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
   rho_tilde = params_.sensitivity_filter ? x : filter_->apply(x);
   rho_bar = rho_tilde;
-  if (params_.heaviside)
+  if (params_.projection.enabled)
     for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
 }
 
@@ -115,7 +127,7 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   }
   if (dc) {
     // ---- chain rule back through projection and filter
-    if (params_.heaviside)
+    if (params_.projection.enabled)
       for (int i = 0; i < num_design; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
     *dc = params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar);
   }
@@ -131,85 +143,123 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
   forward(x, rho_tilde, rho_bar);
   if (dv) {
     VecXd g = vd_ / design_volume_;
-    if (params_.heaviside)
+    if (params_.projection.enabled)
       for (long i = 0; i < g.size(); ++i) g[i] *= proj_.derivative(rho_tilde[i]);
     *dv = params_.sensitivity_filter ? g : filter_->apply_transpose(g);
   }
   return vd_.dot(rho_bar) / design_volume_;
 }
 
+double ComplianceProblem::grey_share(const VecXd& x) const {
+  const VecXd rho_bar = physical(x);
+  double grey = 0;
+  for (long i = 0; i < rho_bar.size(); ++i)
+    if (rho_bar[i] > 0.1 && rho_bar[i] < 0.9) grey += vd_[i];
+  return grey / design_volume_;
+}
+
 VecXd ComplianceProblem::filter_sensitivity(const VecXd& x, const VecXd& dc) const {
   return filter_->filter_sensitivity(x, dc);
 }
+
+namespace {
+
+/// Move limits for OC: adaptive with the projection (a projected design flips its boundary
+/// variables by the full limit otherwise), the one fixed limit without it.
+MoveLimits move_limits(const SimpParams& params, int num_design) {
+  if (params.projection.enabled) return MoveLimits(num_design, params.move);
+  return MoveLimits(num_design, params.move, params.move, 1, 1);
+}
+
+/// The design update of one iteration: OC with move limits that shrink where the design
+/// oscillates, or MMA; both keep what they need from earlier iterations.
+class DesignUpdate {
+ public:
+  DesignUpdate(const SimpParams& params, int num_design)
+      : params_(params), mma_(num_design, 1, params.move), moves_(move_limits(params, num_design)) {}
+
+  /// The next design from x (#D) with compliance c, volume fraction vol and their
+  /// sensitivities dc, dv (#D).
+  VecXd step(const ComplianceProblem& problem, const VecXd& x, double c, const VecXd& dc, double vol, const VecXd& dv) {
+    if (params_.update == UpdateKind::OC) {
+      auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params_.volume_fraction; };
+      return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess);
+    }
+    // objective scaled to about 1 so MMA's regularisation terms are well sized
+    const double s = 1.0 / std::max(1e-300, std::abs(c));
+    VecXd f(1);
+    f[0] = vol / params_.volume_fraction - 1;
+    const Eigen::MatrixXd df = (dv / params_.volume_fraction).transpose();
+    return mma_.update(x, c * s, dc * s, f, df);
+  }
+
+  /// The problem changed (β raised): the oscillation history no longer applies.
+  void restart() {
+    mma_.restart();
+    moves_.restart();
+  }
+
+ private:
+  const SimpParams& params_;
+  Mma mma_;
+  MoveLimits moves_;
+};
+
+/// Keeps an iteration in the history and reports it (callback and progress line).
+void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult& res,
+                      const std::function<void(const IterationRecord&)>& on_iteration, const Progress& progress) {
+  res.history.push_back(rec);
+  if (on_iteration) on_iteration(rec);
+  std::ostringstream msg;
+  msg << "iteration " << rec.iteration << ": compliance " << rec.compliance << ", volume " << rec.volume_fraction
+      << ", change " << rec.change;
+  if (rec.beta != 1) msg << ", beta " << rec.beta << ", grey " << 100 * rec.grey << " %";
+  progress.say("simp", static_cast<double>(rec.iteration) / max_iterations, msg.str());
+}
+
+}  // namespace
 
 SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
                     const Progress& progress, const std::function<void(const IterationRecord&)>& on_iteration,
                     const Eigen::Matrix3Xd& gravity) {
-  if (params.max_iterations < 1) throw Error(ErrorCode::InvalidParameter, "the iteration cap must be at least 1");
+  check_params(params);
   ComplianceProblem problem(mesh, material, supports, loads, weights, params, progress, gravity);
   SimpResult res;
   res.design = problem.design();
   const int num_design = static_cast<int>(res.design.size());
-  Mma mma(num_design, 1, params.move);
+  DesignUpdate update(params, num_design);
+  Continuation schedule(params.projection, params.tol_change, params.tol_objective);
   VecXd x = VecXd::Constant(num_design, params.volume_fraction);
-  double previous = 0;
-  int calm = 0;
   for (int it = 1; it <= params.max_iterations; ++it) {
-    auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     progress.check_cancel("the optimisation (iteration " + std::to_string(it) + ")");
+    problem.set_beta(schedule.beta());
     // ---- FE analysis, objective and sensitivities
     VecXd dc, dv;
-    double c = problem.compliance(x, &dc);
-    double vol = problem.volume_fraction(x, &dv);
+    const double c = problem.compliance(x, &dc);
+    const double vol = problem.volume_fraction(x, &dv);
     // ---- filter (sensitivity filtering; the density filter is inside the chain rule)
     if (params.sensitivity_filter) dc = problem.filter_sensitivity(x, dc);
     // ---- update
-    VecXd xnew;
-    if (params.update == UpdateKind::OC) {
-      auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params.volume_fraction; };
-      xnew = oc_update(x, dc, dv.cwiseMax(1e-30), params.move, excess);
-    } else {
-      // objective scaled to about 1 so MMA's regularisation terms are well sized
-      double s = 1.0 / std::max(1e-300, std::abs(c));
-      VecXd f(1);
-      f[0] = vol / params.volume_fraction - 1;
-      Eigen::MatrixXd df = (dv / params.volume_fraction).transpose();
-      xnew = mma.update(x, c * s, dc * s, f, df);
-    }
-    double change = (xnew - x).cwiseAbs().maxCoeff();
+    const VecXd xnew = update.step(problem, x, c, dc, vol, dv);
+    IterationRecord rec{it, c, vol, (xnew - x).cwiseAbs().maxCoeff(), schedule.beta(), problem.grey_share(x), 0};
     x = xnew;
-
-    IterationRecord rec;
-    rec.iteration = it;
-    rec.compliance = c;
-    rec.volume_fraction = vol;
-    rec.change = change;
-    rec.beta = params.heaviside ? problem.beta() : 1.0;
     rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    res.history.push_back(rec);
-    if (on_iteration) on_iteration(rec);
-    std::ostringstream msg;
-    msg << "iteration " << it << ": compliance " << c << ", volume " << vol << ", change " << change;
-    progress.say("simp", static_cast<double>(it) / params.max_iterations, msg.str());
-
-    // ---- convergence (only at full sharpness when projecting)
-    bool sharp = !params.heaviside || problem.beta() >= params.beta_max;
-    calm = (it > 1 && std::abs(c - previous) < params.tol_objective * std::abs(c)) ? calm + 1 : 0;
-    previous = c;
-    if (sharp && it > 1 && (change < params.tol_change || calm >= 5)) {
+    report_iteration(rec, params.max_iterations, res, on_iteration, progress);
+    // ---- continuation and convergence (judged at the final β only)
+    const NextStep next = schedule.next(c, rec.change);
+    if (next == NextStep::Converged) {
       res.converged = true;
       res.status = "converged after " + std::to_string(it) + " iterations";
       break;
     }
-    if (params.heaviside && it % params.beta_every == 0 && problem.beta() < params.beta_max) {
-      problem.set_beta(std::min(params.beta_max, 2 * problem.beta()));
-      calm = 0;
-    }
+    if (next == NextStep::RaiseBeta) update.restart();
   }
   if (!res.converged) res.status = "iteration cap (" + std::to_string(params.max_iterations) + ") reached";
   res.variables = x;
-  VecXd rho = problem.physical(x);
+  problem.set_beta(schedule.beta());
+  const VecXd rho = problem.physical(x);
   res.density = VecXd::Ones(mesh.T.rows());
   for (int i = 0; i < num_design; ++i) res.density[res.design[i]] = rho[i];
   return res;

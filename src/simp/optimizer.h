@@ -10,6 +10,7 @@
 #include "common/progress.h"
 #include "common/types.h"
 #include "fem/elasticity.h"
+#include "simp/continuation.h"
 #include "simp/density_filter.h"
 #include "simp/simp_law.h"
 
@@ -22,9 +23,7 @@ struct SimpParams {
   SimpLaw law;                      ///< penalty 3, e_min 1e-9
   FilterParams filter;              ///< Gaussian; radius <= 0: 1.5 × mean edge length
   bool sensitivity_filter = false;  ///< filter sensitivities instead of densities
-  bool heaviside = false;           ///< Heaviside projection with β continuation
-  double beta_max = 32;             ///< continuation doubles β from 1 up to this
-  int beta_every = 20;              ///< iterations between doublings
+  ProjectionParams projection;      ///< Heaviside projection and its β continuation (on)
   UpdateKind update = UpdateKind::OC;
   double move = 0.2;  ///< move limit per iteration
   int max_iterations = 100;
@@ -40,6 +39,7 @@ struct IterationRecord {
   double volume_fraction = 0;  ///< of the design domain, with the physical densities
   double change = 0;           ///< max |Δx|
   double beta = 1;             ///< Heaviside sharpness (1 without projection)
+  double grey = 0;             ///< share of the design volume with 0.1 < ρ̄ < 0.9
   double seconds = 0;          ///< wall time of this iteration
 };
 
@@ -70,6 +70,8 @@ class ComplianceProblem {
   double volume_fraction(const VecXd& x, VecXd* dv = nullptr) const;
   /// Physical densities ρ̄ (#D) of x.
   VecXd physical(const VecXd& x) const;
+  /// Share of the design volume whose physical density ρ̄(x) lies strictly between 0.1 and 0.9.
+  double grey_share(const VecXd& x) const;
   /// Sensitivities of compliance filtered by Sigmund's filter (when params ask for it).
   VecXd filter_sensitivity(const VecXd& x, const VecXd& dc) const;
   const std::vector<int>& design() const { return design_; }
@@ -111,6 +113,10 @@ double mean_edge_length(const TetMesh& mesh);
 /// The filter radius SIMP uses for `params` on `mesh`: the given one, or 1.5 × the mean
 /// edge length when it is <= 0.
 double filter_radius(const TetMesh& mesh, const FilterParams& params);
+
+/// Throws Error(InvalidParameter) for an iteration cap below 1 or a projection schedule
+/// that cannot run (β below 1 or above its maximum at the start, a factor not above 1).
+void check_params(const SimpParams& params);
 
 /// The one check of a volume fraction's range, (0, 1). Throws Error(InvalidParameter)
 /// "`name` must lie strictly between 0 and 1 (...)".

@@ -6,14 +6,14 @@
 
 namespace topopt::simp {
 
-VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, double move,
+VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
                 const std::function<double(const VecXd&)>& volume_excess) {
   double l1 = 0, l2 = 1e9;
   VecXd xnew(x.size());
   auto candidate = [&](double lambda) {
     for (long i = 0; i < x.size(); ++i) {
       double b = std::sqrt(std::max(-dc[i], 0.0) / (lambda * dv[i]));
-      xnew[i] = std::clamp(x[i] * b, std::max(0.0, x[i] - move), std::min(1.0, x[i] + move));
+      xnew[i] = std::clamp(x[i] * b, std::max(0.0, x[i] - move[i]), std::min(1.0, x[i] + move[i]));
     }
   };
   // Bracket the multiplier first: compliance sensitivities can be far from 1 in scale.
@@ -32,6 +32,28 @@ VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, double move,
   }
   candidate(l2);
   return xnew;
+}
+
+MoveLimits::MoveLimits(int n, double largest, double smallest, double shrink, double grow)
+    : largest_(largest), smallest_(std::min(smallest, largest)), shrink_(shrink), grow_(grow) {
+  limit_ = VecXd::Constant(n, largest);
+}
+
+const VecXd& MoveLimits::at(const VecXd& x) {
+  if (xold2_.size())
+    for (long i = 0; i < x.size(); ++i) {
+      const double turn = (x[i] - xold1_[i]) * (xold1_[i] - xold2_[i]);
+      if (turn < 0) limit_[i] = std::max(smallest_, shrink_ * limit_[i]);
+      if (turn > 0) limit_[i] = std::min(largest_, grow_ * limit_[i]);
+    }
+  xold2_ = xold1_.size() ? xold1_ : x;
+  xold1_ = x;
+  return limit_;
+}
+
+void MoveLimits::restart() {
+  xold1_.resize(0);
+  xold2_.resize(0);
 }
 
 Mma::Mma(int n, int m, double move) : n_(n), m_(m), move_(move) {}

@@ -8,12 +8,32 @@
 
 namespace topopt::simp {
 
-/// Optimality criteria with move limit. x: #D current design variables in [0, 1]; dc: #D
+/// Optimality criteria with move limits. x: #D current design variables in [0, 1]; dc: #D
 /// objective sensitivities (<= 0 for compliance); dv: #D constraint sensitivities (> 0);
+/// move: #D largest change of each variable (MoveLimits, or one value for all);
 /// volume_excess(x_new): the volume constraint's value for a candidate (> 0 means too much
 /// material). The Lagrange multiplier is found by bisection so the constraint is met.
-VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, double move,
+VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
                 const std::function<double(const VecXd&)>& volume_excess);
+
+/// Move limits per variable for OC that let an oscillating design settle: a variable whose
+/// last two steps went opposite ways gets its limit multiplied by `shrink`, one that kept
+/// its direction by `grow` (as MMA moves its asymptotes, Svanberg 1987), between `smallest`
+/// and `largest`. A projected design (large β) otherwise keeps flipping the variables at its
+/// boundary by the full move limit and never converges.
+class MoveLimits {
+ public:
+  /// n variables starting at `largest`.
+  MoveLimits(int n, double largest, double smallest = 0.005, double shrink = 0.7, double grow = 1.2);
+  /// The limits (#n) for the step from x, given the steps that led to x.
+  const VecXd& at(const VecXd& x);
+  /// Forgets the past steps (the problem changed, e.g. β was raised); limits stay.
+  void restart();
+
+ private:
+  double largest_, smallest_, shrink_, grow_;
+  VecXd limit_, xold1_, xold2_;
+};
 
 /// MMA for  min f0(x)  s.t.  f_i(x) <= 0 (i = 1..m),  0 <= x <= 1. Keeps the history the
 /// asymptote rule needs; call update() once per iteration.
@@ -25,6 +45,11 @@ class Mma {
   /// Returns the next x. The subproblem's dual is solved by coordinate bisection, exact for
   /// m = 1 and convergent for a few constraints.
   VecXd update(const VecXd& x, double f0, const VecXd& df0, const VecXd& f, const Eigen::MatrixXd& df);
+  /// Starts the asymptotes afresh at the next update (the problem changed, e.g. β was raised).
+  void restart() {
+    iter_ = 0;
+    xold1_.resize(0);
+  }
 
  private:
   int n_, m_;

@@ -73,9 +73,9 @@ TEST(Job, OptimizationSectionIsTypedOnce) {
   EXPECT_EQ(p.law.penalty, 3.5);
   EXPECT_EQ(p.filter.kind, simp::FilterKind::Cone);
   EXPECT_EQ(p.filter.radius, 4);
-  EXPECT_TRUE(p.heaviside);
-  EXPECT_EQ(p.beta_max, 16);
-  EXPECT_EQ(p.beta_every, 10);
+  EXPECT_TRUE(p.projection.enabled);
+  EXPECT_EQ(p.projection.beta_max, 16);
+  EXPECT_EQ(p.projection.max_iterations_per_beta, 10);
   EXPECT_EQ(p.update, simp::UpdateKind::MMA);
   EXPECT_EQ(p.solver.kind, fem::SolverKind::Direct);
   EXPECT_EQ(p.solver.tolerance, 1e-6);
@@ -140,6 +140,34 @@ TEST(Job, UnknownKeysNameTheKeyAndTheNearestKnownOne) {
                  {"'supports[0].fix'", "components"});
   expect_message(R"({"load_cases": [{"loads": [{"type": "gravity", "faces": ["Face1"], "vector": [0, 0, -9810]}]}]})",
                  ErrorCode::InvalidParameter, {"'load_cases[0].loads[0].faces'", "whole part"});
+}
+
+TEST(Job, CrispDefaultsAndTheirKeys) {
+  // projection on and voids filled unless the job says otherwise
+  const Job plain = parse_job(R"({"optimization": {}})", "/d");
+  EXPECT_TRUE(plain.optimization.simp.projection.enabled);
+  EXPECT_TRUE(plain.optimization.hygiene.fill_voids);
+  const Job off = parse_job(R"({"optimization": {"heaviside": false, "fill_voids": false}})", "/d");
+  EXPECT_FALSE(off.optimization.simp.projection.enabled);
+  EXPECT_FALSE(off.optimization.hygiene.fill_voids);
+  const Job set = parse_job(
+      R"({"optimization": {"heaviside": {"beta_start": 2, "beta_max": 64, "factor": 1.5, "every": 25, "settle": 1e-3}}})",
+      "/d");
+  const simp::ProjectionParams& p = set.optimization.simp.projection;
+  EXPECT_TRUE(p.enabled);
+  EXPECT_EQ(p.beta_start, 2);
+  EXPECT_EQ(p.beta_max, 64);
+  EXPECT_EQ(p.beta_factor, 1.5);
+  EXPECT_EQ(p.max_iterations_per_beta, 25);
+  EXPECT_EQ(p.settle_tolerance, 1e-3);
+  expect_message(R"({"optimization": {"heaviside": {"factor": 1}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.factor'", "(1, 10]"});
+  expect_message(R"({"optimization": {"heaviside": {"beta_start": 64, "beta_max": 32}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.beta_max'", "[beta_start, 1000]"});
+  expect_message(R"({"optimization": {"heaviside": {"settle": 0}}})", ErrorCode::InvalidParameter,
+                 {"'optimization.heaviside.settle'", "(0, 1)"});
+  expect_message(R"({"optimization": {"fill_voids": "no"}})", ErrorCode::InvalidParameter,
+                 {"'optimization.fill_voids' must be true or false"});
 }
 
 TEST(Job, DuplicatedKeysAreErrors) {

@@ -22,7 +22,7 @@ TEST(OcUpdate, ConvergesToTheAnalyticOptimumOfASeparableProblem) {
   VecXd x = VecXd::Constant(n, 0.4);
   for (int it = 0; it < 200; ++it) {
     VecXd dc = -a.array() / x.array().square();
-    x = oc_update(x, dc, v, 0.2, excess);
+    x = oc_update(x, dc, v, VecXd::Constant(n, 0.2), excess);
     ASSERT_LE(std::abs(excess(x)), 1e-6 * target) << "iteration " << it;
     ASSERT_GE(x.minCoeff(), 0.0);
     ASSERT_LE(x.maxCoeff(), 1.0);
@@ -31,6 +31,32 @@ TEST(OcUpdate, ConvergesToTheAnalyticOptimumOfASeparableProblem) {
   best *= target / v.dot(best);
   ASSERT_LE(best.maxCoeff(), 1.0);  // inside the bounds, so the unconstrained formula holds
   EXPECT_LT((x - best).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+TEST(MoveLimits, ShrinkWhereTheDesignOscillatesAndGrowBackWhereItMovesOneWay) {
+  // variable 0 zig-zags, variable 1 climbs steadily, variable 2 stands still
+  MoveLimits moves(3, 0.2, 0.01, 0.5, 2.0);
+  VecXd x(3);
+  x << 0.5, 0.1, 0.3;
+  EXPECT_EQ(moves.at(x), VecXd::Constant(3, 0.2));  // no history yet
+  for (int it = 1; it <= 10; ++it) {
+    x[0] = it % 2 ? 0.6 : 0.5;
+    x[1] += 0.05;
+    const VecXd limit = moves.at(x);
+    if (it >= 2) {
+      EXPECT_DOUBLE_EQ(limit[0], std::max(0.01, 0.2 * std::pow(0.5, it - 1))) << "iteration " << it;
+      EXPECT_DOUBLE_EQ(limit[1], 0.2) << "capped at the largest limit";
+      EXPECT_DOUBLE_EQ(limit[2], 0.2) << "a still variable keeps its limit";
+    }
+  }
+  // after a restart the old steps no longer count, but the limits stay where they were
+  moves.restart();
+  x[0] = 0.9;
+  EXPECT_DOUBLE_EQ(moves.at(x)[0], 0.01);
+  x[0] = 0.95;
+  EXPECT_DOUBLE_EQ(moves.at(x)[0], 0.01);
+  x[0] = 1.0;  // two steps the same way: grows again
+  EXPECT_DOUBLE_EQ(moves.at(x)[0], 0.02);
 }
 
 }  // namespace

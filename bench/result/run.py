@@ -1,0 +1,107 @@
+#!/usr/bin/python3
+"""Result benchmark (issue 19): the design `topopt optimize` hands over, per example, before
+and after the crisp defaults, in one run of this script on this machine.
+
+For each example (cantilever, rocker, bracket; suggested load cases of
+../shared/data/README.md, steel, volume fraction 0.3) and each setting:
+- `topopt optimize` with OMP_NUM_THREADS=2: iterations, status, SIMP wall time and the CPU
+  time of the whole command (user + system; the machine is shared, so CPU time is the fairer
+  comparison), grey share (design volume with 0.1 < rho < 0.9, element densities);
+- `topopt solve --inp` on the same job writes the problem deck of the first load case on the
+  same mesh (meshing is deterministic; crisp.py checks the nodes are the same);
+- crisp compliance: the tets of the crisp design (non-design tets, and design tets whose
+  node-density field at the centroid reaches the run's threshold, the one of result.stl),
+  face-connected to a loaded node, solved by CalculiX (bench/result/crisp.py).
+
+Settings: "before" is today's old default (no projection: `"heaviside": false`, which is the
+old code path exactly: fixed OC move limit, same convergence test), "after" is the new
+default (projection with beta continuation, adaptive OC move limits).
+
+usage: bench/result/run.py [--build build] [--work /tmp/topopt-bench-result] [--only cantilever,...]
+Prints Markdown for BENCHMARKS.md.
+"""
+import argparse, json, os, resource, subprocess, sys, time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
+sys.path.insert(0, HERE)
+import crisp  # noqa: E402
+
+EXAMPLES = {
+    "cantilever": (1.5, {"supports": [{"type": "fixed", "faces": ["Face1"]}],
+                         "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["NonDesign:Face12"],
+                                                                   "vector": [0, 0, -1000]}]}]}),
+    "rocker": (1.5, {"supports": [{"type": "fixed", "faces": ["Face10"]}],
+                     "load_cases": [{"name": "rocker", "loads": [{"type": "force", "faces": ["Face9"], "vector": [0, -1000, 0]},
+                                                                 {"type": "force", "faces": ["Face11"], "vector": [600, 0, 0]}]}]}),
+    # bolt bores Face10-13 fixed; pin bore Face7: 5000 N along +x, and separately along -z
+    "bracket": (2.5, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
+                      "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
+                                     {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
+}
+SETTINGS = {"before": {"heaviside": False}, "after": {}}
+
+
+def run(cmd):
+    """Runs a topopt command with 2 threads; returns (wall s, CPU s of the child, stdout)."""
+    env = dict(os.environ, OMP_NUM_THREADS="2")
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode:
+        sys.exit(" ".join(cmd) + " failed:\n" + p.stdout[-3000:] + p.stderr[-3000:])
+    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), p.stdout
+
+
+def one(build, work, name, setting):
+    size, problem = EXAMPLES[name]
+    out = os.path.join(work, name + "_" + setting)
+    job = {"part": os.path.join(DATA, name + ".step"), "nondesign": os.path.join(DATA, name + "_nondesign.step"),
+           "mesh": {"size": size}, "material": {"E": 210000.0, "nu": 0.3},
+           "optimization": dict({"volume_fraction": 0.3}, **SETTINGS[setting]), "output": {"directory": out}}
+    job.update(problem)
+    path = out + ".json"
+    json.dump(job, open(path, "w"), indent=1)
+    wall, cpu, _ = run([os.path.join(build, "topopt"), "optimize", path, "--quiet"])
+    h = json.load(open(os.path.join(out, "history.json")))
+    deck = os.path.join(out, "problem.inp")
+    run([os.path.join(build, "topopt"), "solve", path, "--out-dir", os.path.join(out, "solve"), "--inp", deck])
+    points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
+    density, domain = arrays["density"], arrays["domain"]
+    vol = abs(crisp.tet_volumes(points, tets))
+    keep = crisp.crisp_tets(points, tets, domain, density, h["threshold"])
+    c, solved = crisp.ccx_compliance(deck, points, tets, keep, os.path.join(out, "ccx"), name)
+    return {"tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
+            "wall_s": wall, "cpu_s": cpu, "grey": crisp.grey_share(density, domain, vol),
+            "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_tets": solved, "kept_tets": int(keep.sum())}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--work", default="/tmp/topopt-bench-result")
+    ap.add_argument("--only", default=",".join(EXAMPLES))
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    rows = {}
+    for name in a.only.split(","):
+        for setting in SETTINGS:
+            rows[name, setting] = r = one(a.build, a.work, name, setting)
+            print("%s %s: %s" % (name, setting, json.dumps(r)), file=sys.stderr, flush=True)
+    json.dump({"%s/%s" % k: v for k, v in rows.items()}, open(os.path.join(a.work, "rows.json"), "w"), indent=1)
+    print("## Result: crisp designs (bench/result/run.py)\n")
+    print("| example | tets | setting | iterations | status | grey share | SIMP compliance (N·mm) | crisp compliance, "
+          "CalculiX (N·mm) | SIMP wall (s) | optimize CPU (s) | CPU after / before |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for (name, setting), r in rows.items():
+        ratio = r["cpu_s"] / rows[name, "before"]["cpu_s"] if (name, "before") in rows else float("nan")
+        print("| %s | %d | %s | %d | %s | %.1f %% | %.2f | %.2f | %.1f | %.1f | %.2f |"
+              % (name, r["tets"], setting, r["iterations"], r["status"], 100 * r["grey"], r["compliance_simp"], r["crisp"],
+                 r["simp_s"], r["cpu_s"], ratio))
+
+
+if __name__ == "__main__":
+    main()

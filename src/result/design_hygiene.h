@@ -1,0 +1,80 @@
+// Design hygiene: what the density field hands over, cleaned before the result surface is
+// cut from it. On the tets of the crisp design (non-design tets, and design tets whose node
+// densities reach the threshold on average) it removes solid pieces (tets sharing nodes) that
+// no support or load reaches, names the non-design solids that end up apart from the rest, fills closed internal
+// voids (unless allowed) and measures the thinnest member.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+
+namespace topopt::result {
+
+/// Anchor node flags (bits): a support acts there, a load (force or pressure) acts there.
+inline constexpr char kAnchorSupport = 1, kAnchorLoad = 2;
+
+struct HygieneParams {
+  bool fill_voids = true;  ///< fill closed internal voids; false keeps them (printed lattices)
+};
+
+/// A solid piece of the crisp design (tets sharing nodes) apart from the ones that carry the loads.
+struct DesignPiece {
+  double volume = 0;           ///< mm³
+  std::vector<int> nondesign;  ///< non-design solids in it (domain tags, ascending)
+  bool removed = false;        ///< design material only, so taken out of the design
+};
+
+/// What clean_design found and did.
+struct HygieneReport {
+  int pieces = 0;                  ///< solid pieces (tets sharing nodes) before cleaning
+  int anchored_pieces = 0;         ///< ... of them touching a support or load node (or the largest, without anchors)
+  std::vector<DesignPiece> apart;  ///< the other pieces
+  int voids_filled = 0;            ///< closed internal voids filled
+  double void_volume_filled = 0;   ///< mm³
+  int voids_kept = 0;              ///< closed internal voids kept (fill_voids false)
+  double void_volume_kept = 0;     ///< mm³
+  double min_feature = 0;          ///< thinnest member of the design (mm), 0 if none measured
+  std::array<double, 3> min_feature_at{0, 0, 0};  ///< where (the centre of a design tet)
+  std::vector<std::string> warnings;              ///< one sentence each, in the user's terms
+};
+
+/// Face neighbours of tets T (#T by 4, positively oriented): #T by 4, entry k the tet across
+/// the face opposite vertex k, -1 on the mesh boundary.
+MatX4i tet_neighbours(const MatX4i& T);
+
+/// The crisp design's tets (#T, 1 = solid): non-design tets, and design tets whose four node
+/// densities (#V) average at least `threshold`.
+std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, double threshold);
+
+/// Face-connected components of the tets with mask[t] set, over `neighbours` (#T by 4).
+/// Returns #T labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
+VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count);
+
+/// Components of the tets with mask[t] set that share a node (pieces touching at an edge or a
+/// corner are one: the result surface, cut from node densities, joins them). Returns #T
+/// labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
+VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count);
+
+/// The thinnest member of the solid tets (mask #T): every solid tet's centre gets its nearest
+/// point on the solid's boundary faces (the faces tried are propagated through the mesh from
+/// neighbour to neighbour, Danielsson's way); where two face-neighbouring tets, one of them a design tet, see their
+/// nearest points on opposite sides (more than 120° apart), the member between is as thick as those points are apart.
+/// Returns the smallest such thickness (mm; 0 if none), accurate to about one element size; `at` gets where.
+double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std::vector<char>& solid,
+                        std::array<double, 3>& at);
+
+/// Cleans element densities (#T) at the threshold of the result shape. anchors: #V flags
+/// (kAnchorSupport | kAnchorLoad) of the nodes where supports and loads act; empty when
+/// unknown. The pieces that hold both a support and a load carry the loads (failing those,
+/// the pieces holding either; failing those, the largest piece); every other piece is apart:
+/// set to density 0 when it is design material with no load on it, named otherwise (its
+/// non-design solids, or a loaded piece of the design). Closed voids (void tets
+/// face-connected to no boundary face of the mesh) are set to 1 when params.fill_voids.
+/// Fills `report` (a warning for every removal, every piece apart, several load-carrying
+/// pieces, filled or kept voids) and returns the cleaned densities (#T).
+VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
+                   const HygieneParams& params, HygieneReport& report);
+
+}  // namespace topopt::result

@@ -1,0 +1,56 @@
+// When to sharpen the projection and when to stop: the β continuation of the Heaviside
+// projection (Guest, Prévost & Belytschko 2004; Wang, Lazarov & Sigmund 2011) and SIMP's
+// convergence test, in one place so that "converged" always means the same thing.
+#pragma once
+
+namespace topopt::simp {
+
+/// The Heaviside projection ρ̄ = H_β(ρ̃) and its continuation. β starts at beta_start and is
+/// multiplied by beta_factor (up to beta_max) each time the design has settled at the
+/// current β — the compliance changed by less than settle_tolerance (relative) in
+/// settle_iterations iterations running, or no variable moved by more than the tolerance on
+/// the change — or after max_iterations_per_beta iterations at one β, whichever comes
+/// first. Convergence is judged at beta_max only, so the design returned is the sharp one.
+struct ProjectionParams {
+  bool enabled = true;               ///< false: ρ̄ = ρ̃ (no projection, β stays 1)
+  double eta = 0.5;                  ///< the projection's threshold
+  double beta_start = 1;             ///< β of the first iteration, >= 1
+  double beta_max = 32;              ///< the final sharpness; >= beta_start
+  double beta_factor = 2;            ///< β ← min(beta_max, beta_factor β) when settled, > 1
+  int max_iterations_per_beta = 40;  ///< raise β after this many iterations at one β anyway
+  double settle_tolerance = 2e-3;    ///< relative compliance change that counts as settled
+  int settle_iterations = 3;         ///< ... for this many iterations running
+};
+
+/// What the loop does after an iteration.
+enum class NextStep { Continue, RaiseBeta, Converged };
+
+/// The continuation schedule and the convergence test. Call next() once per iteration with
+/// its compliance and design change; read beta() for the projection of the next iteration.
+class Continuation {
+ public:
+  /// tol_change: converged (or settled) when no design variable moved by more than this;
+  /// tol_objective: converged when the compliance changed by less than this (relative) for
+  /// 5 iterations running. Both are judged at the final β only.
+  Continuation(const ProjectionParams& params, double tol_change, double tol_objective);
+
+  /// β to use now (1 without projection).
+  double beta() const { return beta_; }
+  /// True once β has reached beta_max (always without projection).
+  bool sharp() const;
+
+  /// Records an iteration (its compliance and max |Δx|) and says what comes next. On
+  /// RaiseBeta, beta() already holds the new β and the settling count starts again.
+  NextStep next(double compliance, double change);
+
+ private:
+  ProjectionParams params_;
+  double tol_change_, tol_objective_;
+  double beta_ = 1;
+  double previous_ = 0;
+  int iterations_ = 0;   // iterations recorded at the current β
+  int calm_final_ = 0;   // running count below tol_objective
+  int calm_settle_ = 0;  // running count below settle_tolerance
+};
+
+}  // namespace topopt::simp

@@ -1,0 +1,212 @@
+// Design hygiene on hand-made density fields of a structured box: a loose piece is removed
+// and its volume given, a non-design solid apart from the supports is named and kept, closed
+// voids are filled (or kept when allowed) while open ones stay, the thinnest member is
+// measured, and the result surface of a job warns the same way at any threshold.
+#include "result/design_hygiene.h"
+
+#include <gtest/gtest.h>
+
+#include "mesh/core/structured_box.h"
+#include "pipeline/optimize_job.h"
+#include "result/iso_surface.h"
+
+namespace topopt::result {
+namespace {
+
+/// A 10 mm cube of 1 mm cells (6000 tets), non-design boxes as given.
+TetMesh cube(std::vector<std::array<double, 6>> nondesign = {}, int cells = 10) {
+  mesh::StructuredBoxParams p;
+  p.size = {10, 10, 10};
+  p.cells = {cells, cells, cells};
+  p.nondesign = std::move(nondesign);
+  return mesh::structured_box_mesh(p);
+}
+
+Eigen::Vector3d centre(const TetMesh& m, long t) {
+  return 0.25 * (m.V.row(m.T(t, 0)) + m.V.row(m.T(t, 1)) + m.V.row(m.T(t, 2)) + m.V.row(m.T(t, 3))).transpose();
+}
+
+bool inside(const Eigen::Vector3d& c, std::array<double, 6> b) {
+  return c[0] > b[0] && c[1] > b[1] && c[2] > b[2] && c[0] < b[3] && c[1] < b[4] && c[2] < b[5];
+}
+
+/// Density 1 in the boxes, 0 elsewhere (non-design tets 1).
+VecXd densities(const TetMesh& m, const std::vector<std::array<double, 6>>& solid) {
+  VecXd d = VecXd::Zero(m.T.rows());
+  for (long t = 0; t < m.T.rows(); ++t) {
+    if (m.domain[t] != 0) d[t] = 1;
+    for (const auto& b : solid)
+      if (inside(centre(m, t), b)) d[t] = 1;
+  }
+  return d;
+}
+
+/// Nodes on the plane x = 0.
+std::vector<char> anchors_at_x0(const TetMesh& m) {
+  std::vector<char> a(m.V.rows(), 0);
+  for (long v = 0; v < m.V.rows(); ++v) a[v] = m.V(v, 0) < 1e-9;
+  return a;
+}
+
+TEST(DesignHygiene, NeighboursAreSymmetricAndTheBoundaryIsTheBoxSurface) {
+  const TetMesh m = cube({}, 4);
+  const MatX4i nb = tet_neighbours(m.T);
+  long boundary = 0;
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (int k = 0; k < 4; ++k) {
+      const int n = nb(t, k);
+      if (n < 0) {
+        ++boundary;
+        continue;
+      }
+      EXPECT_TRUE((nb.row(n).array() == t).any()) << t << " and " << n;
+    }
+  EXPECT_EQ(boundary, 6 * 4 * 4 * 2);  // two triangles per boundary square
+}
+
+TEST(DesignHygiene, ALoosePieceIsRemovedWithItsVolumeAndTheRestIsOnePiece) {
+  const TetMesh m = cube();
+  // a slab on the supported face x = 0, and a 2 x 4 x 4 mm block floating in the void
+  const VecXd d = densities(m, {{0, 0, 0, 3, 10, 10}, {6, 3, 3, 8, 7, 7}});
+  HygieneReport rep;
+  const VecXd clean = clean_design(m, d, 0.5, anchors_at_x0(m), {}, rep);
+  EXPECT_EQ(rep.pieces, 2);
+  EXPECT_EQ(rep.anchored_pieces, 1);
+  ASSERT_EQ(rep.apart.size(), 1u);
+  EXPECT_TRUE(rep.apart[0].removed);
+  EXPECT_TRUE(rep.apart[0].nondesign.empty());
+  // the crisp block: tets whose node densities average 0.5 or more, about its 32 mm³
+  EXPECT_GT(rep.apart[0].volume, 16);
+  EXPECT_LT(rep.apart[0].volume, 64);
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("removed a loose piece"), std::string::npos) << rep.warnings[0];
+  EXPECT_NE(rep.warnings[0].find("mm³"), std::string::npos) << rep.warnings[0];
+  for (long t = 0; t < m.T.rows(); ++t) {
+    if (inside(centre(m, t), {6, 3, 3, 8, 7, 7})) EXPECT_EQ(clean[t], 0) << t;
+    if (inside(centre(m, t), {0, 0, 0, 3, 10, 10})) EXPECT_EQ(clean[t], 1) << t;
+  }
+  // cleaned once, clean for good
+  HygieneReport again;
+  clean_design(m, clean, 0.5, anchors_at_x0(m), {}, again);
+  EXPECT_EQ(again.pieces, 1);
+  EXPECT_TRUE(again.warnings.empty());
+}
+
+TEST(DesignHygiene, ANonDesignSolidApartFromTheSupportsIsNamedAndKept) {
+  // non-design solids 1 at x = 0 (supported) and 2 at x = 10, the design between them empty
+  const TetMesh m = cube({{0, 0, 0, 2, 10, 10}, {8, 0, 0, 10, 10, 10}});
+  const VecXd d = densities(m, {});
+  HygieneReport rep;
+  const VecXd clean = clean_design(m, d, 0.5, anchors_at_x0(m), {}, rep);
+  ASSERT_EQ(rep.apart.size(), 1u);
+  EXPECT_FALSE(rep.apart[0].removed);
+  EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{2});
+  EXPECT_NEAR(rep.apart[0].volume, 200, 1e-9);
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("non-design solid 2 is not connected"), std::string::npos) << rep.warnings[0];
+  EXPECT_NE(rep.warnings[0].find("touches no support and no load"), std::string::npos) << rep.warnings[0];
+  EXPECT_EQ(clean, d);
+  // the support at x = 0 and the load at x = 10: the load does not reach the support
+  std::vector<char> both = anchors_at_x0(m);
+  for (long v = 0; v < m.V.rows(); ++v)
+    if (m.V(v, 0) > 10 - 1e-9) both[v] = kAnchorLoad;
+  clean_design(m, d, 0.5, both, {}, rep);
+  EXPECT_EQ(rep.anchored_pieces, 2);
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("falls apart into 2 pieces"), std::string::npos) << rep.warnings[0];
+  EXPECT_NE(rep.warnings[0].find("non-design solid 1; non-design solid 2"), std::string::npos) << rep.warnings[0];
+}
+
+TEST(DesignHygiene, APieceWithASupportButNoLoadIsApartFromTheOneCarryingTheLoad) {
+  // non-design solids 1 (supported, x = 0) and 2 (supported, x = 10); the load on solid 1's
+  // top; the design connects nothing, so solid 2 holds a support that carries nothing
+  const TetMesh m = cube({{0, 0, 0, 2, 10, 10}, {8, 0, 0, 10, 10, 10}});
+  std::vector<char> anchors(m.V.rows(), 0);
+  for (long v = 0; v < m.V.rows(); ++v) {
+    if (m.V(v, 0) < 1e-9 || m.V(v, 0) > 10 - 1e-9) anchors[v] = kAnchorSupport;
+    if (m.V(v, 2) > 10 - 1e-9 && m.V(v, 0) < 2 + 1e-9) anchors[v] |= kAnchorLoad;
+  }
+  HygieneReport rep;
+  clean_design(m, densities(m, {}), 0.5, anchors, {}, rep);
+  EXPECT_EQ(rep.anchored_pieces, 1);
+  ASSERT_EQ(rep.apart.size(), 1u);
+  EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{2});
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("holds a support but no load"), std::string::npos) << rep.warnings[0];
+}
+
+TEST(DesignHygiene, ClosedVoidsAreFilledUnlessAllowedAndOpenOnesStay) {
+  const TetMesh m = cube();
+  VecXd d = VecXd::Ones(m.T.rows());
+  for (long t = 0; t < m.T.rows(); ++t) {
+    const Eigen::Vector3d c = centre(m, t);
+    if (inside(c, {3, 3, 3, 7, 7, 7})) d[t] = 0;   // closed cavity, 64 mm³
+    if (inside(c, {0, 0, 8, 2, 2, 10})) d[t] = 0;  // notch open at a corner
+  }
+  HygieneReport rep;
+  const VecXd clean = clean_design(m, d, 0.5, anchors_at_x0(m), {}, rep);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_EQ(rep.voids_filled, 1);
+  EXPECT_GT(rep.void_volume_filled, 20);
+  EXPECT_LT(rep.void_volume_filled, 64);
+  for (long t = 0; t < m.T.rows(); ++t) {
+    if (inside(centre(m, t), {3, 3, 3, 7, 7, 7})) EXPECT_EQ(clean[t], 1);
+    if (inside(centre(m, t), {0, 0, 8, 2, 2, 10})) EXPECT_EQ(clean[t], 0);
+  }
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("filled 1 closed internal void"), std::string::npos) << rep.warnings[0];
+  // allowed: the cavity stays, and the report says so
+  HygieneParams keep;
+  keep.fill_voids = false;
+  EXPECT_EQ(clean_design(m, d, 0.5, anchors_at_x0(m), keep, rep), d);
+  EXPECT_EQ(rep.voids_filled, 0);
+  EXPECT_EQ(rep.voids_kept, 1);
+  EXPECT_NEAR(rep.void_volume_kept, 0, 64);
+  EXPECT_GT(rep.void_volume_kept, 20);
+}
+
+TEST(DesignHygiene, TheThinnestMemberIsMeasuredToAboutAnElementSize) {
+  // 0.5 mm cells: a 6 mm thick slab on x = 0 carrying a 2 mm plate across the cube
+  const TetMesh m = cube({}, 20);
+  const VecXd d = densities(m, {{0, 0, 0, 6, 10, 10}, {0, 0, 4, 10, 10, 6}});
+  HygieneReport rep;
+  clean_design(m, d, 0.5, anchors_at_x0(m), {}, rep);
+  EXPECT_GT(rep.min_feature, 2 - 0.75) << rep.min_feature_at[0] << " " << rep.min_feature_at[1] << " "
+                                       << rep.min_feature_at[2];
+  EXPECT_LT(rep.min_feature, 2 + 0.75);
+  EXPECT_GT(rep.min_feature_at[0], 6 - 0.5) << "in the plate, not the slab";
+  EXPECT_NEAR(rep.min_feature_at[2], 5, 1);
+  // a thicker plate measures thicker
+  HygieneReport thick;
+  clean_design(m, densities(m, {{0, 0, 0, 6, 10, 10}, {0, 0, 3, 10, 10, 7}}), 0.5, anchors_at_x0(m), {}, thick);
+  EXPECT_GT(thick.min_feature, rep.min_feature + 1);
+}
+
+TEST(DesignHygiene, TheResultSurfaceWarnsAtEveryThreshold) {
+  // the job's path and a re-extraction from densities alone (the workbench's slider): the
+  // loose block goes and is warned about either way, and the surface has one piece
+  const TetMesh m = cube();
+  const VecXd d = densities(m, {{0, 0, 0, 3, 10, 10}, {6, 3, 3, 8, 7, 7}});
+  for (const double threshold : {0.5, 0.7}) {
+    for (const bool with_anchors : {true, false}) {
+      std::vector<std::string> warnings;
+      Progress progress;
+      progress.log = [&](LogLevel level, const std::string& w) {
+        if (level == LogLevel::Warning) warnings.push_back(w);
+      };
+      HygieneReport rep;
+      VecXd design;
+      const TriSurface s =
+          pipeline::result_surface(m, d, threshold, 0.3, SmoothParams{}, nullptr,
+                                   with_anchors ? anchors_at_x0(m) : std::vector<char>{}, {}, &rep, &design, progress);
+      ASSERT_EQ(warnings.size(), 1u) << threshold;
+      EXPECT_NE(warnings[0].find("removed a loose piece"), std::string::npos) << warnings[0];
+      EXPECT_EQ(check_surface(s.V, s.F).open_edges, 0);
+      // the surface encloses the slab only (30 mm³ x 10, less what smoothing rounds off)
+      EXPECT_NEAR(check_surface(s.V, s.F).volume, 300, 40) << threshold;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace topopt::result
