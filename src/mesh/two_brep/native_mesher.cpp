@@ -358,6 +358,9 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
                     MeshRun* run) {
   if (!(params.surface.size > 0 && params.surface.min_size > 0))
     throw Error(ErrorCode::Internal, "mesh_native needs its sizes set (pipeline::native_mesh_params decides them)");
+  if (model.meshed.topo.num_solids() != model.nondesign.num_solids())
+    throw Error(ErrorCode::Internal,
+                "mesh_native needs the model from brep::load_two_breps (its imprinted Ω̄ is missing)");
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
   auto lap = [&](const char* stage) {

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <set>
 
+#include "brep/report.h"
 #include "brep/shape_io.h"
 #include "brep/two_breps.h"
 #include "partial_contact_fixtures.h"
@@ -51,15 +53,31 @@ TEST(Imprint, BossOuterCylinderSplitsIntoAPieceOnThePartAndAPieceInside) {
   for (auto [f, a] : area) EXPECT_NEAR(a, m.nondesign.face_area[f], 1e-6 * a) << "input Face" << f + 1;
 }
 
+TEST(Imprint, TheReportNamesEachSplitFaceAndWhereItsPiecesLie) {
+  const auto fx = testing::plate_with_bosses_on_one_side();
+  const TwoBReps m = load_two_breps(fx.part, fx.nondesign);
+  const nlohmann::json r = two_breps_report(m)["imprint"];
+  ASSERT_EQ(r.size(), 2u);  // each boss's outer cylinder
+  for (const auto& face : r) {
+    ASSERT_EQ(face["pieces"].size(), 2u);
+    std::multiset<std::string> on;
+    for (const auto& p : face["pieces"]) on.insert(p["on"].get<std::string>());
+    EXPECT_EQ(on, (std::multiset<std::string>{"face", "interior"})) << face.dump();
+  }
+  const std::string summary = two_breps_summary(m);
+  EXPECT_NE(summary.find("reaches the part's boundary in part: split into"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("[inside]"), std::string::npos) << summary;
+}
+
 TEST(Imprint, TouchingPadsShareIdenticalFacesAfterTheImprint) {
   const auto fx = testing::pads_touching_on_unequal_faces();
   const TwoBReps m = load_two_breps(fx.part, fx.nondesign);
   ASSERT_TRUE(m.meshed.imprinted);
   ASSERT_EQ(m.meshed.relations.contacts.size(), 1u);
   const Contact& c = m.meshed.relations.contacts[0];
-  ASSERT_EQ(c.faces.size(), 1u);  // pad A's 10 x 5 face and the same piece of pad B's face
-  EXPECT_NEAR(m.meshed.topo.face_area[c.faces[0].first], 50.0, 1e-6);
-  EXPECT_NEAR(m.meshed.topo.face_area[c.faces[0].second], 50.0, 1e-6);
+  ASSERT_EQ(c.faces.size(), 1u);  // pad A's 5 x 5 face and the same piece of pad B's face
+  EXPECT_NEAR(m.meshed.topo.face_area[c.faces[0].first], 25.0, 1e-6);
+  EXPECT_NEAR(m.meshed.topo.face_area[c.faces[0].second], 25.0, 1e-6);
 }
 
 TEST(Imprint, ModelsWithoutPartialContactAreKeptAsTheyAre) {

@@ -2,14 +2,22 @@
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepAlgoAPI_Fuse.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
 #include <BRep_Builder.hxx>
+#include <GeomAPI_Interpolate.hxx>
+#include <Geom_BSplineCurve.hxx>
 #include <ShapeUpgrade_UnifySameDomain.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
+#include <cmath>
 #include <gp_Ax2.hxx>
 #include <stdexcept>
 
@@ -68,12 +76,28 @@ PartialContactFixture bracket_with_lug_cut_by_outer_face() {
   return {"bracket with a lug cut by its outer face", part, compound({lug})};
 }
 
-PartialContactFixture boss_on_cylinder_wall(bool bspline_wall) {
-  TopoDS_Shape wall = cylinder(0, 0, 0, 20, 30);
-  if (bspline_wall) wall = BRepBuilderAPI_NurbsConvert(wall).Shape();
-  TopoDS_Shape part = fuse(wall, cylinder(0, 0, 15, 5, 30, gp::DX()), !bspline_wall);
-  TopoDS_Shape boss = cylinder(12, 0, 15, 5, 18, gp::DX());
-  return {bspline_wall ? "boss on a B-spline wall" : "boss half outside a cylinder face", part, compound({boss})};
+PartialContactFixture boss_on_cylinder_wall() {
+  TopoDS_Shape part = fuse(cylinder(0, 0, 0, 20, 30), cylinder(0, 0, 15, 5, 30, gp::DX()));
+  return {"boss half outside a cylinder face", part, compound({cylinder(12, 0, 15, 5, 18, gp::DX())})};
+}
+
+PartialContactFixture boss_on_bspline_wall() {
+  Handle(TColgp_HArray1OfPnt) points = new TColgp_HArray1OfPnt(1, 13);
+  for (int i = 0; i < 13; ++i) points->SetValue(i + 1, gp_Pnt(5.0 * i, 0, 10 + 4 * std::sin(M_PI * i / 12)));
+  GeomAPI_Interpolate fit(points, false, 1e-9);
+  fit.Perform();
+  const Handle(Geom_BSplineCurve) arch = fit.Curve();
+  const gp_Pnt a = arch->StartPoint(), b = arch->EndPoint();
+  BRepBuilderAPI_MakeWire wire;
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(60, 0, 0)).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(60, 0, 0), b).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(arch).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(a, gp_Pnt(0, 0, 0)).Edge());
+  const TopoDS_Face profile = BRepBuilderAPI_MakeFace(wire.Wire(), true).Face();
+  const TopoDS_Shape block =
+      BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakePrism(profile, gp_Vec(0, 40, 0)).Shape()).Shape();
+  const TopoDS_Shape part = fuse(block, cylinder(30, 20, 0, 5, 20), false);
+  return {"boss on a B-spline wall", part, compound({cylinder(30, 20, 0, 5, 20)})};
 }
 
 PartialContactFixture pad_spanning_two_faces() {
@@ -87,8 +111,8 @@ PartialContactFixture pads_touching_on_unequal_faces() {
 }
 
 std::vector<PartialContactFixture> partial_contact_fixtures() {
-  return {plate_with_bosses_on_one_side(), bracket_with_lug_cut_by_outer_face(), boss_on_cylinder_wall(false),
-          pad_spanning_two_faces(),        pads_touching_on_unequal_faces(),     boss_on_cylinder_wall(true)};
+  return {plate_with_bosses_on_one_side(), bracket_with_lug_cut_by_outer_face(), boss_on_cylinder_wall(),
+          pad_spanning_two_faces(),        pads_touching_on_unequal_faces(),     boss_on_bspline_wall()};
 }
 
 }  // namespace topopt::testing

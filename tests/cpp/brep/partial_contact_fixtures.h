@@ -26,15 +26,19 @@ PartialContactFixture bracket_with_lug_cut_by_outer_face();
 
 /// A cylinder r 20, height 30, with a boss r 5 along x standing out of its wall to x = 30;
 /// Ω̄ = the boss from x = 12: its cylinder half inside the big cylinder, half outside.
-/// With `bspline_wall`, the big cylinder is converted to B-spline faces first.
-PartialContactFixture boss_on_cylinder_wall(bool bspline_wall);
+PartialContactFixture boss_on_cylinder_wall();
+
+/// A block 60 x 40 whose top is an arch z = 10 + 4 sin(pi x / 60) (every face converted to
+/// B-splines), with a boss r 5 on the vertical axis at (30, 20) from z = 0 to 20; Ω̄ = the
+/// boss, whose cylinder leaves the part along its intersection with the B-spline top.
+PartialContactFixture boss_on_bspline_wall();
 
 /// Two boxes fused into a part 40 x 30 x 20 whose top is two faces (x < 20, x > 20); Ω̄ = a pad
 /// 10 x 10 x 5 under the top whose top face spans both.
 PartialContactFixture pad_spanning_two_faces();
 
 /// A box 40 x 30 x 20 with two pads on its bottom face touching at x = 20: pad A's face there
-/// (10 x 5) lies inside pad B's (20 x 8).
+/// (5 x 5) lies inside pad B's (20 x 8).
 PartialContactFixture pads_touching_on_unequal_faces();
 
 /// All of the above, in this order.
