@@ -5,7 +5,8 @@ open at a plane so the interface between the domains shows.
     /usr/bin/python3 docs/images/make_mount_picture.py MESH.msh OUT.png [--cut-y Y]
 
 MESH.msh: `topopt mesh --out` (Gmsh MSH 4.1, physical volume 1 = design, 2.. = non-design).
-Reads it with Gmsh's Python module; draws with matplotlib (no display needed)."""
+Reads it with Gmsh's Python module; draws with matplotlib (no display needed). matplotlib sorts
+whole triangles by depth, so faint edges of hidden triangles may show through the plate."""
 import argparse
 from collections import Counter
 
@@ -67,10 +68,10 @@ def draw(ax, V, tris, dom, title):
     shade = 0.55 + 0.45 * np.abs(n @ light)
     base = np.array([matplotlib.colors.to_rgb(COLOURS[d % len(COLOURS)]) for d in dom])
     col = np.clip(base * shade[:, None], 0, 1)
-    ax.add_collection3d(Poly3DCollection(P, facecolors=col, edgecolors=(0, 0, 0, 0.15), linewidths=0.1))
+    ax.add_collection3d(Poly3DCollection(P, facecolors=col, edgecolors=(0, 0, 0, 0.1), linewidths=0.1))
     lo, hi = V.min(axis=0), V.max(axis=0)
     ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(hi - lo, zoom=1.5)
+    ax.set_box_aspect(hi - lo, zoom=1.2)
     ax.view_init(elev=28, azim=-60)
     ax.set_axis_off()
     ax.set_title(title, fontsize=10)
