@@ -100,6 +100,16 @@ TopoDS_Shape split_nondesign(const TopologyIndex& part, const TopologyIndex& non
   return out;
 }
 
+MeshedNonDesign without_imprint(const TopologyIndex& nondesign, const Classification& on_part,
+                                const ContainmentReport& relations) {
+  MeshedNonDesign m;
+  m.topo = nondesign;
+  m.on_part = on_part;
+  m.relations = relations;
+  for (int f = 0; f < nondesign.num_faces(); ++f) m.face_origin.push_back(f);
+  return m;
+}
+
 MeshedNonDesign meshed_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign,
                                  const Classification& on_part, const ContainmentReport& relations,
                                  const ClassifyParams& params) {
@@ -115,13 +125,7 @@ MeshedNonDesign meshed_nondesign(const TopologyIndex& part, const TopologyIndex&
       changed = count(solids(i), TopAbs_FACE) != count(nondesign.solids(i), TopAbs_FACE) ||
                 count(solids(i), TopAbs_EDGE) != count(nondesign.solids(i), TopAbs_EDGE);
   }
-  if (!changed) {
-    m.topo = nondesign;
-    m.on_part = on_part;
-    m.relations = relations;
-    for (int f = 0; f < nondesign.num_faces(); ++f) m.face_origin.push_back(f);
-    return m;
-  }
+  if (!changed) return without_imprint(nondesign, on_part, relations);
   m.imprinted = true;
   m.topo = index_topology(split);
   m.face_origin = std::move(origin);

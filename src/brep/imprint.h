@@ -34,6 +34,11 @@ struct MeshedNonDesign {
 TopoDS_Shape split_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign, double fuzzy,
                              std::vector<int>& face_origin);
 
+/// `nondesign` as it is, with its classification and relations (no imprint; face_origin the
+/// identity).
+MeshedNonDesign without_imprint(const TopologyIndex& nondesign, const Classification& on_part,
+                                const ContainmentReport& relations);
+
 /// The model to mesh: `nondesign` itself (with `on_part` and `relations`) when no face or edge
 /// of it lies partly on Ω's boundary or on another non-design solid, else its imprint
 /// (split_nondesign) classified afresh. The test is the imprint itself: a split that leaves
