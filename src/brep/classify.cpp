@@ -43,10 +43,6 @@ const char* on_name(On on) {
 
 namespace {
 
-double default_tolerance(const TopologyIndex& base, const ClassifyParams& params) {
-  return params.tolerance > 0 ? params.tolerance : 1e-6 * std::max(base.diagonal(), 1.0);
-}
-
 std::vector<gp_Pnt> edge_samples(const TopoDS_Edge& edge, int n) {
   std::vector<gp_Pnt> out;
   if (BRep_Tool::Degenerated(edge)) return out;
@@ -139,8 +135,12 @@ std::string fmt(double x) {
 
 }  // namespace
 
+double coincidence_tolerance(const TopologyIndex& base, const ClassifyParams& params) {
+  return params.tolerance > 0 ? params.tolerance : 1e-6 * std::max(base.diagonal(), 1.0);
+}
+
 Classification classify(const TopologyIndex& base, const TopologyIndex& other, const ClassifyParams& params) {
-  const double tol = default_tolerance(base, params);
+  const double tol = coincidence_tolerance(base, params);
   PointLocator probe(base, tol);
   ensure_triangulated(other.shape);
   Classification out;
@@ -209,9 +209,30 @@ Classification classify(const TopologyIndex& base, const TopologyIndex& other, c
   return out;
 }
 
+bool touching(const TopologyIndex& nondesign, int i, int j, double tol, Contact& contact) {
+  const TopoDS_Shape& a = nondesign.solids(i + 1);
+  const TopoDS_Shape& b = nondesign.solids(j + 1);
+  BRepExtrema_DistShapeShape dist(a, b);
+  if (!dist.IsDone() || dist.Value() > tol) return false;
+  contact = Contact{i, j, {}};
+  // Faces of a lying on faces of b: sample a's faces, probe b's.
+  TopologyIndex bi = index_topology(b);
+  PointLocator probe_b(bi, tol);
+  for (const int* fa = nondesign.solid_faces.begin(i); fa != nondesign.solid_faces.end(i); ++fa) {
+    for (const gp_Pnt& p : face_samples(TopoDS::Face(nondesign.faces(*fa + 1)), 12)) {
+      auto hits = probe_b.faces_at(p, nondesign.face_tolerance[*fa]);
+      if (hits.empty()) continue;
+      int fb = nondesign.faces.FindIndex(bi.faces(hits[0].index + 1)) - 1;
+      if (std::find(contact.faces.begin(), contact.faces.end(), std::make_pair(*fa, fb)) == contact.faces.end())
+        contact.faces.emplace_back(*fa, fb);
+    }
+  }
+  return true;
+}
+
 ContainmentReport check_containment(const TopologyIndex& part, const TopologyIndex& nondesign,
                                     const ClassifyParams& params) {
-  const double tol = default_tolerance(part, params);
+  const double tol = coincidence_tolerance(part, params);
   ContainmentReport report;
   if (part.num_solids() != 1)
     throw Error(ErrorCode::InvalidShape, "the part must be exactly one solid; it has " +
@@ -274,21 +295,8 @@ ContainmentReport check_containment(const TopologyIndex& part, const TopologyInd
         throw Error(ErrorCode::NonDesignOverlap, "non-design solids " + std::to_string(i + 1) + " and " +
                                                      std::to_string(j + 1) + " overlap (" + fmt(vc) +
                                                      " mm³ in common): make them disjoint; they may touch");
-      BRepExtrema_DistShapeShape dist(a, b);
-      if (!dist.IsDone() || dist.Value() > tol) continue;
-      Contact contact{i, j, {}};
-      // Faces of a lying on faces of b: sample a's faces, probe b's.
-      TopologyIndex bi = index_topology(b);
-      PointLocator probe_b(bi, tol);
-      for (const int* fa = nondesign.solid_faces.begin(i); fa != nondesign.solid_faces.end(i); ++fa) {
-        for (const gp_Pnt& p : face_samples(TopoDS::Face(nondesign.faces(*fa + 1)), 12)) {
-          auto hits = probe_b.faces_at(p, nondesign.face_tolerance[*fa]);
-          if (hits.empty()) continue;
-          int fb = nondesign.faces.FindIndex(bi.faces(hits[0].index + 1)) - 1;
-          if (std::find(contact.faces.begin(), contact.faces.end(), std::make_pair(*fa, fb)) == contact.faces.end())
-            contact.faces.emplace_back(*fa, fb);
-        }
-      }
+      Contact contact;
+      if (!touching(nondesign, i, j, tol, contact)) continue;
       if (contact.faces.empty())
         report.warnings.push_back("non-design solids " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
                                   " touch along an edge or at a point only");

@@ -60,6 +60,15 @@ struct ContainmentReport {
   std::vector<std::string> warnings;  ///< things worth telling the user
 };
 
+/// The distance below which entities of the two models coincide: params.tolerance, or 1e-6
+/// times base's bounding-box diagonal (at least 1e-6) when that is <= 0.
+double coincidence_tolerance(const TopologyIndex& base, const ClassifyParams& params);
+
+/// Whether solids i and j (0-based) of `nondesign` come within `tol` of each other; if they do,
+/// `contact` gets the pairs (face of i, face of j) whose samples lie on each other (empty when
+/// they touch along an edge or at a point only).
+bool touching(const TopologyIndex& nondesign, int i, int j, double tol, Contact& contact);
+
 /// Checks that every solid of `nondesign` lies inside the single solid of `part` and that no
 /// two non-design solids overlap; finds the pairs that touch. Throws Error(NonDesignOutside)
 /// or Error(NonDesignOverlap) naming the solids and the volume concerned.

@@ -40,6 +40,39 @@ nlohmann::json face_json(const TopologyIndex& t, int f) {
           {"centre", {t.face_centre(f, 0), t.face_centre(f, 1), t.face_centre(f, 2)}}};
 }
 
+/// Per input face of Ω̄ that the imprint split: its pieces, where each lies and its area.
+nlohmann::json imprint_json(const TwoBReps& m) {
+  nlohmann::json out = nlohmann::json::array();
+  const MeshedNonDesign& md = m.meshed;
+  if (!md.imprinted) return out;
+  std::vector<std::vector<int>> pieces(m.nondesign.num_faces());
+  for (int f = 0; f < md.topo.num_faces(); ++f) pieces[md.face_origin[f]].push_back(f);
+  for (int f = 0; f < m.nondesign.num_faces(); ++f) {
+    if (pieces[f].size() < 2) continue;
+    nlohmann::json pj = nlohmann::json::array();
+    for (int piece : pieces[f]) {
+      nlohmann::json lj = location_json("piece", md.on_part.face[piece]);
+      lj.erase("name");
+      lj["area"] = md.topo.face_area[piece];
+      pj.push_back(lj);
+    }
+    out.push_back({{"face", "Face" + std::to_string(f + 1)}, {"pieces", pj}});
+  }
+  return out;
+}
+
+/// "Face4 (on Face20, interior, on Face28)" for every input face the imprint split.
+std::string imprint_summary(const TwoBReps& m) {
+  std::ostringstream s;
+  for (const auto& face : imprint_json(m)) {
+    s << "  " << face["face"].get<std::string>() << " reaches the part's boundary in part: split into";
+    for (const auto& p : face["pieces"])
+      s << " [" << (p.contains("on_entity") ? "on " + p["on_entity"].get<std::string>() : "inside") << "]";
+    s << "\n";
+  }
+  return s.str();
+}
+
 }  // namespace
 
 nlohmann::json two_breps_report(const TwoBReps& m) {
@@ -81,11 +114,8 @@ nlohmann::json two_breps_report(const TwoBReps& m) {
     for (auto [a, b] : c.faces) pairs.push_back({"Face" + std::to_string(a + 1), "Face" + std::to_string(b + 1)});
     contacts.push_back({{"solids", {c.solid_a + 1, c.solid_b + 1}}, {"faces", pairs}});
   }
-  return {{"part", part},
-          {"nondesign", nondesign},
-          {"contacts", contacts},
-          {"notes", m.notes},
-          {"warnings", m.relations.warnings}};
+  return {{"part", part},     {"nondesign", nondesign},          {"contacts", contacts}, {"imprint", imprint_json(m)},
+          {"notes", m.notes}, {"warnings", m.relations.warnings}};
 }
 
 std::string two_breps_summary(const TwoBReps& m) {
@@ -110,6 +140,7 @@ std::string two_breps_summary(const TwoBReps& m) {
     s << "  solid " << i + 1 << ": volume " << n.solid_volume[i] << " mm³, " << on_face << " faces on the part's faces,"
       << where.str() << "; " << interior << " interior\n";
   }
+  s << imprint_summary(m);
   for (const Contact& c : m.relations.contacts) {
     s << "  solids " << c.solid_a + 1 << " and " << c.solid_b + 1 << " touch";
     for (auto [a, b] : c.faces) s << " (Face" << a + 1 << " on Face" << b + 1 << ")";

@@ -13,6 +13,8 @@ namespace topopt::brep {
 ///   nondesign:  {solids: [{index, volume, faces: [{name, surface, area, on, on_entity}], ...}],
 ///                edges: [{name, on, on_entity}], vertices: [...]}
 ///   contacts:   [{solids: [i, j], faces: [[FaceA, FaceB], ...]}]
+///   imprint:    [{face: FaceN, pieces: [{on, on_entity, area}, ...]}]: the non-design faces
+///               split where they lie partly on the part's boundary (imprint.h)
 ///   notes, warnings: [strings]
 nlohmann::json two_breps_report(const TwoBReps& m);
 

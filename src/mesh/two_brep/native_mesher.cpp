@@ -27,6 +27,7 @@ namespace {
 /// the tets of steps 12-14.
 struct Steps {
   const brep::TwoBReps& in;
+  const brep::MeshedNonDesign& nd;  // Ω̄ as meshed: imprinted where it has partial contact
   const NativeMeshParams& params;
   const Progress& progress;
   std::vector<std::array<double, 3>> nodes;
@@ -37,10 +38,11 @@ struct Steps {
 
   Steps(const brep::TwoBReps& model, const NativeMeshParams& p, const Progress& prog)
       : in(model),
+        nd(model.meshed),
         params(p),
         progress(prog),
         part(model.part, nodes, p.surface),
-        nondesign(model.nondesign, nodes, p.surface),
+        nondesign(model.meshed.topo, nodes, p.surface),
         tol(1e-6 * model.part.diagonal()) {}
 };
 
@@ -67,8 +69,8 @@ std::string face_list(const std::vector<int>& faces, const std::vector<std::stri
 // rest of Ω̄'s vertices get their own (shared between non-design solids that touch there).
 void step1_part_vertex_nodes(Steps& s) { s.part.create_vertex_nodes(); }
 void step2_transfer_vertex_nodes(Steps& s) {
-  for (int v = 0; v < s.in.nondesign.num_vertices(); ++v) {
-    const brep::Location& at = s.in.nd_on_part.vertex[v];
+  for (int v = 0; v < s.nd.topo.num_vertices(); ++v) {
+    const brep::Location& at = s.nd.on_part.vertex[v];
     if (at.on == brep::On::Vertex) s.nondesign.set_vertex_node(v, s.part.vertex_node(at.index));
   }
 }
@@ -76,8 +78,8 @@ void step3_nondesign_vertex_nodes(Steps& s) { s.nondesign.create_vertex_nodes(s.
 
 // Step 4: Ω̄'s vertex nodes that lie on edges of Ω must be nodes of those edges' meshes.
 void step4_transfer_nodes_to_part_edges(Steps& s) {
-  for (int v = 0; v < s.in.nondesign.num_vertices(); ++v) {
-    const brep::Location& at = s.in.nd_on_part.vertex[v];
+  for (int v = 0; v < s.nd.topo.num_vertices(); ++v) {
+    const brep::Location& at = s.nd.on_part.vertex[v];
     if (at.on == brep::On::Edge) s.part.fix_edge_node(at.index, s.nondesign.vertex_node(v));
   }
 }
@@ -87,18 +89,18 @@ void step5_mesh_part_edges(Steps& s) { s.part.mesh_edges(s.progress); }
 // Step 6: an edge of Ω̄ lying on an edge of Ω takes the run of that edge's nodes between its
 // own end nodes, walking in the direction of its curve (around, for closed edges).
 void step6_transfer_edge_segments(Steps& s) {
-  for (int e = 0; e < s.in.nondesign.num_edges(); ++e) {
-    const brep::Location& at = s.in.nd_on_part.edge[e];
-    if (at.on != brep::On::Edge || s.in.nondesign.edge_degenerate[e]) continue;
+  for (int e = 0; e < s.nd.topo.num_edges(); ++e) {
+    const brep::Location& at = s.nd.on_part.edge[e];
+    if (at.on != brep::On::Edge || s.nd.topo.edge_degenerate[e]) continue;
     std::vector<int> ids = s.part.edge_nodes(at.index);
     const bool closed = ids.size() > 2 && ids.front() == ids.back();
     if (closed) ids.pop_back();
     const int n = static_cast<int>(ids.size());
-    const int a = s.nondesign.vertex_node(s.in.nondesign.edge_vertices(e, 0));
-    const int b = s.nondesign.vertex_node(s.in.nondesign.edge_vertices(e, 1));
+    const int a = s.nondesign.vertex_node(s.nd.topo.edge_vertices(e, 0));
+    const int b = s.nondesign.vertex_node(s.nd.topo.edge_vertices(e, 1));
     const int ia = static_cast<int>(std::find(ids.begin(), ids.end(), a) - ids.begin());
     const double t_start =
-        BRepAdaptor_Curve(TopoDS::Edge(s.in.nondesign.edges(e + 1).Oriented(TopAbs_FORWARD))).FirstParameter();
+        BRepAdaptor_Curve(TopoDS::Edge(s.nd.topo.edges(e + 1).Oriented(TopAbs_FORWARD))).FirstParameter();
     std::vector<int> best;
     double best_score = 1e300;
     for (int dir : {1, -1}) {
@@ -133,7 +135,7 @@ void step6_transfer_edge_segments(Steps& s) {
 // Step 7: the rest of Ω̄'s edges (an edge of one non-design solid lying on an edge of
 // another, where they touch, is meshed once and shared).
 void step7_mesh_nondesign_edges(Steps& s) {
-  const brep::TopologyIndex& t = s.in.nondesign;
+  const brep::TopologyIndex& t = s.nd.topo;
   std::vector<int> solid_of(t.num_edges(), -1);
   for (int f = 0; f < t.num_faces(); ++f)
     for (const int* e = t.face_edges.begin(f); e != t.face_edges.end(f); ++e) solid_of[*e] = t.face_solid[f];
@@ -167,15 +169,15 @@ void step7_mesh_nondesign_edges(Steps& s) {
 
 // Step 8: Ω̄'s segments (and lone vertex nodes) lying on faces of Ω constrain those faces.
 void step8_transfer_segments_to_part_faces(Steps& s) {
-  const brep::TopologyIndex& t = s.in.nondesign;
+  const brep::TopologyIndex& t = s.nd.topo;
   for (int e = 0; e < t.num_edges(); ++e) {
-    const brep::Location& at = s.in.nd_on_part.edge[e];
+    const brep::Location& at = s.nd.on_part.edge[e];
     if (at.on != brep::On::Face) continue;
     const std::vector<int>& ids = s.nondesign.edge_nodes(e);
     for (size_t i = 0; i + 1 < ids.size(); ++i) s.part.constrain_face(at.index, ids[i], ids[i + 1]);
   }
   for (int v = 0; v < t.num_vertices(); ++v) {
-    const brep::Location& at = s.in.nd_on_part.vertex[v];
+    const brep::Location& at = s.nd.on_part.vertex[v];
     if (at.on == brep::On::Face) s.part.add_face_node(at.index, s.nondesign.vertex_node(v));
   }
 }
@@ -192,10 +194,10 @@ void step9_mesh_part_faces(Steps& s) {
 // The constraint segments cut Ω's face mesh into regions; each region is given to the Ω̄
 // face that contains it (judged by the B-Rep classifier on a few of its triangles).
 void step10_transfer_triangles(Steps& s) {
-  const brep::TopologyIndex& t = s.in.nondesign;
+  const brep::TopologyIndex& t = s.nd.topo;
   std::map<int, std::vector<int>> on_face;  // Ω face -> Ω̄ faces on it
   for (int f = 0; f < t.num_faces(); ++f)
-    if (s.in.nd_on_part.face[f].on == brep::On::Face) on_face[s.in.nd_on_part.face[f].index].push_back(f);
+    if (s.nd.on_part.face[f].on == brep::On::Face) on_face[s.nd.on_part.face[f].index].push_back(f);
   for (const auto& [pf, nd_faces] : on_face) {
     const auto& tris = s.part.face_triangles(pf);
     std::set<std::pair<int, int>> cuts;
@@ -245,12 +247,12 @@ void step10_transfer_triangles(Steps& s) {
             mine.push_back(tris[k]);
             std::array<int, 3> key = tris[k];
             std::sort(key.begin(), key.end());
-            s.nd_face_of[key] = f + 1;
+            s.nd_face_of[key] = s.nd.face_origin[f] + 1;  // the input's face number
           }
       }
       if (mine.empty()) {
         std::ostringstream m;
-        m << "non-design Face" << f + 1 << " lies on the part's Face" << pf + 1
+        m << "non-design Face" << s.nd.face_origin[f] + 1 << " lies on the part's Face" << pf + 1
           << " but no region of that face's mesh falls inside it";
         throw Error(ErrorCode::MeshingFailed, m.str());
       }
@@ -262,14 +264,17 @@ void step10_transfer_triangles(Steps& s) {
 // Step 11: the rest of Ω̄'s faces (a face where two non-design solids touch is meshed once
 // and shared, reversed); then every non-design solid's surface must be closed.
 void step11_mesh_nondesign_faces(Steps& s) {
-  for (const brep::Contact& c : s.in.relations.contacts)
+  for (const brep::Contact& c : s.nd.relations.contacts)
     for (const auto& [fa, fb] : c.faces) s.nondesign.alias_face(fb, fa, true);
   s.nondesign.mesh_faces(s.progress);
-  if (!s.nondesign.failed_faces().empty())
+  if (!s.nondesign.failed_faces().empty()) {
+    std::vector<int> input_faces;  // in the input's numbers (a face split by the imprint is named as a whole)
+    for (int f : s.nondesign.failed_faces()) input_faces.push_back(s.nd.face_origin[f - 1] + 1);
     throw Error(ErrorCode::MeshingFailed,
                 "the surface mesher could not mesh" +
-                    face_list(s.nondesign.failed_faces(), s.nondesign.failure_reasons(), "non-design solids"));
-  for (int i = 0; i < s.in.nondesign.num_solids(); ++i)
+                    face_list(input_faces, s.nondesign.failure_reasons(), "non-design solids"));
+  }
+  for (int i = 0; i < s.nd.topo.num_solids(); ++i)
     if (const long open = open_edges(rows_of(s.nondesign.solid_triangles(i)))) {
       std::ostringstream m;
       m << "the surface mesh of non-design solid " << i + 1 << " is not closed (" << open
@@ -283,7 +288,7 @@ void step11_mesh_nondesign_faces(Steps& s) {
 void steps12_to_14_fill_volumes(Steps& s) {
   std::vector<std::array<int, 3>> all = s.part.solid_triangles(0);
   std::vector<MatX3i> nondesign;
-  for (int i = 0; i < s.in.nondesign.num_solids(); ++i) {
+  for (int i = 0; i < s.nd.topo.num_solids(); ++i) {
     const auto t = s.nondesign.solid_triangles(i);
     all.insert(all.end(), t.begin(), t.end());
     nondesign.push_back(rows_of(t));
@@ -353,6 +358,9 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
                     MeshRun* run) {
   if (!(params.surface.size > 0 && params.surface.min_size > 0))
     throw Error(ErrorCode::Internal, "mesh_native needs its sizes set (pipeline::native_mesh_params decides them)");
+  if (model.meshed.topo.num_solids() != model.nondesign.num_solids())
+    throw Error(ErrorCode::Internal,
+                "mesh_native needs the model from brep::load_two_breps (its imprinted Ω̄ is missing)");
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
   auto lap = [&](const char* stage) {
