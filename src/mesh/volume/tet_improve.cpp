@@ -2,6 +2,7 @@
 #include "mesh/volume/tet_improve.h"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 
 #include "common/face_key.h"
@@ -18,6 +19,10 @@ namespace {
 double rho(const std::vector<Vec3>& P, const Tet& t) { return radius_ratio(P[t[0]], P[t[1]], P[t[2]], P[t[3]]); }
 
 bool has(const Tet& t, int x) { return t[0] == x || t[1] == x || t[2] == x || t[3] == x; }
+
+double signed_volume(const std::vector<Vec3>& P, const Tet& t) {
+  return (P[t[1]] - P[t[0]]).dot((P[t[2]] - P[t[0]]).cross(P[t[3]] - P[t[0]])) / 6;
+}
 
 /// Compass search: moves x along ±x, ±y, ±z by `step` while f (which reads x) rises, halving
 /// the step when no direction helps, for at most `iterations` tries or until the step is a
@@ -333,11 +338,21 @@ CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad) 
   // alone could leave more than it removed, for the next sweep to find (on NIST 6 the sweeps
   // grew the tets below 0.1 from 5 500 to 9 000)
   int new_bad = 0;
+  double star_volume = 0;
   if (best > old_worst)
-    for (const Tri& f : star.faces) new_bad += radius_ratio(P[f[0]], P[f[2]], P[f[1]], P[id]) < kSliverShare * bad;
+    for (const Tri& f : star.faces) {
+      new_bad += radius_ratio(P[f[0]], P[f[2]], P[f[1]], P[id]) < kSliverShare * bad;
+      star_volume += signed_volume(P, {f[0], f[2], f[1], id});
+    }
   star.point = P[id];
   P.pop_back();
   if (!(best > old_worst) || new_bad > old_bad) return {};
+  // a point that sees every face tiles a cavity of positive tets exactly; one holding a flat or
+  // inverted tet has faces that overlap, and its star would cover part of it twice: the star
+  // must have the cavity's volume
+  double cavity_volume = 0;
+  for (int c : cavity) cavity_volume += signed_volume(P, s.tets[c]);
+  if (!(std::abs(star_volume - cavity_volume) <= 1e-9 * std::abs(cavity_volume))) return {};
   star.cavity = std::move(cavity);
   star.gain = best - old_worst;
   return star;

@@ -108,8 +108,10 @@ struct CavityStar {
 /// Refill (check-only): the untouched tets `cavity` (no node locked) as a star of its faces
 /// from the point that maximises the star's worst radius ratio (a compass search from the
 /// faces' centroid, steps of 0.15 of their mean edge), kept when that point sees every face
-/// (the star tiles the cavity exactly), the star's worst tet beats the cavity's and it has no
-/// more tets below kSliverShare × bad than the cavity had. P is as it was on return.
+/// (the star tiles the cavity exactly) and the star has the cavity's volume (a cavity holding a
+/// flat or inverted tet has overlapping faces: its star would cover part of it twice), the
+/// star's worst tet beats the cavity's and it has no more tets below kSliverShare × bad than
+/// the cavity had. P is as it was on return.
 CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad);
 /// Makes star c: its point is appended to P, its cavity retired (and its nodes locked), its
 /// tets pending until the sweep ends.
