@@ -153,24 +153,24 @@ def product(args):
 
 
 def table(files):
-    """Two --json files (before, after) side by side as a Markdown table."""
+    """Two --json files (before, after) side by side as a Markdown table (rows of the second)."""
     import json
     old, new = (json.load(open(f)) for f in files.split(","))
     print("| part | size | tets before / after | radius ratio min before / after | share < 0.1 before / after |"
-          " share < 0.2 before / after | smallest dihedral before / after | flat or inverted after |"
-          " conformity after | time (s) before / after |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          " share < 0.2 before / after | flat / inverted after | conformity after |")
+    print("|---|---|---|---|---|---|---|---|")
     pct = lambda x: "%.3f %%" % (100 * x)
     for key in new:
         a, b = old.get(key, {}), new[key]
         name, f = key.split("@")
-        if "error" in b or "error" in a:
-            print("| %s | %s× | error: %s / %s | | | | | | | |" % (name, f, a.get("error", "-")[-80:], b.get("error", "-")[-80:]))
+        size = "default" if float(f) == 1.0 else "%s×" % f
+        if "error" in b or "error" in a or not a:
+            print("| %s | %s | before: %s / after: %s | | | | | |" % (name, size, a.get("error", "-")[-80:],
+                                                                    b.get("error", "-")[-80:]))
             continue
-        print("| %s | %s× | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %.1f° / %.1f° | %s | %s | %.0f / %.0f |" % (
-            name, f, a["tets"], b["tets"], a["rr_min"], b["rr_min"], pct(a["below_0.1"]), pct(b["below_0.1"]),
-            pct(a["below_0.2"]), pct(b["below_0.2"]), a["dihedral_min"], b["dihedral_min"],
-            "%s / %s" % (b["flat"], b["inverted"]), "ok" if b["conformity"] else "DEFECTS", a["seconds"], b["seconds"]))
+        print("| %s | %s | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %s / %s | %s |" % (
+            name, size, a["tets"], b["tets"], a["rr_min"], b["rr_min"], pct(a["below_0.1"]), pct(b["below_0.1"]),
+            pct(a["below_0.2"]), pct(b["below_0.2"]), b["flat"], b["inverted"], "ok" if b["conformity"] else "DEFECTS"))
 
 
 def run_gmsh(P, F, h):
