@@ -16,6 +16,15 @@ shared and noisy); the mesh of the last run is measured.
 
 usage: bench/volume/run.py [--build build] [--repeat 3] [--cases rocker:1.0,rocker:2.77,cantilever:1.28]
 Prints a Markdown table for BENCHMARKS.md.
+
+With --product TOPOPT (a `topopt` executable, e.g. build/topopt or an older build's), it runs
+instead the product's path on every part of ../shared/data (the examples with their
+non-design solids, NIST 1-6 and 11, linkrods) at the default size and at the --factors given:
+`topopt mesh --mesher native`, pinned to one CPU (taskset), and reads the written mesh back to
+measure tets, the worst radius ratio, the share of tets below 0.1 and 0.2, the smallest
+dihedral angle, the conformity check's verdict (flat and inverted tets) and the time. Rows go
+to --json as they finish, so two executables' runs can be tabulated side by side with
+--table old.json,new.json.
 """
 import argparse, os, sys, time
 
@@ -52,6 +61,116 @@ def quality(P, T):
         cosang = np.einsum("ij,ij->i", uu, vv) / (np.linalg.norm(uu, axis=1) * np.linalg.norm(vv, axis=1))
         dmin = np.minimum(dmin, np.degrees(np.arccos(np.clip(cosang, -1, 1))))
     return float(rr.min()), float(rr.mean()), float(dmin.min())
+
+
+def quality_shares(P, T):
+    """(min radius ratio, share below 0.1, share below 0.2, min dihedral angle) of tets T."""
+    a, b, c, d = (P[T[:, i]] for i in range(4))
+    vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a))) / 6
+    areas = sum(0.5 * np.linalg.norm(np.cross(y - x, z - x), axis=1) for x, y, z in ((b, c, d), (a, c, d), (a, b, d), (a, b, c)))
+    u, v, w = b - a, c - a, d - a
+    num = (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w) + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)
+           + np.einsum("ij,ij->i", w, w)[:, None] * np.cross(u, v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rr = np.where(vol > 0, 3 * (3 * vol / areas) / (np.linalg.norm(num, axis=1) / (12 * vol)), 0.0)
+    return float(rr.min()), float((rr < 0.1).mean()), float((rr < 0.2).mean()), quality(P, T)[2]
+
+
+def read_msh_tets(path):
+    """Nodes (#V by 3) and tets (#T by 4, 0-based) of a Gmsh MSH 4.1 ASCII file."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    i = lines.index("$Nodes") + 1
+    blocks, count = int(lines[i].split()[0]), int(lines[i].split()[1])
+    tags, xyz = [], []
+    i += 1
+    for _ in range(blocks):
+        n = int(lines[i].split()[3])
+        tags += [int(x) for x in lines[i + 1:i + 1 + n]]
+        xyz += lines[i + 1 + n:i + 1 + 2 * n]
+        i += 1 + 2 * n
+    P = np.zeros((max(tags) + 1, 3))
+    P[tags] = np.array(" ".join(xyz).split(), dtype=float).reshape(-1, 3)
+    i = lines.index("$Elements") + 1
+    blocks = int(lines[i].split()[0])
+    i += 1
+    tets = []
+    for _ in range(blocks):
+        _, _, kind, n = (int(x) for x in lines[i].split())
+        if kind == 4:
+            tets.append(np.array(" ".join(lines[i + 1:i + 1 + n]).split(), dtype=np.int64).reshape(-1, 5)[:, 1:])
+        i += 1 + n
+    return P, np.vstack(tets)
+
+
+def product_parts():
+    """(name, part file, non-design file or None) for every single-solid part of the data."""
+    data = os.path.normpath(os.path.join(ROOT, "..", "shared", "data"))
+    out = [(n, os.path.join(data, "examples", n + ".step"), os.path.join(data, "examples", n + "_nondesign.step"))
+           for n in ("rocker", "cantilever", "bracket")]
+    out += [("NIST %d" % n, os.path.join(data, "nist", "NIST_MBE_PMI_%d.stp" % n), None) for n in (1, 2, 3, 4, 5, 6, 11)]
+    return out + [("linkrods", os.path.join(data, "occt", "linkrods.step"), None)]
+
+
+def product_row(topopt, part, nd, factor, tmp):
+    """One `topopt mesh --mesher native` on one CPU: its row, or its error."""
+    import json, subprocess
+    msh, stats = os.path.join(tmp, "m.msh"), os.path.join(tmp, "m.json")
+    cmd = ["taskset", "-c", "0", topopt, "mesh", "--part", part, "--mesher", "native", "--out", msh, "--stats", stats]
+    cmd += ["--non-design", nd] if nd else []
+    if factor != 1.0:
+        info = json.loads(subprocess.run([topopt, "info", "--part", part, "--json"], capture_output=True, text=True,
+                                         check=True).stdout)
+        lo, hi = info["part"]["bbox"]["min"], info["part"]["bbox"]["max"]
+        cmd += ["--size", repr(factor * sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5 / 50)]
+    t = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    dt = time.perf_counter() - t
+    if not os.path.exists(stats):
+        return {"error": p.stderr.strip()[-400:], "seconds": dt}
+    s = json.load(open(stats))
+    P, T = read_msh_tets(msh)
+    rmin, below1, below2, dih = quality_shares(P, T)
+    c = s["conformity"]
+    os.remove(stats)
+    return {"tets": len(T), "rr_min": rmin, "below_0.1": below1, "below_0.2": below2, "dihedral_min": dih,
+            "conformity": c["ok"], "flat": c.get("flat_tets", "-"), "inverted": c["inverted_tets"],
+            "seconds": round(dt, 1), "mesh_seconds": round(s["seconds"]["mesh"], 1)}
+
+
+def product(args):
+    import json, tempfile
+    rows = json.load(open(args.json)) if os.path.exists(args.json) else {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, part, nd in product_parts():
+            for f in (float(x) for x in args.factors.split(",")):
+                key = "%s@%g" % (name, f)
+                if key in rows or (args.parts and name not in args.parts.split(",")):
+                    continue
+                rows[key] = product_row(args.product, part, nd, f, tmp)
+                print(key, json.dumps(rows[key]), file=sys.stderr, flush=True)
+                json.dump(rows, open(args.json, "w"), indent=1)
+
+
+def table(files):
+    """Two --json files (before, after) side by side as a Markdown table (rows of the second)."""
+    import json
+    old, new = (json.load(open(f)) for f in files.split(","))
+    print("| part | size | tets before / after | radius ratio min before / after | share < 0.1 before / after |"
+          " share < 0.2 before / after | flat / inverted after | conformity after |")
+    print("|---|---|---|---|---|---|---|---|")
+    pct = lambda x: "%.3f %%" % (100 * x)
+    for key in new:
+        a, b = old.get(key, {}), new[key]
+        name, f = key.split("@")
+        size = "default" if float(f) == 1.0 else "%s×" % f
+        if "error" in b or "error" in a or not a:
+            print("| %s | %s | before: %s / after: %s | | | | | |" % (name, size, a.get("error", "-")[-80:],
+                                                                    b.get("error", "-")[-80:]))
+            continue
+        print("| %s | %s | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %s / %s | %s |" % (
+            name, size, a["tets"], b["tets"], a["rr_min"], b["rr_min"], pct(a["below_0.1"]), pct(b["below_0.1"]),
+            pct(a["below_0.2"]), pct(b["below_0.2"]), b["flat"], b["inverted"], "ok" if b["conformity"] else "DEFECTS"))
 
 
 def run_gmsh(P, F, h):
@@ -113,7 +232,16 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--cases", default="rocker:1.0,rocker:2.77,cantilever:1.28,bracket:2.72")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--product", help="a topopt executable: its product path on every shared part (see above)")
+    ap.add_argument("--factors", default="1.0,0.6", help="with --product: sizes as factors of the default")
+    ap.add_argument("--parts", default="", help="with --product: only these parts (names as in the table)")
+    ap.add_argument("--json", default="product.json", help="with --product: rows kept here (a rerun skips them)")
+    ap.add_argument("--table", help="old.json,new.json: the two --product runs as one Markdown table")
     args = ap.parse_args()
+    if args.table:
+        return table(args.table)
+    if args.product:
+        return product(args)
     sys.path.insert(0, os.path.join(args.build, "workbench", "TopOpt", "topopt"))
     import _native
     rows = []

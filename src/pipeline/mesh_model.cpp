@@ -3,14 +3,17 @@
 
 #include <sys/prctl.h>
 #include <sys/syscall.h>
+#include <time.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 
 #include "common/error.h"
 #include "common/isolate.h"
+#include "mesh/core/conformity.h"
 #include "mesh/two_brep/gmsh_fragments.h"
 #include "pipeline/mesh_bytes.h"
 
@@ -62,13 +65,51 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// The native mesher; under "auto" its failure comes back in `reason` instead of as an
-/// error, but a cancel or a mesh too large for memory (Gmsh's would not fit either).
+/// CPU seconds this process has used (all its threads): the native mesher's budget is counted
+/// in them, so that a machine shared with other work does not stop a mesh that would finish.
+double cpu_seconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// The native mesher stopped after `seconds` of computing: it checks its Progress's
+/// cancelled() at safe points in every stage's loop, and here that also answers yes once the
+/// budget is spent; such a stop becomes Error(Timeout) naming the budget and the stage.
+TetMesh mesh_native_within(const brep::TwoBReps& model, const MeshSettings& settings, const MeshSizes& sizes,
+                           const Progress& progress, mesh::MeshRun* run) {
+  const double seconds = native_time_budget(settings, sizes);
+  const double end = cpu_seconds() + seconds;
+  std::atomic<bool> expired{false};
+  Progress timed = progress;
+  timed.cancelled = [&progress, &expired, end] {
+    if (progress.cancelled && progress.cancelled()) return true;
+    if (cpu_seconds() > end) expired = true;
+    return expired.load();
+  };
+  try {
+    return mesh::mesh_native(model, native_mesh_params(settings, sizes), timed, run);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::Cancelled || !expired.load()) throw;
+    const std::string what = e.what();  // "cancelled during <stage>" (Progress::check_cancel)
+    const size_t at = what.find("during ");
+    const std::string stage = at == std::string::npos ? what : what.substr(at + 7);
+    throw Error(ErrorCode::Timeout,
+                "the native mesher did not finish within its time budget of " +
+                    std::to_string(static_cast<long>(std::ceil(seconds))) + " s of computing (for about " +
+                    std::to_string(static_cast<long>(sizes.estimated_tets)) +
+                    " tets at this size) and was stopped in " + stage + ": give a larger mesh size, or mesh with Gmsh");
+  }
+}
+
+/// The native mesher; under "auto" its failure (a timeout included) comes back in `reason`
+/// instead of as an error, but a cancel or a mesh too large for memory (Gmsh's would not fit
+/// either).
 bool try_native(const brep::TwoBReps& model, const MeshSettings& settings, const MeshSizes& sizes,
                 const Progress& progress, mesh::MeshRun* run, TetMesh& out, std::string& reason) {
   const bool fallback = settings.mesher == Mesher::Auto;
   try {
-    out = mesh::mesh_native(model, native_mesh_params(settings, sizes), progress, run);
+    out = mesh_native_within(model, settings, sizes, progress, run);
     return true;
   } catch (const Error& e) {
     if (!fallback || e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::TooLarge) throw;
@@ -96,6 +137,12 @@ TetMesh gmsh(const brep::TwoBReps& model, const MeshSettings& settings, const Me
     run->mesher = settings.gmsh_volume_by_front ? "gmsh surfaces + native volumes" : "gmsh";
     run->seconds = {{"gmsh fragments, surface and volume", seconds_since(t0)}};
   }
+  // the same check as the native mesher's own (mesh::mesh_native): no mesh leaves unchecked
+  const auto t1 = std::chrono::steady_clock::now();
+  mesh::ConformityParams cp;
+  cp.volume_tolerance = 0.05;  // gross errors only: the faceting of curved faces is not one
+  mesh::require_valid_mesh(mesh::check_conformity(m, &model, cp), "the mesh made by Gmsh");
+  if (run) run->seconds.push_back({"conformity check", seconds_since(t1)});
   return m;
 }
 

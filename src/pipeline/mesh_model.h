@@ -15,9 +15,14 @@ namespace topopt::pipeline {
 /// order the mesher made them. Sizes from resolve_mesh_sizes (a warning through `progress`
 /// when a size is clamped). "auto": whatever stops the native mesher, except a cancel or a
 /// mesh too large for memory, falls back to Gmsh with a warning (the reason in run->fallback_reason). `run` (optional)
-/// gets the mesher used and the seconds per stage. Throws Error(TooLarge) before any meshing for a size asking for too
-/// many tets; Error(MeshingFailed) naming where a mesher failed; Error(Crashed) or Error(Timeout) when Gmsh crashed or
-/// ran past its budget (naming the native mesher's failure first under "auto"); Error(Cancelled).
+/// gets the mesher used and the seconds per stage. Each mesher runs within a time budget proportional to the estimated
+/// tet count (native_time_budget, gmsh_time_budget), and every mesh is checked before it is returned
+/// (mesh::check_conformity: exact orientation of every tet, conformity, volumes; the native mesher checks its own).
+/// Throws Error(TooLarge) before any meshing for a size asking for too many tets; Error(MeshingFailed) naming where a
+/// mesher failed or what is wrong with its mesh (the worst tets by position and quality); Error(Timeout) when the
+/// native mesher ran past its budget (naming the stage; under "auto" Gmsh follows), Error(Crashed) or Error(Timeout)
+/// when Gmsh crashed or ran past its budget (naming the native mesher's failure first under "auto");
+/// Error(Cancelled).
 TetMesh mesh_model(const brep::TwoBReps& model, const MeshSettings& settings, const Progress& progress = {},
                    mesh::MeshRun* run = nullptr);
 

@@ -54,6 +54,9 @@ void check_mesh_settings(const MeshSettings& s, const std::string& size_name, co
                 "gmsh): the native mesher fills its volumes itself");
   if (!(std::isfinite(s.gmsh_seconds) && s.gmsh_seconds >= 0))
     throw Error(ErrorCode::InvalidParameter, "the Gmsh time limit must be a positive number of seconds, or 0");
+  if (!(std::isfinite(s.native_seconds) && s.native_seconds >= 0))
+    throw Error(ErrorCode::InvalidParameter,
+                "the native mesher's time limit must be a positive number of seconds, or 0 for automatic");
 }
 
 MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volume, const Progress& progress) {
@@ -112,6 +115,11 @@ mesh::FragmentMeshParams gmsh_mesh_params(const MeshSettings& s, const MeshSizes
 double gmsh_time_budget(const MeshSettings& s, const MeshSizes& sizes) {
   if (s.gmsh_seconds > 0) return s.gmsh_seconds;
   return MeshDefaults::kGmshBaseSeconds + sizes.estimated_tets / MeshDefaults::kGmshTetsPerSecond;
+}
+
+double native_time_budget(const MeshSettings& s, const MeshSizes& sizes) {
+  if (s.native_seconds > 0) return s.native_seconds;
+  return MeshDefaults::kNativeBaseSeconds + sizes.estimated_tets / MeshDefaults::kNativeTetsPerSecond;
 }
 
 }  // namespace topopt::pipeline

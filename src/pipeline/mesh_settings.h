@@ -36,6 +36,12 @@ struct MeshDefaults {
   static constexpr double kMaxTets = 6e6;
   /// The Gmsh fallback's time budget: this many seconds, plus one per this many estimated tets.
   static constexpr double kGmshBaseSeconds = 120, kGmshTetsPerSecond = 2000;
+  /// The native mesher's budget in CPU seconds of the process, the same way. The estimate
+  /// misses the surface's refinement: on the shared parts the native mesh has 0.7 to 160
+  /// times the estimated tets (NIST 3 at its default size: 207 k for 1.3 k), and took up to
+  /// 171 s (NIST 2 at 0.6x, 1.8 M tets, 118 k estimated); this budget is over four times that
+  /// on every shared part at the default size and at 0.6x.
+  static constexpr double kNativeBaseSeconds = 300, kNativeTetsPerSecond = 250;
 };
 
 /// What the user decides about meshing, before it meets a part.
@@ -48,11 +54,15 @@ struct MeshSettings {
   /// Seconds the Gmsh fallback may run before it is stopped; 0: from the estimated tet count
   /// (MeshDefaults::kGmshBaseSeconds + estimate / kGmshTetsPerSecond).
   double gmsh_seconds = 0;
+  /// CPU seconds the native mesher may use before it is stopped with Error(Timeout) (under
+  /// "auto": then Gmsh); 0: from the estimated tet count (MeshDefaults::kNativeBaseSeconds +
+  /// estimate / kNativeTetsPerSecond).
+  double native_seconds = 0;
   /// Gmsh's surfaces filled by our 3D front (topopt mesh --volume native: a comparison aid).
   bool gmsh_volume_by_front = false;
 };
 
-/// Throws Error(InvalidParameter) for a size, smallest size or time limit that is negative
+/// Throws Error(InvalidParameter) for a size, smallest size or time limits that are negative
 /// or not finite, a smallest size above the size when both are given, or Gmsh's surfaces
 /// filled by the front with another mesher than Gmsh. `size_name`,
 /// `min_size_name`: how the caller's user writes them ("'mesh.size'", "--size").
@@ -83,5 +93,8 @@ mesh::FragmentMeshParams gmsh_mesh_params(const MeshSettings& s, const MeshSizes
 
 /// The Gmsh fallback's time budget in seconds (MeshSettings::gmsh_seconds, or from the estimate).
 double gmsh_time_budget(const MeshSettings& s, const MeshSizes& sizes);
+
+/// The native mesher's time budget in seconds (MeshSettings::native_seconds, or from the estimate).
+double native_time_budget(const MeshSettings& s, const MeshSizes& sizes);
 
 }  // namespace topopt::pipeline

@@ -15,14 +15,14 @@ bool SurfaceJobResult::ok() const {
   return mesh.failed_faces.empty() && open == 0 && crossings.empty();
 }
 
-brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes,
-                                     const brep::ForeignParams& budget, const Progress& progress) {
+brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what,
+                                     std::vector<std::string>& notes, const brep::ForeignParams& budget,
+                                     const Progress& progress) {
   const TopoDS_Shape checked = brep::check_solids(shape, what, notes, budget, progress);
   return brep::guard_occt("indexing the " + what, [&] { return brep::index_topology(checked); });
 }
 
-SurfaceJobResult surface_job(const brep::TopologyIndex& topo, const MeshSettings& settings,
-                             const Progress& progress) {
+SurfaceJobResult surface_job(const brep::TopologyIndex& topo, const MeshSettings& settings, const Progress& progress) {
   const MeshSizes sizes = resolve_mesh_sizes(settings, topo.diagonal(), std::abs(topo.solid_volume.sum()), progress);
   mesh::SurfaceMeshParams p;
   p.size = sizes.size;

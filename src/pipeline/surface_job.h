@@ -19,11 +19,11 @@ namespace topopt::pipeline {
 
 /// A surface mesh and what was checked on it.
 struct SurfaceJobResult {
-  mesh::SurfaceMesh mesh;                        ///< nodes, triangles (outward), face numbers, failed faces
-  std::vector<long> open_edges_per_solid;        ///< 0 = closed and consistently oriented
-  std::vector<std::pair<int, int>> crossings;    ///< intersecting triangle pairs within a solid (≤ 100)
-  mesh::SurfaceQuality quality;                  ///< angle figures
-  double seconds_mesh = 0;                       ///< meshing wall time
+  mesh::SurfaceMesh mesh;                      ///< nodes, triangles (outward), face numbers, failed faces
+  std::vector<long> open_edges_per_solid;      ///< 0 = closed and consistently oriented
+  std::vector<std::pair<int, int>> crossings;  ///< intersecting triangle pairs within a solid (≤ 100)
+  mesh::SurfaceQuality quality;                ///< angle figures
+  double seconds_mesh = 0;                     ///< meshing wall time
 
   /// True when every face meshed, every solid is closed and nothing intersects.
   bool ok() const;
@@ -33,8 +33,9 @@ struct SurfaceJobResult {
 /// checked and healed (brep::check_solids, in a child process under `budget`), then indexed
 /// with OCCT's failures named. `what` names the input in messages; repairs are appended to
 /// `notes`. Throws what check_solids throws (InvalidShape, Crashed, Timeout).
-brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what, std::vector<std::string>& notes,
-                                     const brep::ForeignParams& budget = {}, const Progress& progress = {});
+brep::TopologyIndex checked_topology(const TopoDS_Shape& shape, const std::string& what,
+                                     std::vector<std::string>& notes, const brep::ForeignParams& budget = {},
+                                     const Progress& progress = {});
 
 /// Meshes the faces of `topo` at the sizes `settings` resolve to (the same defaults, clamp and
 /// element budget as every mesher: resolve_mesh_sizes), then checks each solid: open edges

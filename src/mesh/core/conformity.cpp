@@ -3,24 +3,32 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <unordered_map>
 
 #include "brep/point_locator.h"
+#include "common/error.h"
 #include "common/face_key.h"
+#include "mesh/core/predicates.h"
+#include "mesh/core/tet_quality.h"
 
 namespace topopt::mesh {
 
 bool ConformityReport::ok() const {
-  return inverted_tets == 0 && duplicate_nodes == 0 && overshared_faces == 0 && boundary_not_in_F == 0 &&
-         F_not_boundary == 0 && open_boundary_edges == 0 && interface_off_nondesign == 0 && volumes_ok;
+  return inverted_tets == 0 && flat_tets == 0 && duplicate_nodes == 0 && overshared_faces == 0 &&
+         boundary_not_in_F == 0 && F_not_boundary == 0 && open_boundary_edges == 0 && interface_off_nondesign == 0 &&
+         volumes_ok;
 }
 
 nlohmann::json ConformityReport::to_json() const {
+  nlohmann::json worst = nlohmann::json::array();
+  for (const TetDefect& d : worst_tets) worst.push_back(d.to_json());
   return {{"ok", ok()},
           {"nodes", nodes},
           {"tets", tets},
           {"boundary_triangles", boundary_triangles},
           {"inverted_tets", inverted_tets},
+          {"flat_tets", flat_tets},
           {"duplicate_nodes", duplicate_nodes},
           {"overshared_faces", overshared_faces},
           {"boundary_not_in_F", boundary_not_in_F},
@@ -31,7 +39,60 @@ nlohmann::json ConformityReport::to_json() const {
           {"interface_off_nondesign", interface_off_nondesign},
           {"domain_volume", domain_volume},
           {"expected_volume", expected_volume},
-          {"max_volume_error", max_volume_error}};
+          {"max_volume_error", max_volume_error},
+          {"worst_tets", worst}};
+}
+
+nlohmann::json TetDefect::to_json() const {
+  return {{"tet", tet},
+          {"centroid", {centroid.x(), centroid.y(), centroid.z()}},
+          {"radius_ratio", radius_ratio},
+          {"min_dihedral", min_dihedral},
+          {"orientation", orientation}};
+}
+
+namespace {
+
+std::string where(const TetDefect& d) {
+  std::ostringstream s;
+  s << "tet " << d.tet << " near (" << d.centroid.x() << ", " << d.centroid.y() << ", " << d.centroid.z()
+    << ") with radius ratio " << d.radius_ratio << " and smallest dihedral angle " << d.min_dihedral << "°";
+  return s.str();
+}
+
+/// "<n> <what>, the worst <tet> near (x, y, z) ..." for the first defect of that orientation.
+void describe_tets(std::ostringstream& s, const ConformityReport& r, int n, const char* what, int orientation) {
+  if (n == 0) return;
+  s << "; " << n << " " << what;
+  for (const TetDefect& d : r.worst_tets)
+    if (d.orientation == orientation || (orientation == 0 && d.orientation > 0)) {
+      s << ", the worst " << where(d);
+      break;
+    }
+}
+
+}  // namespace
+
+std::string ConformityReport::describe() const {
+  if (ok()) return "";
+  std::ostringstream s;
+  describe_tets(s, *this, inverted_tets, "inverted tets (negative volume)", -1);
+  describe_tets(s, *this, flat_tets, "flat tets (four nodes on one plane, or nearly)", 0);
+  const std::pair<int, const char*> counts[] = {
+      {duplicate_nodes, "nodes at the place of another node"},
+      {overshared_faces, "tet faces shared by more than two tets"},
+      {boundary_not_in_F, "free tet faces that are not boundary triangles (holes)"},
+      {F_not_boundary, "boundary triangles that are not the face of exactly one tet"},
+      {open_boundary_edges, "open or inconsistently oriented boundary edges"},
+      {interface_off_nondesign, "faces between design and non-design tets that lie on no non-design face"}};
+  for (const auto& [n, what] : counts)
+    if (n) s << "; " << n << " " << what;
+  if (!volumes_ok) s << "; a domain's volume is " << 100 * max_volume_error << " % off its solid's";
+  return s.str().substr(2);
+}
+
+void require_valid_mesh(const ConformityReport& report, const std::string& what) {
+  if (!report.ok()) throw Error(ErrorCode::MeshingFailed, what + " is not a valid mesh: " + report.describe());
 }
 
 namespace {
@@ -44,6 +105,39 @@ double signed_volume(const TetMesh& m, int t) {
   Eigen::Vector3d a = m.V.row(m.T(t, 1)) - m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 2)) - m.V.row(m.T(t, 0)),
                   c = m.V.row(m.T(t, 3)) - m.V.row(m.T(t, 0));
   return a.cross(b).dot(c) / 6.0;
+}
+
+/// The tets on their own: exact orientation (inverted and flat ones counted), volume per
+/// domain, and the `worst_reported` worst of them.
+void check_tets(const TetMesh& m, const ConformityParams& params, ConformityReport& r) {
+  std::vector<std::pair<double, int>> candidates;  // (sort key, tet): the worst so far
+  const size_t keep = static_cast<size_t>(std::max(params.worst_reported, 0));
+  for (int t = 0; t < m.T.rows(); ++t) {
+    const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                          d = m.V.row(m.T(t, 3));
+    const int o = predicates::orient3d(a.data(), b.data(), c.data(), d.data());
+    const double rho = o > 0 ? radius_ratio(a, b, c, d) : 0;
+    if (o < 0) ++r.inverted_tets;
+    if (o == 0 || (o > 0 && rho < params.flat_below)) ++r.flat_tets;
+    const int dom = m.domain.size() ? m.domain[t] : 0;
+    if (dom >= 0 && dom < static_cast<int>(r.domain_volume.size())) r.domain_volume[dom] += signed_volume(m, t);
+    const double key = o < 0 ? -2.0 : (o == 0 ? -1.0 : rho);
+    if (candidates.size() < keep || (keep && key < candidates.back().first)) {
+      candidates.insert(std::upper_bound(candidates.begin(), candidates.end(), std::make_pair(key, t)), {key, t});
+      if (candidates.size() > keep) candidates.pop_back();
+    }
+  }
+  for (const auto& [key, t] : candidates) {
+    const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                          d = m.V.row(m.T(t, 3));
+    TetDefect x;
+    x.tet = t;
+    x.centroid = (a + b + c + d) / 4.0;
+    x.orientation = key == -2.0 ? -1 : (key == -1.0 ? 0 : 1);
+    x.radius_ratio = radius_ratio(a, b, c, d);
+    x.min_dihedral = dihedral_range(a, b, c, d).first;
+    r.worst_tets.push_back(x);
+  }
 }
 
 int count_duplicates(const MatX3d& V, double tol) {
@@ -95,11 +189,8 @@ ConformityReport check_conformity(const TetMesh& m, const brep::TwoBReps* geomet
   faces.reserve(4 * m.T.rows());
   const auto& local = kTetFace;
   std::vector<std::pair<Key3, std::pair<int, int>>> interfaces;  // key, (tet a, tet b)
+  check_tets(m, params, r);
   for (int t = 0; t < m.T.rows(); ++t) {
-    double v = signed_volume(m, t);
-    if (!(v > 0)) ++r.inverted_tets;
-    int d = m.domain.size() ? m.domain[t] : 0;
-    if (d >= 0 && d < num_domains) r.domain_volume[d] += v;
     for (const auto& f : local) {
       Key3 k = sorted(m.T(t, f[0]), m.T(t, f[1]), m.T(t, f[2]));
       auto [it, inserted] = faces.try_emplace(k, 1, t);

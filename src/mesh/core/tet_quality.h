@@ -7,6 +7,12 @@
 
 namespace topopt::mesh {
 
+/// A tet whose exact orientation is positive but whose radius ratio is below this counts as
+/// flat (degenerate): its volume is at the rounding of its coordinates (radius ratio 1e-39 was
+/// seen on a real part), and no solver can use it. The meshers never return one; the
+/// conformity check rejects it.
+constexpr double kFlatRadiusRatio = 1e-6;
+
 /// Radius ratio 3·r_in/R_circ of one tet (0 for a degenerate one).
 double radius_ratio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                     const Eigen::Vector3d& d);

@@ -237,8 +237,10 @@ std::vector<std::vector<int>> front_components(const TetFront& front) {
 }
 
 void close_cavities(TetFront& front, std::vector<Vec3>& P, std::vector<Tet>& tets, const Progress& progress) {
-  for (const std::vector<int>& cf : front_components(front))
+  for (const std::vector<int>& cf : front_components(front)) {
+    progress.check_cancel("volume meshing (closing cavities)");
     close_cavity(front, P, tets, cf, nodes_of(front, cf), progress);
+  }
 }
 
 }  // namespace topopt::mesh

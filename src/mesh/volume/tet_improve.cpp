@@ -2,6 +2,7 @@
 #include "mesh/volume/tet_improve.h"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 
 #include "common/face_key.h"
@@ -18,6 +19,10 @@ namespace {
 double rho(const std::vector<Vec3>& P, const Tet& t) { return radius_ratio(P[t[0]], P[t[1]], P[t[2]], P[t[3]]); }
 
 bool has(const Tet& t, int x) { return t[0] == x || t[1] == x || t[2] == x || t[3] == x; }
+
+double signed_volume(const std::vector<Vec3>& P, const Tet& t) {
+  return (P[t[1]] - P[t[0]]).dot((P[t[2]] - P[t[0]]).cross(P[t[3]] - P[t[0]])) / 6;
+}
 
 /// Compass search: moves x along ±x, ±y, ±z by `step` while f (which reads x) rises, halving
 /// the step when no direction helps, for at most `iterations` tries or until the step is a
@@ -333,11 +338,21 @@ CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad) 
   // alone could leave more than it removed, for the next sweep to find (on NIST 6 the sweeps
   // grew the tets below 0.1 from 5 500 to 9 000)
   int new_bad = 0;
+  double star_volume = 0;
   if (best > old_worst)
-    for (const Tri& f : star.faces) new_bad += radius_ratio(P[f[0]], P[f[2]], P[f[1]], P[id]) < kSliverShare * bad;
+    for (const Tri& f : star.faces) {
+      new_bad += radius_ratio(P[f[0]], P[f[2]], P[f[1]], P[id]) < kSliverShare * bad;
+      star_volume += signed_volume(P, {f[0], f[2], f[1], id});
+    }
   star.point = P[id];
   P.pop_back();
   if (!(best > old_worst) || new_bad > old_bad) return {};
+  // a point that sees every face tiles a cavity of positive tets exactly; one holding a flat or
+  // inverted tet has faces that overlap, and its star would cover part of it twice: the star
+  // must have the cavity's volume
+  double cavity_volume = 0;
+  for (int c : cavity) cavity_volume += signed_volume(P, s.tets[c]);
+  if (!(std::abs(star_volume - cavity_volume) <= 1e-9 * std::abs(cavity_volume))) return {};
   star.cavity = std::move(cavity);
   star.gain = best - old_worst;
   return star;
@@ -435,6 +450,89 @@ std::vector<std::vector<int>> candidate_cavities(const TetSweep& s, int t) {
 
 }  // namespace
 
+namespace {
+
+/// The wider cavities around tet t: the stars of its nodes, the stars of both ends of each of
+/// its edges, and t with three layers of face neighbours (each sorted, without repeats).
+std::vector<std::vector<int>> wide_cavities(const TetSweep& s, int t) {
+  std::vector<std::vector<int>> options;
+  const Tet v = s.tets[t];
+  auto add = [&options](std::vector<int> c) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    options.push_back(std::move(c));
+  };
+  for (int i = 0; i < 4; ++i) {
+    const NodeStars::Range star = s.stars.of(v[i]);
+    add(std::vector<int>(star.begin(), star.end()));
+  }
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      std::vector<int> both(s.stars.of(v[i]).begin(), s.stars.of(v[i]).end());
+      both.insert(both.end(), s.stars.of(v[j]).begin(), s.stars.of(v[j]).end());
+      add(std::move(both));
+    }
+  std::vector<int> layer{t};
+  for (int l = 0; l < 3; ++l) {
+    for (int c : std::vector<int>(layer))
+      for (const auto& o : kTetFace) {
+        const int a = s.tets[c][o[0]], b = s.tets[c][o[1]], d = s.tets[c][o[2]];
+        for (int q : s.stars.of(a))
+          if (q != c && has(s.tets[q], b) && has(s.tets[q], d)) layer.push_back(q);
+      }
+    std::sort(layer.begin(), layer.end());
+    layer.erase(std::unique(layer.begin(), layer.end()), layer.end());
+  }
+  add(std::move(layer));
+  return options;
+}
+
+/// The tets below `floor`, worst first, as (radius ratio, tet).
+std::vector<std::pair<double, size_t>> tets_below(const std::vector<Vec3>& P, const std::vector<Tet>& tets,
+                                                  double floor) {
+  std::vector<std::pair<double, size_t>> order;
+  for (size_t t = 0; t < tets.size(); ++t)
+    if (tets[t][0] >= 0) {
+      const double r = rho(P, tets[t]);
+      if (r < floor) order.push_back({r, t});
+    }
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+}  // namespace
+
+long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floor, int sweeps,
+                       const Progress& progress) {
+  long done = 0;
+  const double bad = floor / kSliverShare;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    progress.check_cancel("volume meshing (sliver removal)");
+    const std::vector<std::pair<double, size_t>> order = tets_below(P, tets, floor);
+    if (order.empty()) break;
+    TetSweep s(P, tets);
+    for (const auto& [r0, t] : order) {
+      if (s.touched[t]) continue;
+      bool skip = false;
+      for (int x : tets[t]) skip |= s.locked[x] != 0;
+      if (skip) continue;
+      CavityStar best;
+      std::vector<std::vector<int>> options = candidate_cavities(s, static_cast<int>(t));
+      for (std::vector<int>& c : wide_cavities(s, static_cast<int>(t))) options.push_back(std::move(c));
+      for (std::vector<int>& cavity : options) {
+        CavityStar star = plan_refill_cavity(s, std::move(cavity), bad);
+        if (!star.empty() && star.gain > best.gain) best = std::move(star);
+      }
+      if (best.empty()) continue;
+      apply(s, best);
+      ++done;
+    }
+    if (s.pending.empty()) break;
+    s.end();
+  }
+  return done;
+}
+
 long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad) {
   long done = 0;
   for (int sweep = 0; sweep < 3; ++sweep) {
@@ -467,8 +565,10 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, doub
   return done;
 }
 
-void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, const TetImproveParams& params) {
+void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, const TetImproveParams& params,
+                  const Progress& progress) {
   for (int round = 0; round < params.quality_rounds; ++round) {
+    progress.check_cancel("volume meshing (quality)");
     if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
     if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
       const NodeStars stars(P.size(), tets);
@@ -479,12 +579,14 @@ void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, c
   // slivers the flips and moves left (e.g. with two faces on the boundary): re-filled from a
   // new point, then one more round of flips and compass search
   for (int again = 0; again < 3 && params.sliver_below > 0; ++again) {
+    progress.check_cancel("volume meshing (quality)");
     if (insert_points_at_slivers(P, tets, params.sliver_below) == 0) break;
     if (params.flip_below > 0) {
       flip_bad_tets(P, tets, params.sliver_below);
       search_nodes_of_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.sliver_below);
     }
   }
+  if (params.sliver_floor > 0) remove_tets_below(P, tets, params.sliver_floor, 4, progress);
 }
 
 }  // namespace topopt::mesh

@@ -22,6 +22,7 @@
 #include <array>
 #include <vector>
 
+#include "common/progress.h"
 #include "common/types.h"
 #include "mesh/volume/node_stars.h"
 
@@ -107,8 +108,10 @@ struct CavityStar {
 /// Refill (check-only): the untouched tets `cavity` (no node locked) as a star of its faces
 /// from the point that maximises the star's worst radius ratio (a compass search from the
 /// faces' centroid, steps of 0.15 of their mean edge), kept when that point sees every face
-/// (the star tiles the cavity exactly), the star's worst tet beats the cavity's and it has no
-/// more tets below kSliverShare × bad than the cavity had. P is as it was on return.
+/// (the star tiles the cavity exactly) and the star has the cavity's volume (a cavity holding a
+/// flat or inverted tet has overlapping faces: its star would cover part of it twice), the
+/// star's worst tet beats the cavity's and it has no more tets below kSliverShare × bad than
+/// the cavity had. P is as it was on return.
 CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad);
 /// Makes star c: its point is appended to P, its cavity retired (and its nodes locked), its
 /// tets pending until the sweep ends.
@@ -135,17 +138,30 @@ void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector
 /// Returns the number of cavities re-filled.
 long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
 
+/// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
+/// each is taken out with the best of wider cavities than insert_points_at_slivers tries —
+/// those, the star of each of its nodes, the stars of both ends of each of its edges, and
+/// three layers of face neighbours — re-filled from one point (refill_cavity with
+/// bad = floor / kSliverShare: no more tets below floor than the cavity had); up to `sweeps`
+/// sweeps while any cavity is re-filled, progress checked for cancellation between them.
+/// Returns the number of cavities re-filled.
+long remove_tets_below(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double floor, int sweeps,
+                       const Progress& progress = {});
+
 struct TetImproveParams {
   double flip_below = 0.55;      ///< tets below this radius ratio get edge removal and 2-3 flips (0: none)
   int smoothing_iterations = 1;  ///< smooth_node sweeps per round
   int quality_rounds = 3;        ///< rounds of flips, smoothing and compass search
   double sliver_below = 0.4;     ///< compass search at tets below this each round, then point insertion (0: none)
+  /// Then tets below this get wider cavities (remove_tets_below, up to 4 sweeps; 0: none).
+  double sliver_floor = 0.1;
 };
 
 /// The improvement after a fill: `quality_rounds` rounds of flips, smoothing of the nodes
 /// from first_new on and compass search at the bad tets; then up to three rounds of sliver
-/// insertion, each followed by flips and compass search. Nodes below first_new never move.
+/// insertion, each followed by flips and compass search; then remove_tets_below(sliver_floor).
+/// Nodes below first_new never move. Checks progress for cancellation between rounds.
 void improve_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new,
-                  const TetImproveParams& params);
+                  const TetImproveParams& params, const Progress& progress = {});
 
 }  // namespace topopt::mesh

@@ -357,6 +357,26 @@ std::function<double(const double*)> default_size(const MatX3d& V, const MatX3i&
   return [background](const double* x) { return background->at(x); };
 }
 
+/// No flat tet leaves the fill: the tets exactly flat or inverted (orient3d; the kernels make
+/// none) or below kFlatRadiusRatio are taken out with their cavities re-filled
+/// (remove_tets_below); throws Error(MeshingFailed) naming where one is left.
+void remove_flat_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, const Progress& progress) {
+  auto flat = [&P](const Tet& t) {
+    return orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data()) <= 0 ||
+           radius_ratio(P[t[0]], P[t[1]], P[t[2]], P[t[3]]) < kFlatRadiusRatio;
+  };
+  if (std::none_of(tets.begin(), tets.end(), flat)) return;
+  remove_tets_below(P, tets, kFlatRadiusRatio, 4, progress);
+  const auto left = std::find_if(tets.begin(), tets.end(), flat);
+  if (left == tets.end()) return;
+  const Vec3 c = (P[(*left)[0]] + P[(*left)[1]] + P[(*left)[2]] + P[(*left)[3]]) / 4;
+  std::ostringstream s;
+  s << "the volume mesh holds a flat tet near (" << c.x() << ", " << c.y() << ", " << c.z()
+    << ") that re-filling its cavity could not remove (" << std::count_if(tets.begin(), tets.end(), flat)
+    << " such tets); a finer or smoother surface mesh there may help";
+  throw Error(ErrorCode::MeshingFailed, s.str());
+}
+
 /// The input nodes as they were, then only the new nodes some tet uses (tets removed by the
 /// re-meshing rounds leave theirs behind, and a later point may land on one), renumbered in
 /// the order the tets first use them.
@@ -412,7 +432,9 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   ip.smoothing_iterations = params.smoothing_iterations;
   ip.quality_rounds = params.quality_rounds;
   ip.sliver_below = params.sliver_below;
-  improve_tets(P, tets, static_cast<int>(V.rows()), ip);
+  ip.sliver_floor = params.sliver_floor;
+  improve_tets(P, tets, static_cast<int>(V.rows()), ip, progress);
+  remove_flat_tets(P, tets, progress);
   return compact(V.rows(), P, tets);
 }
 

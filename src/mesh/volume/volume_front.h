@@ -34,6 +34,7 @@ struct VolumeFillParams {
   bool delaunay_bulk = true;     ///< fill the bulk by Delaunay refinement first (delaunay_bulk.h), the front the rest
   double sliver_below = 0.4;     ///< new tets below this get a compass search on their nodes each round, then sliver
                                  ///< removal by point insertion, worst first, up to 3 times (0: none)
+  double sliver_floor = 0.1;     ///< then tets below this get wider cavities re-filled (tet_improve.h; 0: none)
 };
 
 struct VolumeFillResult {
@@ -43,8 +44,11 @@ struct VolumeFillResult {
 
 /// Fills the region bounded by F (#F by 3, oriented with normals pointing OUT of the region)
 /// on nodes V (#V by 3), around the existing tets T0 (#T0 by 4, kept, may be empty).
-/// Throws Error(MeshingFailed) naming where the front could not be closed, or where it went
-/// on making tets past ten times what its size asks for (expected_tets) without closing.
+/// Never returns a flat or inverted tet (exact orientation, or radius ratio below
+/// kFlatRadiusRatio): such a tet is taken out and its cavity re-filled. Throws
+/// Error(MeshingFailed) naming where the front could not be closed, where it went on making
+/// tets past ten times what its size asks for (expected_tets) without closing, or where a flat
+/// tet could not be removed; Error(Cancelled) when progress says so (checked in every loop).
 VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params = {},
                              const Progress& progress = {});
 

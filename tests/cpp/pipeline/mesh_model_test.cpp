@@ -9,6 +9,7 @@
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Builder.hxx>
 #include <TopoDS_Compound.hxx>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -145,6 +146,32 @@ TEST(MeshModel, GmshWritesNoFileOfItsOwn) {
   EXPECT_EQ(left, std::vector<std::string>{".gmsh-tmp"});
   EXPECT_TRUE(fs::exists(home / ".gmsh-tmp"));
   fs::remove_all(home);
+}
+
+TEST(MeshModel, NativePastItsTimeBudgetIsANamedErrorSoonAfter) {
+  const brep::TwoBReps model = example("rocker");
+  MeshSettings s = with(Mesher::Native);
+  s.native_seconds = 0.05;
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_error([&] { mesh_model(model, s); }, ErrorCode::Timeout,
+               {"the native mesher did not finish within its time budget of 1 s of computing", "and was stopped in ",
+                "give a larger mesh size"});
+  // the stages check the deadline often: stopped well before the mesh would be done (the
+  // whole mesh takes about 1 s unloaded; this bound allows for a machine shared six ways)
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  // under auto, Gmsh meshes it instead, and says why
+  s.mesher = Mesher::Auto;
+  mesh::MeshRun run;
+  const TetMesh m = mesh_model(example("cantilever"), s, {}, &run);
+  EXPECT_EQ(run.mesher, "gmsh");
+  EXPECT_NE(run.fallback_reason.find("did not finish within its time budget"), std::string::npos)
+      << run.fallback_reason;
+  EXPECT_GT(m.T.rows(), 1000);
+  ASSERT_FALSE(run.seconds.empty());
+  EXPECT_EQ(run.seconds.back().first, "conformity check");  // Gmsh's mesh is checked too
+  // a negative budget is the user's mistake, named
+  s.native_seconds = -1;
+  expect_error([&] { mesh_model(model, s); }, ErrorCode::InvalidParameter, {"time limit"});
 }
 
 }  // namespace

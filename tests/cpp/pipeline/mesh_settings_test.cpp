@@ -104,6 +104,9 @@ TEST(MeshSettings, TheMeshersReceiveEveryDecision) {
   EXPECT_DOUBLE_EQ(gmsh_time_budget(s, sizes), 120 + sizes.estimated_tets / 2000);
   s.gmsh_seconds = 7;
   EXPECT_EQ(gmsh_time_budget(s, sizes), 7);
+  EXPECT_DOUBLE_EQ(native_time_budget(s, sizes), 300 + sizes.estimated_tets / 250);
+  s.native_seconds = 9;
+  EXPECT_EQ(native_time_budget(s, sizes), 9);
 }
 
 TEST(MeshBytes, AMeshGoesThroughBytesUnchanged) {

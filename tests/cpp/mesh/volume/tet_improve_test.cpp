@@ -270,6 +270,31 @@ TEST(TetImprove, RefillCavityReplacesASliverByAStarFromItsCentre) {
   EXPECT_FALSE(plan_refill_cavity(v, {0, 1, 2, 3, 4}, 0.4).empty());
 }
 
+TEST(TetImprove, RemoveTetsBelowTakesOutFlatTetsAndSlivers) {
+  // w = 0: the middle tet's four nodes lie on one plane (exactly flat); w = 1e-9: positive but
+  // at radius ratio ~1e-9; w = 0.02: a sliver of radius ratio 0.06. Each goes with its
+  // cavity re-filled, the volume kept, every tet positive.
+  for (const double w : {0.0, 1e-9, 0.02}) {
+    std::vector<Tet> tets;
+    Points P = warped_octahedron(w, tets);
+    double v0 = 0;
+    for (const Tet& t : tets) v0 += (P[t[1]] - P[t[0]]).dot((P[t[2]] - P[t[0]]).cross(P[t[3]] - P[t[0]])) / 6;
+    EXPECT_LT(worst(P, tets), 0.1) << w;
+    EXPECT_EQ(remove_tets_below(P, tets, 0.1, 4), 1) << w;
+    EXPECT_GT(worst(P, tets), 0.7) << w;
+    EXPECT_NEAR(volume(P, tets), v0, 1e-14) << w;
+    std::vector<Tet> scratch;
+    const Points P0 = warped_octahedron(w, scratch);
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(P[i], P0[i]) << "a node moved";
+  }
+  // nothing below the floor: nothing changes
+  std::vector<Tet> regular;
+  Points Q = octahedron_star(Vec3::Zero(), regular);
+  const std::vector<Tet> before = regular;
+  EXPECT_EQ(remove_tets_below(Q, regular, 0.1, 4), 0);
+  EXPECT_EQ(regular, before);
+}
+
 TEST(TetImprove, DriversSweepTheKernelsOverTheBadTets) {
   {  // flips: the two flat tets become three; two good ones stay
     Points P = bipyramid(0.3);

@@ -212,6 +212,40 @@ TEST(VolumeFill, GradesFromAFineBoundaryWithoutASize) {
   EXPECT_LT(r.T.rows(), 150000);  // about 42 000; the runaway passed a million in 30 s
 }
 
+/// A shared part's surface at its default size, filled with the default settings: conformal,
+/// the volume of the surface, no flat tet, no tet below radius ratio `floor` and at most
+/// `share` of them below 0.1 (issue 20 asks for none below 0.1 anywhere).
+void expect_no_sliver(const std::string& file, double floor = 0.1, double share = 0) {
+  const SurfaceMesh s = default_surface(file);
+  ASSERT_TRUE(s.failed_faces.empty()) << file;
+  double volume = 0;
+  for (long t = 0; t < s.F.rows(); ++t)
+    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i());
+  check_fill(s.V, s.F, MatX4i(), r, volume);
+  TetMesh m;
+  m.V = r.V, m.T = r.T;
+  m.F = s.F;
+  m.domain = VecXi::Zero(m.T.rows());
+  const ConformityReport c = check_conformity(m);
+  EXPECT_EQ(c.flat_tets, 0) << c.describe();
+  const QualityReport q = tet_quality(m);
+  EXPECT_GE(q.min_radius_ratio, floor) << file;
+  EXPECT_LE(q.share_radius_ratio_below_01, share) << file;
+  EXPECT_GT(q.mean_radius_ratio, 0.7) << file;
+}
+
+// one part per family of ../shared/data (bench/volume --product covers them all, at the
+// default size and at 0.6x, through the product's path)
+TEST(VolumeFillQuality, NoSliverOnTheBracketExample) { expect_no_sliver("examples/bracket.step"); }
+TEST(VolumeFillQuality, FewSliversOnNist5) {
+  // NOT yet what issue 20 asks (none below 0.1): the wider cavities of remove_tets_below
+  // lift the worst tet here to 0.038, 0.12 % of the tets below 0.1 (the product's path on
+  // this part, before them: worst 0.0157, 0.032 % below 0.1; after: 0.041, 0.023 %)
+  expect_no_sliver("nist/NIST_MBE_PMI_5.stp", 0.03, 0.0015);
+}
+TEST(VolumeFillQuality, NoSliverOnLinkrods) { expect_no_sliver("occt/linkrods.step"); }
+
 INSTANTIATE_TEST_SUITE_P(BulkThenFrontAndFrontAlone, VolumeFill, ::testing::Values(true, false),
                          [](const ::testing::TestParamInfo<bool>& i) {
                            return i.param ? "DelaunayBulk" : "FrontAlone";
