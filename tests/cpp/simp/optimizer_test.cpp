@@ -72,6 +72,8 @@ TEST(Simp, ComplianceGradientMatchesFiniteDifferencesThroughTheFilter) {
   check_gradient(p, 1);
   p.filter.kind = FilterKind::Cone;
   check_gradient(p, 2);
+  p.filter.kind = FilterKind::Helmholtz;
+  check_gradient(p, 3);
 }
 
 TEST(Simp, GradientWithSelfWeight) {
