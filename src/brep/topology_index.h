@@ -6,23 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "common/adjacency.h"
 #include "common/types.h"
 
 namespace topopt::brep {
-
-/// Compressed rows: the entities related to entity i are index[offset[i] .. offset[i+1]).
-struct Adjacency {
-  std::vector<int> offset{0};
-  std::vector<int> index;
-  int rows() const { return static_cast<int>(offset.size()) - 1; }
-  int size(int i) const { return offset[i + 1] - offset[i]; }
-  const int* begin(int i) const { return index.data() + offset[i]; }
-  const int* end(int i) const { return index.data() + offset[i + 1]; }
-  void push_row(const std::vector<int>& row) {
-    index.insert(index.end(), row.begin(), row.end());
-    offset.push_back(static_cast<int>(index.size()));
-  }
-};
 
 /// The topology of one shape. Maps hold the OCCT sub-shapes (1-based, OCCT convention); every
 /// other array is 0-based with row k describing map entry k+1.

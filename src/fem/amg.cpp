@@ -1,15 +1,13 @@
-// Smoothed-aggregation AMG and AMG-preconditioned conjugate gradients (see amg.h).
+// Smoothed-aggregation AMG (see amg.h).
 #include "fem/amg.h"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Sparse>
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <deque>
-#include <numeric>
-#include <sstream>
 
+#include "common/adjacency.h"
 #include "common/error.h"
 #include "common/parallel.h"
 
@@ -17,171 +15,7 @@ namespace topopt::fem {
 
 namespace {
 
-/// y = M x with M's pattern and the values `val` (double, or float copies for the V-cycle:
-/// the products are memory-bound, and 4-byte values cut the bytes read by a third).
-template <class Value>
-void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
-  const std::vector<int>& ptr = M.ptr;
-  const std::vector<int>& col = M.col;
-  if (M.blocks.empty()) {
-    parallel_for(
-        M.rows, threads,
-        [&](long b, long e) {
-          for (long i = b; i < e; ++i) {
-            double s = 0;
-            for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
-            y[i] = s;
-          }
-        },
-        4096);
-    return;
-  }
-  const long nb = static_cast<long>(M.blocks.size()) - 1;
-  parallel_for(
-      nb, threads,
-      [&](long bb, long be) {
-        for (long blk = bb; blk < be; ++blk) {
-          const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
-          const int* c = &col[ptr[r0]];
-          for (int r = 0; r < nr; ++r) {
-            const Value* v = &val[ptr[r0 + r]];
-            double acc = 0;
-            for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
-            y[r0 + r] = acc;
-          }
-        }
-      },
-      1024);
-}
-
-}  // namespace
-
-void CsrMatrix::multiply(const double* x, double* y, int threads) const {
-  sparse_product(*this, val.data(), x, y, threads);
-}
-
-bool CsrMatrix::blocks_consistent() const {
-  if (blocks.empty()) return true;
-  if (blocks.front() != 0 || blocks.back() != rows) return false;
-  for (size_t b = 0; b + 1 < blocks.size(); ++b) {
-    const int r0 = blocks[b], nr = blocks[b + 1] - r0;
-    if (nr < 1 || nr > kMaxBlock) return false;
-    const int len = ptr[r0 + 1] - ptr[r0];
-    for (int r = 1; r < nr; ++r)
-      if (ptr[r0 + r + 1] - ptr[r0 + r] != len || !std::equal(&col[ptr[r0]], &col[ptr[r0]] + len, &col[ptr[r0 + r]]))
-        return false;
-  }
-  return true;
-}
-
-namespace {
-
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-
-/// C = A B (Gustavson's row-by-row product with a dense accumulator per thread). With row
-/// blocks in A, the rows of a block are formed together (one index walk for all of them) and
-/// C inherits A's blocks.
-CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
-  assert(A.cols == B.rows);
-  constexpr int kB = CsrMatrix::kMaxBlock;
-  CsrMatrix C;
-  C.rows = A.rows;
-  C.cols = B.cols;
-  std::vector<int> blocks = A.blocks;
-  if (blocks.empty()) {  // one row a block
-    blocks.resize(A.rows + 1);
-    std::iota(blocks.begin(), blocks.end(), 0);
-  }
-  const long nblocks = static_cast<long>(blocks.size()) - 1;
-  const int chunks = static_cast<int>(std::max(1L, std::min<long>(threads, nblocks / 512 + 1)));
-  struct Part {
-    std::vector<int> count, col;
-    std::vector<double> val;
-  };
-  std::vector<Part> parts(chunks);
-  parallel_for(
-      chunks, chunks,
-      [&](long cb, long ce) {
-        std::vector<int> mark(B.cols, -1), slot(B.cols), touched;
-        std::vector<double> acc;
-        for (long c = cb; c < ce; ++c) {
-          Part& part = parts[c];
-          const long b0 = nblocks * c / chunks, b1 = nblocks * (c + 1) / chunks;
-          part.count.reserve(blocks[b1] - blocks[b0]);
-          part.col.reserve(static_cast<size_t>(A.ptr[blocks[b1]] - A.ptr[blocks[b0]]) * 4);
-          part.val.reserve(part.col.capacity());
-          for (long blk = b0; blk < b1; ++blk) {
-            const int r0 = blocks[blk], nr = blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
-            touched.clear();
-            for (int k = 0; k < len; ++k) {
-              const int cc = A.col[A.ptr[r0] + k];
-              double a[kB];
-              for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
-              for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
-                const int j = B.col[kb];
-                const double v = B.val[kb];
-                if (mark[j] != blk) {
-                  mark[j] = static_cast<int>(blk);
-                  slot[j] = static_cast<int>(touched.size());
-                  touched.push_back(j);
-                  if (acc.size() < touched.size() * kB) acc.resize(2 * touched.size() * kB);
-                  double* q = &acc[kB * slot[j]];
-                  for (int r = 0; r < nr; ++r) q[r] = a[r] * v;
-                } else {
-                  double* q = &acc[kB * slot[j]];
-                  for (int r = 0; r < nr; ++r) q[r] += a[r] * v;
-                }
-              }
-            }
-            for (int r = 0; r < nr; ++r) {
-              part.count.push_back(static_cast<int>(touched.size()));
-              for (size_t t = 0; t < touched.size(); ++t) {
-                part.col.push_back(touched[t]);
-                part.val.push_back(acc[kB * t + r]);
-              }
-            }
-          }
-        }
-      },
-      1);
-  C.ptr.assign(A.rows + 1, 0);
-  long nnz = 0, row = 0;
-  for (const Part& p : parts) nnz += static_cast<long>(p.col.size());
-  C.col = std::move(parts[0].col);  // the first part in place, the others appended
-  C.val = std::move(parts[0].val);
-  C.col.reserve(nnz);
-  C.val.reserve(nnz);
-  for (size_t k = 0; k < parts.size(); ++k) {
-    const Part& p = parts[k];
-    for (int n : p.count) C.ptr[row + 1] = C.ptr[row] + n, ++row;
-    if (k == 0) continue;
-    C.col.insert(C.col.end(), p.col.begin(), p.col.end());
-    C.val.insert(C.val.end(), p.val.begin(), p.val.end());
-  }
-  assert(row == A.rows);
-  C.blocks = A.blocks;
-  return C;
-}
-
-/// A^T in compressed rows.
-CsrMatrix transpose(const CsrMatrix& A) {
-  CsrMatrix T;
-  T.rows = A.cols;
-  T.cols = A.rows;
-  T.ptr.assign(T.rows + 1, 0);
-  for (int c : A.col) ++T.ptr[c + 1];
-  for (int i = 0; i < T.rows; ++i) T.ptr[i + 1] += T.ptr[i];
-  T.col.resize(A.col.size());
-  T.val.resize(A.val.size());
-  std::vector<int> fill(T.ptr.begin(), T.ptr.end() - 1);
-  for (int i = 0; i < A.rows; ++i)
-    for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k) {
-      int p = fill[A.col[k]]++;
-      T.col[p] = i;
-      T.val[p] = A.val[k];
-    }
-  return T;
-}
 
 struct Level {
   CsrMatrix own;                 // this level's matrix (unused on level 0)
@@ -197,6 +31,178 @@ struct Level {
   mutable std::vector<double> b, x, r, d, q;
 };
 
+/// The node of each row: rows node_ptr[k] .. node_ptr[k+1]-1 belong to node k.
+std::vector<int> row_nodes(const std::vector<int>& node_ptr, int rows) {
+  std::vector<int> node_of(rows);
+  const int nnode = static_cast<int>(node_ptr.size()) - 1;
+  for (int k = 0; k < nnode; ++k)
+    for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i) node_of[i] = k;
+  return node_of;
+}
+
+/// The strong neighbours of every node (rows of A grouped by node_ptr, node_of: the node of
+/// each row): m is one of k's if ||A_km||_F² > θ² ||A_kk||_F ||A_mm||_F, θ = `strength`.
+/// Neighbours are listed in the order the rows of k first reach them.
+Adjacency strength_graph(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<int>& node_of,
+                         double strength) {
+  const int nnode = static_cast<int>(node_ptr.size()) - 1;
+  std::vector<double> dnorm(nnode, 0.0);  // ||A_kk||_F
+  for (int i = 0; i < A.rows; ++i)
+    for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k)
+      if (node_of[A.col[k]] == node_of[i]) dnorm[node_of[i]] += A.val[k] * A.val[k];
+  for (double& d : dnorm) d = std::sqrt(d);
+  const double theta2 = strength * strength;
+  Adjacency strong;
+  std::vector<double> acc(nnode, 0.0);  // ||A_km||_F² of the neighbours m touched
+  std::vector<int> mark(nnode, -1), touched;
+  for (int k = 0; k < nnode; ++k) {
+    touched.clear();
+    for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i)
+      for (int e = A.ptr[i]; e < A.ptr[i + 1]; ++e) {
+        int m = node_of[A.col[e]];
+        if (m == k) continue;
+        if (mark[m] != k) mark[m] = k, acc[m] = 0, touched.push_back(m);
+        acc[m] += A.val[e] * A.val[e];
+      }
+    for (int m : touched)
+      if (acc[m] > theta2 * dnorm[k] * dnorm[m]) strong.index.push_back(m);
+    strong.close_row();
+  }
+  return strong;
+}
+
+/// Greedy aggregation of the nodes over their strong neighbours, in three phases: a node whose
+/// whole neighbourhood is free seeds an aggregate of it; a node left over joins a neighbouring
+/// aggregate of phase 1; what is still left forms aggregates with its free neighbours.
+/// Returns the aggregate of each node (-2 for a node without rows); `count` gets their number.
+std::vector<int> aggregate_nodes(const Adjacency& strong, const std::vector<int>& node_ptr, int& count) {
+  const int nnode = strong.rows();
+  std::vector<int> agg(nnode, -1);
+  int naggs = 0;
+  for (int k = 0; k < nnode; ++k)
+    if (node_ptr[k] == node_ptr[k + 1]) agg[k] = -2;  // no rows
+  for (int k = 0; k < nnode; ++k) {                   // 1: seeds with their whole neighbourhood
+    if (agg[k] != -1 || strong.size(k) == 0) continue;
+    bool free = true;
+    for (const int* e = strong.begin(k); e != strong.end(k) && free; ++e) free = agg[*e] == -1;
+    if (!free) continue;
+    agg[k] = naggs;
+    for (int m : strong.row(k)) agg[m] = naggs;
+    ++naggs;
+  }
+  const std::vector<int> first = agg;
+  for (int k = 0; k < nnode; ++k) {  // 2: join a neighbouring aggregate of phase 1
+    if (agg[k] != -1) continue;
+    for (int m : strong.row(k))
+      if (first[m] >= 0) {
+        agg[k] = first[m];
+        break;
+      }
+  }
+  for (int k = 0; k < nnode; ++k) {  // 3: the rest with its free neighbours
+    if (agg[k] != -1) continue;
+    agg[k] = naggs;
+    for (int m : strong.row(k))
+      if (agg[m] == -1) agg[m] = naggs;
+    ++naggs;
+  }
+  count = naggs;
+  return agg;
+}
+
+/// Orthonormalises the six rigid modes restricted to the m rows `rows` of one aggregate
+/// (modified Gram-Schmidt, twice for stability): B = Q R with Q's columns appended to `Q`
+/// (m values each) and R (kept by 6, row-major) appended to `R`. Modes that depend on the
+/// others on this aggregate (a lone node cannot tell rotations from translations) drop out.
+/// Returns kept, the number of columns of Q.
+int orthonormal_modes(const int* rows, int m, const std::vector<double>& modes, std::vector<double>& Q,
+                      std::vector<double>& R) {
+  Q.clear();
+  double Rm[6][6] = {};
+  std::vector<double> v(m);
+  int kept = 0;
+  for (int j = 0; j < 6; ++j) {
+    double norm0 = 0;
+    for (int i = 0; i < m; ++i) v[i] = modes[6 * rows[i] + j], norm0 += v[i] * v[i];
+    norm0 = std::sqrt(norm0);
+    double coef[6] = {};
+    for (int pass = 0; pass < 2; ++pass)
+      for (int q = 0; q < kept; ++q) {
+        double s = 0;
+        for (int i = 0; i < m; ++i) s += Q[q * m + i] * v[i];
+        for (int i = 0; i < m; ++i) v[i] -= s * Q[q * m + i];
+        coef[q] += s;
+      }
+    double nv = 0;
+    for (double x : v) nv += x * x;
+    nv = std::sqrt(nv);
+    for (int q = 0; q < kept; ++q) Rm[q][j] = coef[q];
+    if (norm0 > 0 && nv > 1e-8 * norm0 && kept < m) {
+      Rm[kept][j] = nv;
+      for (double x : v) Q.push_back(x / nv);
+      ++kept;
+    }
+  }
+  for (int q = 0; q < kept; ++q) R.insert(R.end(), Rm[q], Rm[q] + 6);
+  return kept;
+}
+
+/// The tentative prolongator Pt (rows by #coarse dofs): on each aggregate, the orthonormalised
+/// rigid modes (orthonormal_modes), one coarse dof per kept mode. `agg_rows`: the rows of each
+/// aggregate. Sets coarse_ptr (the coarse dofs of each aggregate, offsets) and coarse_modes
+/// (#coarse dofs by 6: the modes on the coarse level, R of each aggregate).
+CsrMatrix tentative_prolongator(const Adjacency& agg_rows, int rows, const std::vector<double>& modes,
+                                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes) {
+  coarse_ptr.assign(1, 0);
+  coarse_modes.clear();
+  std::vector<int> pt_col(rows * 6, -1);  // up to 6 entries a row, row-major
+  std::vector<double> pt_val(rows * 6, 0.0);
+  std::vector<int> pt_count(rows, 0);
+  std::vector<double> Q;
+  for (int a = 0; a < agg_rows.rows(); ++a) {
+    const int m = agg_rows.size(a);
+    const int* arows = agg_rows.begin(a);
+    const int kept = orthonormal_modes(arows, m, modes, Q, coarse_modes);
+    const int c0 = coarse_ptr.back();
+    for (int q = 0; q < kept; ++q)
+      for (int i = 0; i < m; ++i) {
+        const int r = arows[i];
+        pt_col[6 * r + pt_count[r]] = c0 + q;
+        pt_val[6 * r + pt_count[r]] = Q[q * m + i];
+        ++pt_count[r];
+      }
+    coarse_ptr.push_back(c0 + kept);
+  }
+  CsrMatrix Pt;
+  Pt.rows = rows;
+  Pt.cols = coarse_ptr.back();
+  Pt.ptr.assign(rows + 1, 0);
+  for (int i = 0; i < rows; ++i) {
+    for (int k = 0; k < pt_count[i]; ++k) Pt.col.push_back(pt_col[6 * i + k]), Pt.val.push_back(pt_val[6 * i + k]);
+    Pt.ptr[i + 1] = static_cast<int>(Pt.col.size());
+  }
+  return Pt;
+}
+
+/// The smoothed prolongator P = (I − ω D⁻¹ A) Pt with ω = 4 / (3 λmax), λmax ≈ 1.1 `lambda`
+/// (an estimate of λmax(D⁻¹A)): damps the high-energy part of the tentative prolongator.
+/// inv_diag: D⁻¹ (A.rows).
+CsrMatrix smoothed_prolongator(const CsrMatrix& A, const CsrMatrix& Pt, const std::vector<double>& inv_diag,
+                               double lambda, int threads) {
+  CsrMatrix AP = multiply(A, Pt, threads);
+  const double omega = 4.0 / (3.0 * 1.1 * lambda);
+  for (int i = 0; i < A.rows; ++i) {
+    for (int k = AP.ptr[i]; k < AP.ptr[i + 1]; ++k) AP.val[k] *= -omega * inv_diag[i];
+    for (int kt = Pt.ptr[i]; kt < Pt.ptr[i + 1]; ++kt)
+      for (int k = AP.ptr[i]; k < AP.ptr[i + 1]; ++k)
+        if (AP.col[k] == Pt.col[kt]) {
+          AP.val[k] += Pt.val[kt];
+          break;
+        }
+  }
+  return AP;
+}
+
 }  // namespace
 
 struct SmoothedAggregationAmg::Impl {
@@ -211,9 +217,11 @@ struct SmoothedAggregationAmg::Impl {
   void estimate_lambda(Level& L, int steps = 15) const;
   void inverse_diagonal(Level& L) const;
   void factor_coarsest();
-  /// Builds the next level's tentative prolongator from this one; returns false if the
-  /// level does not coarsen any more.
-  bool coarsen(Level& L, const std::vector<int>& node_ptr, const std::vector<double>& modes,
+  /// The tentative prolongator Pt from level matrix A (rows grouped into nodes by node_ptr,
+  /// rigid modes `modes`, #rows by 6) to the next level, whose node offsets and modes it sets:
+  /// strength graph, aggregation, rigid modes orthonormalised per aggregate. Returns false if
+  /// A does not coarsen any more (the next level would keep 80 % of the unknowns or more).
+  bool coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
   static void to_float(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
@@ -288,144 +296,20 @@ void SmoothedAggregationAmg::Impl::inverse_diagonal(Level& L) const {
   }
 }
 
-bool SmoothedAggregationAmg::Impl::coarsen(Level& L, const std::vector<int>& node_ptr, const std::vector<double>& modes,
-                                           std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes,
-                                           CsrMatrix& Pt) const {
-  const CsrMatrix& A = *L.A;
-  const int nnode = static_cast<int>(node_ptr.size()) - 1;
-  std::vector<int> node_of(A.rows);
-  for (int k = 0; k < nnode; ++k)
-    for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i) node_of[i] = k;
-  // Block norms: ||A_kk||_F, then the strong neighbours of every node.
-  std::vector<double> dnorm(nnode, 0.0);
-  for (int i = 0; i < A.rows; ++i)
-    for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k)
-      if (node_of[A.col[k]] == node_of[i]) dnorm[node_of[i]] += A.val[k] * A.val[k];
-  for (double& d : dnorm) d = std::sqrt(d);
-  const double theta2 = params.strength * params.strength;
-  std::vector<int> sptr(nnode + 1, 0), sadj;
-  {
-    std::vector<double> acc(nnode, 0.0);
-    std::vector<int> mark(nnode, -1), touched;
-    for (int k = 0; k < nnode; ++k) {
-      touched.clear();
-      for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i)
-        for (int e = A.ptr[i]; e < A.ptr[i + 1]; ++e) {
-          int m = node_of[A.col[e]];
-          if (m == k) continue;
-          if (mark[m] != k) mark[m] = k, acc[m] = 0, touched.push_back(m);
-          acc[m] += A.val[e] * A.val[e];
-        }
-      for (int m : touched)
-        if (acc[m] > theta2 * dnorm[k] * dnorm[m]) sadj.push_back(m);
-      sptr[k + 1] = static_cast<int>(sadj.size());
-    }
-  }
-  // Greedy aggregation in three phases.
-  std::vector<int> agg(nnode, -1);
+bool SmoothedAggregationAmg::Impl::coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr,
+                                           const std::vector<double>& modes, std::vector<int>& coarse_ptr,
+                                           std::vector<double>& coarse_modes, CsrMatrix& Pt) const {
+  const std::vector<int> node_of = row_nodes(node_ptr, A.rows);
+  const Adjacency strong = strength_graph(A, node_ptr, node_of, params.strength);
   int naggs = 0;
-  for (int k = 0; k < nnode; ++k) {
-    if (node_ptr[k] == node_ptr[k + 1]) agg[k] = -2;  // no rows
-  }
-  for (int k = 0; k < nnode; ++k) {  // 1: a node whose whole neighbourhood is free seeds one
-    if (agg[k] != -1 || sptr[k] == sptr[k + 1]) continue;
-    bool free = true;
-    for (int e = sptr[k]; e < sptr[k + 1] && free; ++e) free = agg[sadj[e]] == -1;
-    if (!free) continue;
-    agg[k] = naggs;
-    for (int e = sptr[k]; e < sptr[k + 1]; ++e) agg[sadj[e]] = naggs;
-    ++naggs;
-  }
-  std::vector<int> first = agg;
-  for (int k = 0; k < nnode; ++k) {  // 2: join a neighbouring aggregate of phase 1
-    if (agg[k] != -1) continue;
-    for (int e = sptr[k]; e < sptr[k + 1]; ++e)
-      if (first[sadj[e]] >= 0) {
-        agg[k] = first[sadj[e]];
-        break;
-      }
-  }
-  for (int k = 0; k < nnode; ++k) {  // 3: what is left forms aggregates with its free neighbours
-    if (agg[k] != -1) continue;
-    agg[k] = naggs;
-    for (int e = sptr[k]; e < sptr[k + 1]; ++e)
-      if (agg[sadj[e]] == -1) agg[sadj[e]] = naggs;
-    ++naggs;
-  }
-  // Rows of each aggregate.
-  std::vector<int> aptr(naggs + 1, 0), arows(A.rows);
-  for (int k = 0; k < nnode; ++k)
-    if (agg[k] >= 0) aptr[agg[k] + 1] += node_ptr[k + 1] - node_ptr[k];
-  for (int a = 0; a < naggs; ++a) aptr[a + 1] += aptr[a];
-  {
-    std::vector<int> fill(aptr.begin(), aptr.end() - 1);
-    for (int k = 0; k < nnode; ++k)
+  const std::vector<int> agg = aggregate_nodes(strong, node_ptr, naggs);
+  const Adjacency agg_rows = group_pairs(naggs, [&](auto emit) {
+    for (int k = 0; k + 1 < static_cast<int>(node_ptr.size()); ++k)
       if (agg[k] >= 0)
-        for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i) arows[fill[agg[k]]++] = i;
-  }
-  // Tentative prolongator: per aggregate, the rigid modes restricted to its rows,
-  // orthonormalised by modified Gram-Schmidt (twice, for stability); modes that are
-  // dependent on the aggregate (a lone node cannot tell rotations from translations) drop out.
-  // B_a = Q_a R_a, with Q_a the prolongator's block and R_a the coarse modes.
-  coarse_ptr.assign(1, 0);
-  coarse_modes.clear();
-  std::vector<int> pt_col(A.rows * 6, -1);  // up to 6 entries a row, row-major
-  std::vector<double> pt_val(A.rows * 6, 0.0);
-  std::vector<int> pt_count(A.rows, 0);
-  std::vector<double> Q, v;
-  for (int a = 0; a < naggs; ++a) {
-    const int m = aptr[a + 1] - aptr[a];
-    const int* rows = &arows[aptr[a]];
-    Q.clear();
-    double Rm[6][6] = {};
-    int kept = 0;
-    for (int j = 0; j < 6; ++j) {
-      v.resize(m);
-      double norm0 = 0;
-      for (int i = 0; i < m; ++i) v[i] = modes[6 * rows[i] + j], norm0 += v[i] * v[i];
-      norm0 = std::sqrt(norm0);
-      double coef[6] = {};
-      for (int pass = 0; pass < 2; ++pass)
-        for (int q = 0; q < kept; ++q) {
-          double s = 0;
-          for (int i = 0; i < m; ++i) s += Q[q * m + i] * v[i];
-          for (int i = 0; i < m; ++i) v[i] -= s * Q[q * m + i];
-          coef[q] += s;
-        }
-      double nv = 0;
-      for (double x : v) nv += x * x;
-      nv = std::sqrt(nv);
-      for (int q = 0; q < kept; ++q) Rm[q][j] = coef[q];
-      if (norm0 > 0 && nv > 1e-8 * norm0 && kept < m) {
-        Rm[kept][j] = nv;
-        for (double x : v) Q.push_back(x / nv);
-        ++kept;
-      }
-    }
-    const int c0 = coarse_ptr.back();
-    for (int q = 0; q < kept; ++q) {
-      for (int i = 0; i < m; ++i) {
-        const int r = rows[i];
-        pt_col[6 * r + pt_count[r]] = c0 + q;
-        pt_val[6 * r + pt_count[r]] = Q[q * m + i];
-        ++pt_count[r];
-      }
-      for (int j = 0; j < 6; ++j) coarse_modes.push_back(Rm[q][j]);
-    }
-    coarse_ptr.push_back(c0 + kept);
-  }
-  const int nc = coarse_ptr.back();
-  if (nc == 0 || nc >= A.rows * 0.8) return false;
-  Pt.rows = A.rows;
-  Pt.cols = nc;
-  Pt.ptr.assign(A.rows + 1, 0);
-  Pt.col.clear();
-  Pt.val.clear();
-  for (int i = 0; i < A.rows; ++i) {
-    for (int k = 0; k < pt_count[i]; ++k) Pt.col.push_back(pt_col[6 * i + k]), Pt.val.push_back(pt_val[6 * i + k]);
-    Pt.ptr[i + 1] = static_cast<int>(Pt.col.size());
-  }
-  return true;
+        for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i) emit(agg[k], i);
+  });
+  Pt = tentative_prolongator(agg_rows, A.rows, modes, coarse_ptr, coarse_modes);
+  return Pt.cols > 0 && Pt.cols < A.rows * 0.8;
 }
 
 void SmoothedAggregationAmg::Impl::smooth(const Level& L, const double* b, double* x, bool zero_start) const {
@@ -507,21 +391,9 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     for (auto* v : {&L.b, &L.x, &L.r, &L.d, &L.q}) v->assign(n, 0.0);
     if (n <= params.coarse_dofs || static_cast<int>(m.levels.size()) >= params.max_levels) break;
     CsrMatrix Pt;
-    if (!m.coarsen(L, nodes, modes, coarse_nodes, coarse_modes, Pt)) break;
+    if (!m.coarsen(Al, nodes, modes, coarse_nodes, coarse_modes, Pt)) break;
     m.estimate_lambda(L);
-    // P = (I - ω D⁻¹ A) P_t with ω = 4 / (3 λmax): damps the prolongator's high-energy part.
-    CsrMatrix AP = multiply(Al, Pt, m.threads);
-    const double omega = 4.0 / (3.0 * 1.1 * L.lambda);
-    for (int i = 0; i < n; ++i) {
-      for (int k = AP.ptr[i]; k < AP.ptr[i + 1]; ++k) AP.val[k] *= -omega * L.inv_diag[i];
-      for (int kt = Pt.ptr[i]; kt < Pt.ptr[i + 1]; ++kt)
-        for (int k = AP.ptr[i]; k < AP.ptr[i + 1]; ++k)
-          if (AP.col[k] == Pt.col[kt]) {
-            AP.val[k] += Pt.val[kt];
-            break;
-          }
-    }
-    L.P = std::move(AP);
+    L.P = smoothed_prolongator(Al, Pt, L.inv_diag, L.lambda, m.threads);
     L.R = transpose(L.P);
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
     CsrMatrix APs = multiply(Al, L.P, m.threads);
@@ -570,52 +442,6 @@ std::vector<int> SmoothedAggregationAmg::level_sizes() const {
   std::vector<int> n;
   for (const Level& L : impl_->levels) n.push_back(L.A->rows);
   return n;
-}
-
-PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x, double tolerance,
-                  int max_iterations, int threads, const Progress& progress) {
-  const int n = A.rows;
-  using Vec = Eigen::VectorXd;
-  Eigen::Map<const Vec> bv(b, n);
-  Eigen::Map<Vec> xv(x, n);
-  Vec r(n), z(n), p(n), q(n);
-  PcgResult res;
-  const double bnorm = bv.norm();
-  if (bnorm == 0) {
-    xv.setZero();
-    res.converged = true;
-    return res;
-  }
-  A.multiply(x, q.data(), threads);
-  r = bv - q;
-  double rnorm = r.norm();
-  amg.apply(r.data(), z.data());
-  p = z;
-  double rz = r.dot(z);
-  const double goal = tolerance * bnorm;
-  int it = 0;
-  for (; rnorm > goal && it < max_iterations; ++it) {
-    if (it % 16 == 15) progress.check_cancel("the FE solve");
-    A.multiply(p.data(), q.data(), threads);
-    const double pq = p.dot(q);
-    if (!(pq > 0)) break;  // breakdown: A (or the preconditioner) is not positive definite
-    const double alpha = rz / pq;
-    xv += alpha * p;
-    r -= alpha * q;
-    rnorm = r.norm();
-    if (rnorm <= goal) {
-      ++it;
-      break;
-    }
-    amg.apply(r.data(), z.data());
-    const double rz_new = r.dot(z);
-    p = z + (rz_new / rz) * p;
-    rz = rz_new;
-  }
-  res.iterations = it;
-  res.relative_residual = rnorm / bnorm;
-  res.converged = rnorm <= goal;
-  return res;
 }
 
 }  // namespace topopt::fem

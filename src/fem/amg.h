@@ -1,7 +1,7 @@
 // Smoothed-aggregation algebraic multigrid (Vaněk, Mandel, Brezina 1996) for linear
-// elasticity, used as the preconditioner of conjugate gradients: the "strong preconditioner"
-// of the iterative solver, and SIMP's solver of choice where a Cholesky factor is too slow or
-// too big (see elasticity.cpp for how the default is chosen).
+// elasticity, used as the preconditioner of conjugate gradients (fem/pcg.h): the "strong
+// preconditioner" of the iterative solver, and SIMP's solver of choice where a Cholesky factor
+// is too slow or too big (see fem/linear_solver.h for how the default is chosen).
 //
 // Per level: a strength graph on nodes (blocks of rows that belong together: a mesh node's
 // free dofs on the finest level, an aggregate's coarse dofs below), greedy aggregation, a
@@ -16,26 +16,10 @@
 
 #include "common/progress.h"
 #include "common/types.h"
+#include "fem/csr_matrix.h"
+#include "fem/pcg.h"
 
 namespace topopt::fem {
-
-/// A square sparse matrix in compressed rows, full storage (both triangles of a symmetric one).
-struct CsrMatrix {
-  int rows = 0, cols = 0;
-  std::vector<int> ptr;     ///< rows+1 offsets into col/val
-  std::vector<int> col;     ///< column of each entry (any order within a row)
-  std::vector<double> val;  ///< value of each entry
-  /// Optional row blocks (offsets, first 0, last rows): the rows of a block have the same
-  /// columns in the same order (a mesh node's dofs, an aggregate's coarse dofs), so products
-  /// read each column index once per block. At most kMaxBlock rows a block. Empty: none.
-  std::vector<int> blocks;
-  static constexpr int kMaxBlock = 8;
-  long nonzeros() const { return static_cast<long>(col.size()); }
-  /// y = A x, on `threads` threads. x: cols, y: rows.
-  void multiply(const double* x, double* y, int threads) const;
-  /// True if `blocks` is empty or describes rows with identical column lists.
-  bool blocks_consistent() const;
-};
 
 struct AmgParams {
   /// Strength of connection θ between nodes i, j: ||A_ij||_F² > θ² ||A_ii||_F ||A_jj||_F.
@@ -52,9 +36,10 @@ struct AmgParams {
   int threads = 0;              ///< 0 = hardware concurrency
 };
 
-/// The multigrid hierarchy of one matrix. setup() may be called again for new values
-/// (SIMP's next stiffness); the matrix passed must stay alive while apply() is used.
-class SmoothedAggregationAmg {
+/// The multigrid hierarchy of one matrix, a preconditioner for pcg(). setup() may be called
+/// again for new values (SIMP's next stiffness); the matrix passed must stay alive while
+/// apply() is used.
+class SmoothedAggregationAmg final : public Preconditioner {
  public:
   SmoothedAggregationAmg();
   ~SmoothedAggregationAmg();
@@ -79,6 +64,8 @@ class SmoothedAggregationAmg {
 
   /// z = M⁻¹ r: one V-cycle from zero. r, z: n.
   void apply(const double* r, double* z) const;
+  /// The same on vectors (the Preconditioner interface).
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override { apply(r.data(), z.data()); }
 
   int levels() const;
   /// Operator complexity: Σ nnz(A_l) / nnz(A_0).
@@ -90,17 +77,5 @@ class SmoothedAggregationAmg {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-struct PcgResult {
-  int iterations = 0;
-  double relative_residual = 0;  ///< ||b - A x|| / ||b|| at exit
-  bool converged = false;
-};
-
-/// Conjugate gradients on A x = b preconditioned by `amg`, starting from x (warm start).
-/// Stops when ||b - A x|| <= tolerance ||b|| or after max_iterations. Checks `progress` for
-/// cancellation every few iterations.
-PcgResult amg_pcg(const CsrMatrix& A, const SmoothedAggregationAmg& amg, const double* b, double* x, double tolerance,
-                  int max_iterations, int threads, const Progress& progress = {});
 
 }  // namespace topopt::fem

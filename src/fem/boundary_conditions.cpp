@@ -11,35 +11,36 @@
 namespace topopt::fem {
 namespace {
 
+/// Appends to `out` the boundary triangles t with tag[t] == f (tag: #F face numbers); returns
+/// how many.
+size_t append_tagged(const VecXi& tag, int f, std::vector<int>& out) {
+  const size_t before = out.size();
+  for (long t = 0; t < tag.size(); ++t)
+    if (tag[t] == f) out.push_back(static_cast<int>(t));
+  return out.size() - before;
+}
+
 /// Triangles of the mesh boundary on the given Ω faces and Ω̄ faces. Throws FaceNotFound
 /// naming the first face that has no triangle. `what` names the support or load.
 std::vector<int> triangles_on(const TetMesh& mesh, const std::vector<int>& faces, const std::vector<int>& nd_faces,
                               const std::string& what) {
   std::vector<int> out;
   int max_face = mesh.face.size() ? mesh.face.maxCoeff() : 0;
-  for (int f : faces) {
-    size_t before = out.size();
-    for (long t = 0; t < mesh.F.rows(); ++t)
-      if (mesh.face[t] == f) out.push_back(static_cast<int>(t));
-    if (out.size() == before) {
+  for (int f : faces)
+    if (append_tagged(mesh.face, f, out) == 0) {
       std::ostringstream s;
       s << what << ": the part has no face Face" << f << " (its mesh has faces Face1 to Face" << max_face
         << "); pick a face of the part";
       throw Error(ErrorCode::FaceNotFound, s.str());
     }
-  }
-  for (int f : nd_faces) {
-    size_t before = out.size();
-    for (long t = 0; t < mesh.nd_face.size(); ++t)
-      if (mesh.nd_face[t] == f) out.push_back(static_cast<int>(t));
-    if (out.size() == before) {
+  for (int f : nd_faces)
+    if (append_tagged(mesh.nd_face, f, out) == 0) {
       std::ostringstream s;
       s << what << ": face NonDesign:Face" << f
         << " is not on the outside of the part (or does not exist); loads and supports act on "
            "the part's boundary";
       throw Error(ErrorCode::FaceNotFound, s.str());
     }
-  }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

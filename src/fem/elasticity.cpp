@@ -10,42 +10,25 @@
 //  - assembly runs on threads over element colours (no two elements of a colour share a
 //    node), so there are no write races and no atomics.
 //
-// Solvers (measured in bench/fem and bench/simp, see BENCHMARKS.md):
-//  - Direct: CHOLMOD's supernodal Cholesky (METIS ordering, symbolic analysis once per mesh);
-//    in SIMP the previous factor preconditions CG until that gets slow.
-//  - Iterative: CG preconditioned by our smoothed-aggregation multigrid (fem/amg.h) on a full
-//    CSR copy of K, warm-started from the previous solution; in SIMP the hierarchy is kept
-//    (only its finest smoother refreshed) until the iteration count grows.
-// Auto takes the direct solver for small systems (exact, and cheap to factorise) and the
-// multigrid above `kDirectDofLimit` unknowns: on the rocker (83 k unknowns) the multigrid
-// solve takes 1.6 s against 2.4-2.9 s for analysis + factorisation, and its memory grows
-// linearly where the factor's grows much faster (5.2 GB at 560 k unknowns).
+// Solving is the LinearSolver's business (fem/linear_solver.h: direct or multigrid CG, and
+// what each reuses between SIMP iterations); this file hands it the free-dof system.
 #include "fem/elasticity.h"
 
-#include "fem/amg.h"
-
-#include <xmmintrin.h>
-#include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cassert>
-#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <sstream>
 
-#include "common/blas_threads.h"
+#include "common/adjacency.h"
 #include "common/error.h"
 #include "common/parallel.h"
+#include "common/stopwatch.h"
 
 namespace topopt::fem {
 namespace {
-
-using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-
-/// Above this many free dofs, Auto uses multigrid CG instead of the direct solver.
-constexpr int kDirectDofLimit = 40'000;
 
 /// Local entry p of the 78 upper-triangle entries (i <= j) of a 12 by 12 element matrix.
 struct LocalPair {
@@ -83,6 +66,18 @@ inline void element_matrix(const double* g, double vol, double lambda, double mu
     }
 }
 
+/// The node graph of tets T (#T by 4) on nv nodes: each node's neighbours through the tets,
+/// itself included, sorted.
+Adjacency node_graph(const MatX4i& T, int nv) {
+  Adjacency graph = group_pairs(nv, [&T](auto emit) {
+    for (long e = 0; e < T.rows(); ++e)
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) emit(T(e, a), T(e, b));
+  });
+  sort_unique_rows(graph);
+  return graph;
+}
+
 }  // namespace
 
 struct Elasticity::Impl {
@@ -102,31 +97,14 @@ struct Elasticity::Impl {
   std::vector<double> prescribed;  // 3#V: prescribed value (0 where free)
   bool nonzero_prescribed = false;
 
-  SpMat K;                                // free-free, lower triangle
+  SparseLower K;                          // free-free, lower triangle
   std::vector<int> slot;                  // #T * 78: index into K's values, or -1
   std::vector<std::vector<int>> colours;  // element ids per colour
 
   std::string singular_reason;  // non-empty: the supports do not hold the structure
-  bool dirty = true;            // values need re-assembly / re-factorisation
-  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> direct;
-  bool analysed = false;
-  // Iterative solver: K in full compressed rows (refilled from K's lower triangle through
-  // full_pos: two positions per lower entry, the second -1 on the diagonal), the nodes'
-  // dof ranges and rigid-body modes that the multigrid aggregates, and its hierarchy.
-  CsrMatrix full;
-  std::vector<int> full_pos;
-  std::vector<int> node_ptr;
-  std::vector<double> modes;
-  SmoothedAggregationAmg amg;
-  bool amg_built = false;    // the hierarchy exists (perhaps of an earlier matrix)
-  bool amg_rebuild = false;  // the last solve was slow: rebuild at the next new matrix
-  int amg_baseline = -1;     // CG iterations of the first solve after the last full setup
-  bool amg_kept = false;     // the hierarchy in use was built for an earlier matrix
-  Eigen::MatrixXd last;      // previous free solution, for warm starts
-  bool use_direct = true;
-  bool factor_valid = false;    // the factor exists (perhaps of an earlier matrix)
-  bool factor_current = false;  // the factor is of the current matrix
-  int skip_recycle = 0;         // solves to factorise directly after a failed recycling
+  bool dirty = true;            // values need re-assembly (and the solver an update)
+  std::unique_ptr<LinearSolver> solver;
+  Eigen::MatrixXd last;  // previous free solution, for warm starts
 
   void compute_geometry();
   void build_dof_maps();
@@ -134,85 +112,14 @@ struct Elasticity::Impl {
   void build_colours();
   void check_rigid_body_modes();
   void assemble();
-  void build_full();
-  template <class Lap>
-  void setup_amg(const Progress& progress, Lap& lap) {
-    AmgParams ap;
-    ap.threads = threads;
-    amg.setup(full, node_ptr, modes, ap);
-    amg_built = true;
-    amg_rebuild = amg_kept = false;
-    amg_baseline = -1;
-    std::ostringstream s;
-    s << "multigrid setup " << lap() << ", " << amg.levels() << " levels (";
-    const std::vector<int> sizes = amg.level_sizes();
-    for (size_t l = 0; l < sizes.size(); ++l) s << (l ? ", " : "") << sizes[l];
-    s << " unknowns), operator complexity " << amg.complexity();
-    progress.info(s.str());
-  }
-  void refill_full();
+  /// loads (3#V by #cases) on the free dofs, minus the reactions of prescribed displacements.
+  Eigen::MatrixXd free_loads(const Eigen::MatrixXd& loads) const;
+  /// The free solution x (nf by #cases) with the prescribed values added: 3#V by #cases.
+  Eigen::MatrixXd all_dofs(const Eigen::MatrixXd& x) const;
+  /// #T: f(t, ε_t) for each element t, ε_t its strain under the displacements u (3#V).
+  template <class F>
+  VecXd per_element_strain(const VecXd& u, const F& f) const;
 };
-
-void Elasticity::Impl::build_full() {
-  const int nf = static_cast<int>(K.rows());
-  const int* op = K.outerIndexPtr();
-  const int* ip = K.innerIndexPtr();
-  full.rows = full.cols = nf;
-  full.ptr.assign(nf + 1, 0);
-  for (int c = 0; c < nf; ++c)
-    for (int k = op[c]; k < op[c + 1]; ++k) {
-      ++full.ptr[ip[k] + 1];
-      if (ip[k] != c) ++full.ptr[c + 1];
-    }
-  for (int i = 0; i < nf; ++i) full.ptr[i + 1] += full.ptr[i];
-  full.col.assign(full.ptr[nf], 0);
-  full.val.assign(full.ptr[nf], 0.0);
-  full_pos.assign(2 * static_cast<size_t>(K.nonZeros()), -1);
-  std::vector<int> fill(full.ptr.begin(), full.ptr.end() - 1);
-  for (int c = 0; c < nf; ++c)
-    for (int k = op[c]; k < op[c + 1]; ++k) {
-      const int r = ip[k];
-      full_pos[2 * k] = fill[r];
-      full.col[fill[r]++] = c;
-      if (r != c) {
-        full_pos[2 * k + 1] = fill[c];
-        full.col[fill[c]++] = r;
-      }
-    }
-  // Dof ranges of the nodes (free dofs are numbered node by node) and the rigid-body modes
-  // about the centre of the mesh, lengths scaled by its size.
-  node_ptr.assign(1, 0);
-  for (int k = 0; k < nf; ++k)
-    if (k > 0 && free_dofs[k] / 3 != free_dofs[k - 1] / 3) node_ptr.push_back(k);
-  if (nf > 0) node_ptr.push_back(nf);
-  full.blocks = node_ptr;  // a node's rows share their columns (the pattern is per node pair)
-  const Eigen::RowVector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
-  const Eigen::RowVector3d centre = 0.5 * (lo + hi);
-  const double size = std::max(1e-300, (hi - lo).norm());
-  modes.assign(6 * static_cast<size_t>(nf), 0.0);
-  for (int k = 0; k < nf; ++k) {
-    const int n = free_dofs[k] / 3, c = free_dofs[k] % 3;
-    const Eigen::RowVector3d x = (mesh.V.row(n) - centre) / size;
-    double* row = &modes[6 * k];
-    row[c] = 1;
-    // rotations about x, y, z: e_a × x, component c
-    const double rot[3][3] = {{0, -x[2], x[1]}, {x[2], 0, -x[0]}, {-x[1], x[0], 0}};
-    for (int a = 0; a < 3; ++a) row[3 + a] = rot[a][c];
-  }
-}
-
-void Elasticity::Impl::refill_full() {
-  const double* v = K.valuePtr();
-  parallel_for(
-      K.nonZeros(), threads,
-      [&](long b, long e) {
-        for (long k = b; k < e; ++k) {
-          full.val[full_pos[2 * k]] = v[k];
-          if (full_pos[2 * k + 1] >= 0) full.val[full_pos[2 * k + 1]] = v[k];
-        }
-      },
-      1 << 16);
-}
 
 void Elasticity::Impl::compute_geometry() {
   const long nt = mesh.T.rows();
@@ -270,34 +177,16 @@ void Elasticity::Impl::build_dof_maps() {
 void Elasticity::Impl::build_pattern() {
   const int nv = static_cast<int>(mesh.V.rows());
   const long nt = mesh.T.rows();
-  // Node graph (CSR, each node's neighbours including itself, sorted).
-  std::vector<int> deg(nv + 1, 0);
-  for (long e = 0; e < nt; ++e)
-    for (int a = 0; a < 4; ++a) deg[mesh.T(e, a) + 1] += 4;
-  for (int n = 0; n < nv; ++n) deg[n + 1] += deg[n];
-  std::vector<int> nbr(deg[nv]);
-  std::vector<int> fill(deg.begin(), deg.end() - 1);
-  for (long e = 0; e < nt; ++e)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) nbr[fill[mesh.T(e, a)]++] = mesh.T(e, b);
-  std::vector<int> start(nv + 1, 0), list;
-  list.reserve(nbr.size() / 3);
-  for (int n = 0; n < nv; ++n) {
-    auto b = nbr.begin() + deg[n], e = nbr.begin() + deg[n + 1];
-    std::sort(b, e);
-    auto last = std::unique(b, e);
-    list.insert(list.end(), b, last);
-    start[n + 1] = static_cast<int>(list.size());
-  }
+  const Adjacency graph = node_graph(mesh.T, nv);
   // Column c = free dof (node nb, comp j); rows: free dofs (na, i), na a neighbour, row >= c.
   const int nf = static_cast<int>(free_dofs.size());
   std::vector<int> outer(nf + 1, 0);
   std::vector<int> inner;
   for (int c = 0; c < nf; ++c) {
     int nb = free_dofs[c] / 3;
-    for (int k = start[nb]; k < start[nb + 1]; ++k)
+    for (int na : graph.row(nb))
       for (int i = 0; i < 3; ++i) {
-        int r = free_index[3 * list[k] + i];
+        int r = free_index[3 * na + i];
         if (r >= c) inner.push_back(r);
       }
     // rows of a column come out sorted because neighbours are sorted and the free numbering
@@ -306,7 +195,7 @@ void Elasticity::Impl::build_pattern() {
   }
   const long nnz = static_cast<long>(inner.size());
   std::vector<double> zeros(nnz, 0.0);
-  K = Eigen::Map<const SpMat>(nf, nf, nnz, outer.data(), inner.data(), zeros.data());
+  K = Eigen::Map<const SparseLower>(nf, nf, nnz, outer.data(), inner.data(), zeros.data());
   K.makeCompressed();
   // Slots of the element entries.
   slot.assign(kPairs * nt, -1);
@@ -364,10 +253,20 @@ void Elasticity::Impl::build_colours() {
   for (long e = 0; e < nt; ++e) colours[colour[e]].push_back(static_cast<int>(e));
 }
 
-void Elasticity::Impl::check_rigid_body_modes() {
-  // Each connected piece of the mesh must have its six rigid-body motions held by the fixed
-  // dofs: with r_k the rigid modes sampled at the fixed dofs of the piece, Σ r r^T must have
-  // full rank. This is exact where a "tiny pivot" test would depend on round-off.
+namespace {
+
+/// A connected piece of a mesh: its node count, the sum and extent of its nodes' positions,
+/// and the moment matrix Σ r rᵀ of the rigid modes r sampled at its fixed dofs.
+struct Piece {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), lo = Eigen::Vector3d::Constant(1e300),
+                  hi = Eigen::Vector3d::Constant(-1e300);
+  int nodes = 0;
+  Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
+};
+
+/// The connected pieces of a mesh (tets joined by shared nodes), with their node counts and
+/// positions (M left zero). Returns the piece of every node (-1 for a node in no tet).
+std::vector<int> mesh_pieces(const TetMesh& mesh, std::vector<Piece>& pieces) {
   const int nv = static_cast<int>(mesh.V.rows());
   std::vector<int> parent(nv);
   std::iota(parent.begin(), parent.end(), 0);
@@ -383,16 +282,8 @@ void Elasticity::Impl::check_rigid_body_modes() {
   std::vector<char> used(nv, 0);
   for (long e = 0; e < mesh.T.rows(); ++e)
     for (int a = 0; a < 4; ++a) used[mesh.T(e, a)] = 1;
-  // piece -> centroid, extent, fixed-dof moment matrix
-  struct Piece {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero(), lo = Eigen::Vector3d::Constant(1e300),
-                    hi = Eigen::Vector3d::Constant(-1e300);
-    int nodes = 0;
-    Eigen::Matrix<double, 6, 6> M = Eigen::Matrix<double, 6, 6>::Zero();
-  };
-  std::vector<int> piece_of(nv, -1);
-  std::vector<Piece> pieces;
-  std::vector<int> root_piece(nv, -1);
+  std::vector<int> piece_of(nv, -1), root_piece(nv, -1);
+  pieces.clear();
   for (int n = 0; n < nv; ++n) {
     if (!used[n]) continue;
     int r = find(n);
@@ -402,19 +293,44 @@ void Elasticity::Impl::check_rigid_body_modes() {
     Eigen::Vector3d x = mesh.V.row(n).transpose();
     p.sum += x, p.nodes++, p.lo = p.lo.cwiseMin(x), p.hi = p.hi.cwiseMax(x);
   }
+  return piece_of;
+}
+
+/// The number of rigid-body motions a piece's fixed dofs leave free (the near-zero eigenvalues
+/// of its moment matrix M) and, in `example`, the mode (0..5) that dominates the first of them.
+int free_rigid_modes(const Eigen::Matrix<double, 6, 6>& M, int& example) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(M);
+  Eigen::VectorXd ev = es.eigenvalues();
+  double tol = 1e-9 * std::max(1.0, ev.maxCoeff());
+  int free_modes = 0;
+  example = -1;
+  for (int i = 0; i < 6; ++i)
+    if (ev(i) <= tol) {
+      ++free_modes;
+      if (example < 0) {
+        Eigen::Matrix<double, 6, 1> v = es.eigenvectors().col(i);
+        v.cwiseAbs().maxCoeff(&example);
+      }
+    }
+  return free_modes;
+}
+
+}  // namespace
+
+void Elasticity::Impl::check_rigid_body_modes() {
+  // Each connected piece of the mesh must have its six rigid-body motions held by the fixed
+  // dofs: with r_k the rigid modes sampled at the fixed dofs of the piece, Σ r r^T must have
+  // full rank. This is exact where a "tiny pivot" test would depend on round-off.
+  std::vector<Piece> pieces;
+  const std::vector<int> piece_of = mesh_pieces(mesh, pieces);
   for (size_t d = 0; d < free_index.size(); ++d) {
     int n = static_cast<int>(d / 3), c = static_cast<int>(d % 3);
     if (free_index[d] >= 0 || piece_of[n] < 0) continue;
     Piece& p = pieces[piece_of[n]];
     double L = std::max(1e-300, (p.hi - p.lo).norm());
     Eigen::Vector3d x = (mesh.V.row(n).transpose() - p.sum / p.nodes) / L;
-    Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
-    r(c) = 1;  // translation along c
-    // rotation about axis a: (e_a × x)_c
-    for (int a = 0; a < 3; ++a) {
-      Eigen::Vector3d ea = Eigen::Vector3d::Unit(a);
-      r(3 + a) = ea.cross(x)(c);
-    }
+    Eigen::Matrix<double, 6, 1> r;
+    rigid_modes_at(x, c, r.data());
     p.M += r * r.transpose();
   }
   const char* names[6] = {"translation along x", "translation along y", "translation along z",
@@ -422,19 +338,8 @@ void Elasticity::Impl::check_rigid_body_modes() {
   int unheld = 0;
   std::ostringstream why;
   for (size_t k = 0; k < pieces.size(); ++k) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(pieces[k].M);
-    Eigen::VectorXd ev = es.eigenvalues();
-    double tol = 1e-9 * std::max(1.0, ev.maxCoeff());
-    int free_modes = 0;
     int example = -1;
-    for (int i = 0; i < 6; ++i)
-      if (ev(i) <= tol) {
-        ++free_modes;
-        if (example < 0) {
-          Eigen::Matrix<double, 6, 1> v = es.eigenvectors().col(i);
-          v.cwiseAbs().maxCoeff(&example);
-        }
-      }
+    const int free_modes = free_rigid_modes(pieces[k].M, example);
     if (free_modes == 0) continue;
     ++unheld;
     Eigen::Vector3d c = pieces[k].sum / pieces[k].nodes;
@@ -497,8 +402,7 @@ Elasticity::Elasticity(const TetMesh& mesh, const Material& material, const Supp
   m.build_pattern();
   m.build_colours();
   m.check_rigid_body_modes();
-  const int nf = static_cast<int>(m.free_dofs.size());
-  m.use_direct = params.kind == SolverKind::Direct || (params.kind == SolverKind::Auto && nf <= kDirectDofLimit);
+  m.solver = make_linear_solver({&m.K, &m.free_dofs, &m.mesh.V, m.threads}, params);
 }
 
 Elasticity::~Elasticity() = default;
@@ -512,183 +416,60 @@ void Elasticity::set_scale(const VecXd& scale) {
   impl_->dirty = true;
 }
 
-Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& progress) {
-  Impl& m = *impl_;
-  const int ndof = num_dofs();
-  if (loads.rows() != ndof) throw Error(ErrorCode::Internal, "solve: loads must have 3*#V rows");
-  if (!m.singular_reason.empty()) throw Error(ErrorCode::NoSupport, m.singular_reason);
-  progress.check_cancel("the FE solve");
-  const int nf = static_cast<int>(m.free_dofs.size());
-
-  auto t0 = std::chrono::steady_clock::now();
-  auto lap = [&t0]() {
-    auto t1 = std::chrono::steady_clock::now();
-    double s = std::chrono::duration<double>(t1 - t0).count();
-    t0 = t1;
-    return std::to_string(s) + " s";
-  };
-  auto factorise = [&]() {
-    if (!m.analysed) {
-      // Nested dissection (METIS) only: on 3D meshes it gives far less fill than AMD, and
-      // trying several orderings (CHOLMOD's default) costs more than it saves.
-      cholmod_common& c = m.direct.cholmod();
-      c.nmethods = 1;
-      c.method[0].ordering = CHOLMOD_METIS;
-      c.postorder = 1;
-      m.direct.analyzePattern(m.K);
-      m.analysed = true;
-      progress.info("symbolic analysis " + lap());
-    }
-    // Flush denormals to zero while factorising: with SIMP's 1e-9 void stiffness, fill
-    // entries decay through void regions into the subnormal range, where every operation
-    // costs ~100 times more (the factorisation slowed 4x over a run without this).
-    const unsigned csr = _mm_getcsr();
-    _mm_setcsr(csr | 0x8040);  // FTZ | DAZ
-    m.direct.factorize(m.K);
-    _mm_setcsr(csr);
-    if (m.direct.info() != Eigen::Success)
-      throw Error(ErrorCode::NoSupport,
-                  "the stiffness matrix is not positive definite (a part of the structure is "
-                  "not held, or elements are degenerate); check the supports");
-    m.factor_valid = m.factor_current = true;
-    progress.info("factorisation " + lap() + ", " + std::to_string(m.K.rows()) + " unknowns");
-  };
-  if (m.dirty) {
-    m.assemble();
-    progress.info("assembly " + lap());
-    m.factor_current = false;
-    if (m.use_direct) {
-      if (!m.factor_valid || !m.params.recycle_factor) factorise();
-    } else {
-      if (m.full.rows != m.K.rows()) m.build_full();
-      m.refill_full();
-      m.amg_kept = m.amg_built && !m.amg_rebuild && m.params.recycle_factor;
-      if (m.amg_kept) {
-        // SIMP's next matrix: keep the hierarchy, refresh the finest smoother only.
-        m.amg.refresh_finest();
-        progress.info("multigrid kept, finest level refreshed " + lap());
-      } else {
-        m.setup_amg(progress, lap);
-      }
-    }
-    m.dirty = false;
-  }
-  // Right-hand sides on the free dofs, minus the prescribed displacements' reactions.
+Eigen::MatrixXd Elasticity::Impl::free_loads(const Eigen::MatrixXd& loads) const {
+  const int nf = static_cast<int>(free_dofs.size());
   Eigen::MatrixXd b(nf, loads.cols());
-  for (int k = 0; k < nf; ++k) b.row(k) = loads.row(m.free_dofs[k]);
-  if (m.nonzero_prescribed) {
-    double Ke[144];
-    for (long t = 0; t < m.mesh.T.rows(); ++t) {
-      double up[12];
-      bool any = false;
-      for (int i = 0; i < 12; ++i) {
-        up[i] = m.prescribed[3 * m.mesh.T(t, i / 3) + i % 3];
-        any |= up[i] != 0;
-      }
-      if (!any) continue;
-      element_matrix(&m.grad[12 * t], m.vol[t] * m.scale[t], m.lambda, m.mu, Ke);
-      for (int i = 0; i < 12; ++i) {
-        int r = m.free_index[3 * m.mesh.T(t, i / 3) + i % 3];
-        if (r < 0) continue;
-        double s = 0;
-        for (int j = 0; j < 12; ++j) s += Ke[i * 12 + j] * up[j];
-        b.row(r).array() -= s;
-      }
+  for (int k = 0; k < nf; ++k) b.row(k) = loads.row(free_dofs[k]);
+  if (!nonzero_prescribed) return b;
+  double Ke[144];
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    double up[12];
+    bool any = false;
+    for (int i = 0; i < 12; ++i) {
+      up[i] = prescribed[3 * mesh.T(t, i / 3) + i % 3];
+      any |= up[i] != 0;
+    }
+    if (!any) continue;
+    element_matrix(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+    for (int i = 0; i < 12; ++i) {
+      int r = free_index[3 * mesh.T(t, i / 3) + i % 3];
+      if (r < 0) continue;
+      double s = 0;
+      for (int j = 0; j < 12; ++j) s += Ke[i * 12 + j] * up[j];
+      b.row(r).array() -= s;
     }
   }
-  Eigen::MatrixXd x(nf, loads.cols());
-  if (m.use_direct && !m.factor_current && m.skip_recycle > 0) {
-    --m.skip_recycle;
-    factorise();
-  }
-  if (m.use_direct && !m.factor_current) {
-    // Conjugate gradients preconditioned by the factor of an earlier matrix, warm-started.
-    // Abandoned as soon as the convergence rate says it would need more than
-    // recycle_iterations; after a failure the next two solves refactorise directly.
-    bool ok = m.last.rows() == nf && m.last.cols() == b.cols();
-    int worst = 0;
-    for (int c = 0; ok && c < b.cols(); ++c) {
-      Eigen::VectorXd xc = m.last.col(c), r = b.col(c) - m.K.selfadjointView<Eigen::Lower>() * xc;
-      const double bnorm = b.col(c).norm(), goal = m.params.recycle_tolerance * bnorm;
-      Eigen::VectorXd z = m.direct.solve(r), p = z, Kp(nf);
-      double rz = r.dot(z);
-      int k = 0;
-      const double r0 = r.norm();
-      for (; r.norm() > goal && bnorm > 0; ++k) {
-        const int limit = m.params.recycle_iterations;
-        if (k >= limit || (k == 6 && std::pow(r.norm() / r0, static_cast<double>(limit) / 6) > goal / r0)) {
-          ok = false;
-          break;
-        }
-        Kp.noalias() = m.K.selfadjointView<Eigen::Lower>() * p;
-        double alpha = rz / p.dot(Kp);
-        xc += alpha * p;
-        r -= alpha * Kp;
-        z = m.direct.solve(r);
-        double rz_new = r.dot(z);
-        p = z + (rz_new / rz) * p;
-        rz = rz_new;
-      }
-      worst = std::max(worst, k);
-      x.col(c) = xc;
-    }
-    if (ok) {
-      progress.info("recycled factor: " + std::to_string(worst) + " CG iterations, " + lap());
-    } else {
-      progress.info("recycling abandoned after " + lap());
-      m.skip_recycle = 2;
-      factorise();
-    }
-  }
-  if (m.use_direct && m.factor_current) {
-    x = m.direct.solve(b);
-  } else if (!m.use_direct) {
-    int worst = 0;
-    // The V-cycle's BLAS work (coarse triangular solves) is small: one BLAS thread, so that
-    // OpenBLAS's spinning workers leave the cores to our sparse products.
-    BlasThreadLimit blas_limit(1);
-    for (int c = 0; c < b.cols(); ++c) {
-      Eigen::VectorXd xc =
-          (m.last.rows() == nf && c < m.last.cols()) ? Eigen::VectorXd(m.last.col(c)) : Eigen::VectorXd::Zero(nf);
-      Eigen::VectorXd bc = b.col(c);
-      PcgResult r = amg_pcg(m.full, m.amg, bc.data(), xc.data(), m.params.tolerance, m.params.max_iterations, m.threads,
-                            progress);
-      if (!r.converged && m.amg_kept) {
-        // the kept hierarchy no longer fits this matrix: rebuild it and solve again
-        progress.info("multigrid CG stalled with the kept hierarchy; rebuilding it");
-        m.setup_amg(progress, lap);
-        r = amg_pcg(m.full, m.amg, bc.data(), xc.data(), m.params.tolerance, m.params.max_iterations, m.threads,
-                    progress);
-      }
-      if (!r.converged) {
-        std::ostringstream s;
-        s << "the iterative solver did not converge in " << r.iterations << " iterations (relative residual "
-          << r.relative_residual << "); try the direct solver (\"solver\": \"direct\")";
-        throw Error(ErrorCode::Internal, s.str());
-      }
-      worst = std::max(worst, r.iterations);
-      x.col(c) = xc;
-    }
-    progress.info("multigrid CG: " + std::to_string(worst) + " iterations, " + lap());
-    // A kept hierarchy that now needs clearly more iterations than right after its setup
-    // is rebuilt for the next matrix.
-    if (m.amg_baseline < 0)
-      m.amg_baseline = worst;
-    else if (worst > 1.5 * m.amg_baseline + 4)
-      m.amg_rebuild = true;
-    m.last = x;
-  }
-  if (m.use_direct) m.last = x;
-  if (!x.allFinite()) throw Error(ErrorCode::NoSupport, "the solution is not finite: the structure is not held");
-  Eigen::MatrixXd U(ndof, loads.cols());
+  return b;
+}
+
+Eigen::MatrixXd Elasticity::Impl::all_dofs(const Eigen::MatrixXd& x) const {
+  const int ndof = static_cast<int>(free_index.size());
+  Eigen::MatrixXd U(ndof, x.cols());
   for (int d = 0; d < ndof; ++d) {
-    int k = m.free_index[d];
+    int k = free_index[d];
     if (k >= 0)
       U.row(d) = x.row(k);
     else
-      U.row(d).setConstant(m.prescribed[d]);
+      U.row(d).setConstant(prescribed[d]);
   }
   return U;
+}
+
+Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& progress) {
+  Impl& m = *impl_;
+  if (loads.rows() != num_dofs()) throw Error(ErrorCode::Internal, "solve: loads must have 3*#V rows");
+  if (!m.singular_reason.empty()) throw Error(ErrorCode::NoSupport, m.singular_reason);
+  progress.check_cancel("the FE solve");
+  if (m.dirty) {
+    Stopwatch watch;
+    m.assemble();
+    progress.info("assembly " + watch.lap());
+    m.solver->update(progress);
+    m.dirty = false;
+  }
+  m.solver->solve(m.free_loads(loads), m.last, progress);
+  if (!m.last.allFinite()) throw Error(ErrorCode::NoSupport, "the solution is not finite: the structure is not held");
+  return m.all_dofs(m.last);
 }
 
 namespace {
@@ -705,36 +486,34 @@ Eigen::Matrix3d element_strain(const TetMesh& mesh, const std::vector<double>& g
 }
 }  // namespace
 
-VecXd Elasticity::element_energy(const VecXd& u) const {
-  const Impl& m = *impl_;
-  const long nt = m.mesh.T.rows();
+template <class F>
+VecXd Elasticity::Impl::per_element_strain(const VecXd& u, const F& f) const {
+  const long nt = mesh.T.rows();
   VecXd out(nt);
-  parallel_for(nt, m.threads, [&](long b, long e) {
-    for (long t = b; t < e; ++t) {
-      // u^T K0 u = vol (λ (tr ε)² + 2μ ε:ε)
-      Eigen::Matrix3d eps = element_strain(m.mesh, m.grad, t, u);
-      double tr = eps.trace();
-      out[t] = m.vol[t] * (m.lambda * tr * tr + 2 * m.mu * eps.cwiseAbs2().sum());
-    }
+  parallel_for(nt, threads, [&](long b, long e) {
+    for (long t = b; t < e; ++t) out[t] = f(t, element_strain(mesh, grad, t, u));
   });
   return out;
 }
 
+VecXd Elasticity::element_energy(const VecXd& u) const {
+  const Impl& m = *impl_;
+  return m.per_element_strain(u, [&m](long t, const Eigen::Matrix3d& eps) {
+    // u^T K0 u = vol (λ (tr ε)² + 2μ ε:ε)
+    double tr = eps.trace();
+    return m.vol[t] * (m.lambda * tr * tr + 2 * m.mu * eps.cwiseAbs2().sum());
+  });
+}
+
 VecXd Elasticity::von_mises(const VecXd& u) const {
   const Impl& m = *impl_;
-  const long nt = m.mesh.T.rows();
-  VecXd out(nt);
-  parallel_for(nt, m.threads, [&](long b, long e) {
-    for (long t = b; t < e; ++t) {
-      Eigen::Matrix3d eps = element_strain(m.mesh, m.grad, t, u);
-      Eigen::Matrix3d s = m.scale[t] * (m.lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * m.mu * eps);
-      double d = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) + (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
-                        (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
-                 3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
-      out[t] = std::sqrt(d);
-    }
+  return m.per_element_strain(u, [&m](long t, const Eigen::Matrix3d& eps) {
+    Eigen::Matrix3d s = m.scale[t] * (m.lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * m.mu * eps);
+    double d = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) + (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
+                      (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
+               3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
+    return std::sqrt(d);
   });
-  return out;
 }
 
 int Elasticity::num_dofs() const { return 3 * static_cast<int>(impl_->mesh.V.rows()); }

@@ -11,6 +11,7 @@
 
 #include "common/progress.h"
 #include "common/types.h"
+#include "fem/linear_solver.h"
 
 namespace topopt::fem {
 
@@ -19,22 +20,6 @@ struct Material {
   double young = 210000.0;   ///< Young's modulus E, MPa (steel)
   double poisson = 0.3;      ///< Poisson's ratio ν, in (-1, 0.5)
   double density = 7.85e-9;  ///< mass density, t/mm³ (for gravity loads)
-};
-
-enum class SolverKind { Auto, Direct, Iterative };
-
-struct SolverParams {
-  SolverKind kind = SolverKind::Auto;  ///< Auto: chosen by problem size (see elasticity.cpp)
-  double tolerance = 1e-8;             ///< iterative: relative residual
-  int max_iterations = 5000;           ///< iterative
-  int threads = 0;                     ///< assembly threads; 0 = hardware concurrency
-  /// Direct solver, after set_scale: first try conjugate gradients preconditioned by the
-  /// previous Cholesky factor (SIMP's stiffness changes little between iterations) and
-  /// refactorise only when that takes more than `recycle_iterations` iterations. The result
-  /// then meets `recycle_tolerance` (relative residual) instead of machine precision.
-  bool recycle_factor = true;
-  int recycle_iterations = 20;
-  double recycle_tolerance = 1e-9;
 };
 
 /// Dirichlet data: fixed degrees of freedom (3*node + component) with prescribed values.
@@ -56,9 +41,10 @@ class Elasticity {
   /// Per-element stiffness factors (#T, > 0), e.g. SIMP's E(ρ)/E0. Default all 1.
   void set_scale(const VecXd& scale);
 
-  /// Solves K U = F for each column of `loads` ((3*#V) by #cases, node-major: 3*i+c).
-  /// Returns U of the same shape (supports imposed). Warm-starts from the previous solution
-  /// when iterative. Throws Error(NoSupport) for a singular system.
+  /// Solves K U = F for each column of `loads` ((3*#V) by #cases, node-major: 3*i+c) through
+  /// the LinearSolver that `params.kind` names (fem/linear_solver.h), assembling K first if
+  /// set_scale changed it. Returns U of the same shape (supports imposed). Warm-starts from
+  /// the previous solution. Throws Error(NoSupport) for a singular system.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& loads, const Progress& progress = {});
 
   /// #T: u_e^T K0_e u_e for a displacement field u (3*#V), the unscaled element energy

@@ -165,103 +165,181 @@ class Tokens {
 
 }  // namespace
 
+namespace {
+
+/// What read_msh collects from the sections of a file before it becomes a TetMesh.
+struct MshContents {
+  std::map<std::pair<int, int>, std::vector<int>> phys;  // (dim, entity) -> physical tags
+  std::unordered_map<long, int> node_index;              // node tag -> index into nodes
+  std::vector<std::array<double, 3>> nodes;
+  std::vector<std::array<long, 4>> tets;      // corner node tags
+  std::vector<int> tet_dom;                   // domain of each tet
+  std::vector<std::array<long, 3>> tris;      // corner node tags of the tagged triangles
+  std::vector<std::pair<int, int>> tri_tags;  // (face, nd_face) of each triangle
+};
+
+/// $MeshFormat: version 4.x, ASCII.
+void read_format(Tokens& in) {
+  std::string version = in.word();
+  long binary = in.integer();
+  in.integer();
+  if (version.rfind("4", 0) != 0) {
+    const bool looks_like_a_version =
+        version.size() <= 8 && version.find_first_not_of("0123456789.") == std::string::npos;
+    in.fail("MSH version " + (looks_like_a_version ? version + " " : std::string()) + "is not supported; save as 4.1");
+  }
+  if (binary) in.fail("binary MSH is not supported; save as ASCII");
+  in.skip_section("$EndMeshFormat", "$MeshFormat");
+}
+
+/// $Entities: the physical tags of every point, curve, surface and volume entity.
+void read_entities(Tokens& in, MshContents& c) {
+  long count[4];
+  for (long& n : count) n = in.integer();
+  for (int dim = 0; dim <= 3; ++dim)
+    for (long i = 0; i < count[dim]; ++i) {
+      int tag = static_cast<int>(in.integer());
+      for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) in.real();  // a point, or a bounding box
+      long n = in.integer();
+      for (long k = 0; k < n; ++k) c.phys[{dim, tag}].push_back(static_cast<int>(in.integer()));
+      if (dim == 0) continue;
+      long nb = in.integer();  // bounding entities
+      for (long k = 0; k < nb; ++k) in.integer();
+    }
+  in.skip_section("$EndEntities", "$Entities");
+}
+
+/// $Nodes: coordinates by node tag (parametric coordinates skipped).
+void read_nodes(Tokens& in, MshContents& c) {
+  long blocks = in.integer(), total = in.integer();
+  in.integer(), in.integer();
+  c.nodes.reserve(total);
+  for (long b = 0; b < blocks; ++b) {
+    long dim = in.integer();
+    in.integer();
+    long parametric = in.integer(), n = in.integer();
+    std::vector<long> tags(n);
+    for (long k = 0; k < n; ++k) tags[k] = in.integer();
+    for (long k = 0; k < n; ++k) {
+      std::array<double, 3> x{in.real(), in.real(), in.real()};
+      if (parametric)
+        for (long p = 0; p < std::min<long>(dim, 2); ++p) in.real();
+      c.node_index[tags[k]] = static_cast<int>(c.nodes.size());
+      c.nodes.push_back(x);
+    }
+  }
+  in.skip_section("$EndNodes", "$Nodes");
+}
+
+/// One element of $Elements: a (linear or quadratic) tet gets its block's domain, a tagged
+/// (linear or quadratic) triangle its face and non-design face; corners only.
+void add_element(MshContents& c, long type, int entity, const std::vector<int>& ph, const std::array<long, 10>& v) {
+  if (type == 4 || type == 11) {
+    c.tets.push_back({v[0], v[1], v[2], v[3]});
+    int tag = ph.empty() ? entity : ph.front();
+    c.tet_dom.push_back(std::max(0, tag - 1));
+  } else if ((type == 2 || type == 9) && !ph.empty()) {
+    int face = 0, nd_face = 0;
+    for (int p : ph)
+      if (p > kNonDesignFaceTag)
+        nd_face = p - kNonDesignFaceTag;
+      else
+        face = p;
+    c.tris.push_back({v[0], v[1], v[2]});
+    c.tri_tags.emplace_back(face, nd_face);
+  }
+}
+
+/// $Elements: tets and tagged triangles (other types read and skipped).
+void read_elements(Tokens& in, MshContents& c) {
+  long blocks = in.integer();
+  in.integer(), in.integer(), in.integer();
+  static const std::map<long, int> kNodesOf = {{1, 2}, {2, 3}, {3, 4}, {4, 4},  {5, 8},   {6, 6},
+                                               {7, 5}, {8, 3}, {9, 6}, {10, 9}, {11, 10}, {15, 1}};
+  for (long b = 0; b < blocks; ++b) {
+    int dim = static_cast<int>(in.integer());
+    int entity = static_cast<int>(in.integer());
+    long type = in.integer(), n = in.integer();
+    auto it = kNodesOf.find(type);
+    if (it == kNodesOf.end()) in.fail("element type " + std::to_string(type) + " is not supported");
+    const std::vector<int>& ph = c.phys[{dim, entity}];
+    for (long k = 0; k < n; ++k) {
+      in.integer();
+      std::array<long, 10> v{};
+      for (int j = 0; j < it->second; ++j) v[j] = in.integer();
+      add_element(c, type, entity, ph, v);
+    }
+  }
+  in.skip_section("$EndElements", "$Elements");
+}
+
+/// The index of the node with `tag`; throws Error(Io) if the file does not define it.
+int node_of_tag(const MshContents& c, long tag, const std::string& path) {
+  auto it = c.node_index.find(tag);
+  if (it == c.node_index.end())
+    throw Error(ErrorCode::Io, path + ": an element uses node " + std::to_string(tag) + " which is not defined");
+  return it->second;
+}
+
+/// m.V, m.T (negatively oriented tets flipped) and m.domain from the file's contents.
+void set_tets(const MshContents& c, const std::string& path, TetMesh& m) {
+  m.V.resize(c.nodes.size(), 3);
+  for (size_t i = 0; i < c.nodes.size(); ++i) m.V.row(i) << c.nodes[i][0], c.nodes[i][1], c.nodes[i][2];
+  m.T.resize(c.tets.size(), 4);
+  m.domain.resize(c.tets.size());
+  for (size_t t = 0; t < c.tets.size(); ++t) {
+    for (int a = 0; a < 4; ++a) m.T(t, a) = node_of_tag(c, c.tets[t][a], path);
+    Eigen::RowVector3d p0 = m.V.row(m.T(t, 0));
+    Eigen::Matrix3d J;
+    for (int a = 0; a < 3; ++a) J.row(a) = m.V.row(m.T(t, a + 1)) - p0;
+    if (J.determinant() < 0) std::swap(m.T(t, 2), m.T(t, 3));
+    m.domain[t] = c.tet_dom[t];
+  }
+}
+
+/// m.F, m.face, m.nd_face: the file's tagged triangles, each oriented as the boundary of the
+/// tets says (outwards); without any, the boundary of the tets with face 0.
+void set_boundary(const MshContents& c, const std::string& path, TetMesh& m) {
+  if (c.tris.empty()) {
+    m.F = boundary_triangles(m.T);
+    m.face = VecXi::Zero(m.F.rows());
+    m.nd_face = VecXi::Zero(m.F.rows());
+    return;
+  }
+  m.F.resize(c.tris.size(), 3);
+  m.face.resize(c.tris.size());
+  m.nd_face.resize(c.tris.size());
+  MatX3i B = boundary_triangles(m.T);
+  std::unordered_map<std::array<int, 3>, std::array<int, 3>, KeyHash> outward;
+  for (long i = 0; i < B.rows(); ++i) outward[sorted_key(B(i, 0), B(i, 1), B(i, 2))] = {B(i, 0), B(i, 1), B(i, 2)};
+  for (size_t t = 0; t < c.tris.size(); ++t) {
+    std::array<int, 3> tri{node_of_tag(c, c.tris[t][0], path), node_of_tag(c, c.tris[t][1], path),
+                           node_of_tag(c, c.tris[t][2], path)};
+    auto it = outward.find(sorted_key(tri[0], tri[1], tri[2]));
+    if (it != outward.end()) tri = it->second;
+    m.F.row(t) << tri[0], tri[1], tri[2];
+    m.face[t] = c.tri_tags[t].first;
+    m.nd_face[t] = c.tri_tags[t].second;
+  }
+}
+
+}  // namespace
+
 TetMesh read_msh(const std::string& path) {
   Tokens in(path);
-  std::map<std::pair<int, int>, std::vector<int>> phys;  // (dim, entity) -> physical tags
-  std::unordered_map<long, int> node_index;
-  std::vector<std::array<double, 3>> nodes;
-  std::vector<std::array<long, 4>> tets;
-  std::vector<int> tet_dom;
-  std::vector<std::array<long, 3>> tris;
-  std::vector<std::pair<int, int>> tri_tags;
+  MshContents c;
   bool saw_format = false;
   while (!in.done()) {
     std::string sec = in.word();
     if (sec == "$MeshFormat") {
-      std::string version = in.word();
-      long binary = in.integer();
-      in.integer();
-      if (version.rfind("4", 0) != 0) {
-        const bool looks_like_a_version =
-            version.size() <= 8 && version.find_first_not_of("0123456789.") == std::string::npos;
-        in.fail("MSH version " + (looks_like_a_version ? version + " " : std::string()) +
-                "is not supported; save as 4.1");
-      }
-      if (binary) in.fail("binary MSH is not supported; save as ASCII");
-      in.skip_section("$EndMeshFormat", "$MeshFormat");
+      read_format(in);
       saw_format = true;
     } else if (sec == "$Entities") {
-      long np = in.integer(), nc = in.integer(), ns = in.integer(), nvol = in.integer();
-      for (long i = 0; i < np; ++i) {
-        int tag = static_cast<int>(in.integer());
-        for (int k = 0; k < 3; ++k) in.real();
-        long n = in.integer();
-        for (long k = 0; k < n; ++k) phys[{0, tag}].push_back(static_cast<int>(in.integer()));
-      }
-      for (int dim = 1; dim <= 3; ++dim) {
-        long count = dim == 1 ? nc : dim == 2 ? ns : nvol;
-        for (long i = 0; i < count; ++i) {
-          int tag = static_cast<int>(in.integer());
-          for (int k = 0; k < 6; ++k) in.real();
-          long n = in.integer();
-          for (long k = 0; k < n; ++k) phys[{dim, tag}].push_back(static_cast<int>(in.integer()));
-          long nb = in.integer();
-          for (long k = 0; k < nb; ++k) in.integer();
-        }
-      }
-      in.skip_section("$EndEntities", "$Entities");
+      read_entities(in, c);
     } else if (sec == "$Nodes") {
-      long blocks = in.integer(), total = in.integer();
-      in.integer(), in.integer();
-      nodes.reserve(total);
-      for (long b = 0; b < blocks; ++b) {
-        long dim = in.integer();
-        in.integer();
-        long parametric = in.integer(), n = in.integer();
-        std::vector<long> tags(n);
-        for (long k = 0; k < n; ++k) tags[k] = in.integer();
-        for (long k = 0; k < n; ++k) {
-          std::array<double, 3> x{in.real(), in.real(), in.real()};
-          if (parametric)
-            for (long p = 0; p < std::min<long>(dim, 2); ++p) in.real();
-          node_index[tags[k]] = static_cast<int>(nodes.size());
-          nodes.push_back(x);
-        }
-      }
-      in.skip_section("$EndNodes", "$Nodes");
+      read_nodes(in, c);
     } else if (sec == "$Elements") {
-      long blocks = in.integer();
-      in.integer(), in.integer(), in.integer();
-      static const std::map<long, int> kNodesOf = {{1, 2}, {2, 3}, {3, 4}, {4, 4},  {5, 8},   {6, 6},
-                                                   {7, 5}, {8, 3}, {9, 6}, {10, 9}, {11, 10}, {15, 1}};
-      for (long b = 0; b < blocks; ++b) {
-        int dim = static_cast<int>(in.integer());
-        int entity = static_cast<int>(in.integer());
-        long type = in.integer(), n = in.integer();
-        auto it = kNodesOf.find(type);
-        if (it == kNodesOf.end()) in.fail("element type " + std::to_string(type) + " is not supported");
-        const auto& ph = phys[{dim, entity}];
-        for (long k = 0; k < n; ++k) {
-          in.integer();
-          std::array<long, 10> v{};
-          for (int j = 0; j < it->second; ++j) v[j] = in.integer();
-          if (type == 4 || type == 11) {
-            tets.push_back({v[0], v[1], v[2], v[3]});
-            int tag = ph.empty() ? entity : ph.front();
-            tet_dom.push_back(std::max(0, tag - 1));
-          } else if ((type == 2 || type == 9) && !ph.empty()) {
-            int face = 0, nd = 0;
-            for (int p : ph)
-              if (p > kNonDesignFaceTag)
-                nd = p - kNonDesignFaceTag;
-              else
-                face = p;
-            tris.push_back({v[0], v[1], v[2]});
-            tri_tags.emplace_back(face, nd);
-          }
-        }
-      }
-      in.skip_section("$EndElements", "$Elements");
+      read_elements(in, c);
     } else if (!sec.empty() && sec[0] == '$') {
       in.skip_section("$End" + sec.substr(1), "a section this reader skips");
     } else {
@@ -270,47 +348,10 @@ TetMesh read_msh(const std::string& path) {
     }
   }
   if (!saw_format) in.fail("no $MeshFormat section");
-  if (tets.empty()) throw Error(ErrorCode::Io, path + ": the mesh has no tetrahedra");
+  if (c.tets.empty()) throw Error(ErrorCode::Io, path + ": the mesh has no tetrahedra");
   TetMesh m;
-  m.V.resize(nodes.size(), 3);
-  for (size_t i = 0; i < nodes.size(); ++i) m.V.row(i) << nodes[i][0], nodes[i][1], nodes[i][2];
-  auto idx = [&](long tag) {
-    auto it = node_index.find(tag);
-    if (it == node_index.end())
-      throw Error(ErrorCode::Io, path + ": an element uses node " + std::to_string(tag) + " which is not defined");
-    return it->second;
-  };
-  m.T.resize(tets.size(), 4);
-  m.domain.resize(tets.size());
-  for (size_t t = 0; t < tets.size(); ++t) {
-    for (int a = 0; a < 4; ++a) m.T(t, a) = idx(tets[t][a]);
-    Eigen::RowVector3d p0 = m.V.row(m.T(t, 0));
-    Eigen::Matrix3d J;
-    for (int a = 0; a < 3; ++a) J.row(a) = m.V.row(m.T(t, a + 1)) - p0;
-    if (J.determinant() < 0) std::swap(m.T(t, 2), m.T(t, 3));
-    m.domain[t] = tet_dom[t];
-  }
-  if (!tris.empty()) {
-    m.F.resize(tris.size(), 3);
-    m.face.resize(tris.size());
-    m.nd_face.resize(tris.size());
-    // Orient each triangle as the boundary of the tets says (outwards).
-    MatX3i B = boundary_triangles(m.T);
-    std::unordered_map<std::array<int, 3>, std::array<int, 3>, KeyHash> outward;
-    for (long i = 0; i < B.rows(); ++i) outward[sorted_key(B(i, 0), B(i, 1), B(i, 2))] = {B(i, 0), B(i, 1), B(i, 2)};
-    for (size_t t = 0; t < tris.size(); ++t) {
-      std::array<int, 3> tri{idx(tris[t][0]), idx(tris[t][1]), idx(tris[t][2])};
-      auto it = outward.find(sorted_key(tri[0], tri[1], tri[2]));
-      if (it != outward.end()) tri = it->second;
-      m.F.row(t) << tri[0], tri[1], tri[2];
-      m.face[t] = tri_tags[t].first;
-      m.nd_face[t] = tri_tags[t].second;
-    }
-  } else {
-    m.F = boundary_triangles(m.T);
-    m.face = VecXi::Zero(m.F.rows());
-    m.nd_face = VecXi::Zero(m.F.rows());
-  }
+  set_tets(c, path, m);
+  set_boundary(c, path, m);
   return m;
 }
 

@@ -1,0 +1,99 @@
+// Sparse matrix kernels against dense arithmetic: products with and without row blocks, the
+// single-precision product, the matrix product and the transpose.
+#include "fem/csr_matrix.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+namespace topopt::fem {
+namespace {
+
+/// A random sparse matrix whose rows come in blocks of `block` rows sharing their columns.
+CsrMatrix random_blocked(int rows, int cols, int block, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> value(-1, 1);
+  std::bernoulli_distribution keep(0.3);
+  CsrMatrix M;
+  M.rows = rows;
+  M.cols = cols;
+  M.ptr.assign(1, 0);
+  for (int r0 = 0; r0 < rows; r0 += block) {
+    std::vector<int> cols_of_block;
+    for (int c = cols - 1; c >= 0; --c)  // any order within a row
+      if (keep(rng)) cols_of_block.push_back(c);
+    const int nr = std::min(block, rows - r0);
+    for (int r = 0; r < nr; ++r) {
+      for (int c : cols_of_block) M.col.push_back(c), M.val.push_back(value(rng));
+      M.ptr.push_back(static_cast<int>(M.col.size()));
+    }
+    M.blocks.push_back(r0);
+  }
+  M.blocks.push_back(rows);
+  return M;
+}
+
+Eigen::MatrixXd dense(const CsrMatrix& M) {
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(M.rows, M.cols);
+  for (int i = 0; i < M.rows; ++i)
+    for (int k = M.ptr[i]; k < M.ptr[i + 1]; ++k) D(i, M.col[k]) += M.val[k];
+  return D;
+}
+
+TEST(CsrMatrix, ProductsEqualDenseArithmetic) {
+  const CsrMatrix A = random_blocked(30, 20, 3, 1);
+  ASSERT_TRUE(A.blocks_consistent());
+  CsrMatrix plain = A;
+  plain.blocks.clear();
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(20, -2, 3);
+  const Eigen::VectorXd ref = dense(A) * x;
+  Eigen::VectorXd y(30), z(30), w(30);
+  A.multiply(x.data(), y.data(), 2);
+  plain.multiply(x.data(), z.data(), 1);
+  EXPECT_LT((y - ref).norm(), 1e-13 * ref.norm());
+  EXPECT_EQ(y, z);  // blocks change the walk, not the sums
+  const std::vector<float> single(A.val.begin(), A.val.end());
+  sparse_product(A, single.data(), x.data(), w.data(), 2);
+  EXPECT_LT((w - ref).norm(), 1e-6 * ref.norm());
+  EXPECT_GT((w - ref).norm(), 0.0);  // it did use the float values
+}
+
+TEST(CsrMatrix, MatrixProductAndTransposeEqualDenseArithmetic) {
+  const CsrMatrix A = random_blocked(24, 18, 4, 2), B = random_blocked(18, 11, 1, 3);
+  const CsrMatrix C = multiply(A, B, 2);
+  EXPECT_LT((dense(C) - dense(A) * dense(B)).norm(), 1e-12 * (dense(A) * dense(B)).norm());
+  EXPECT_EQ(C.blocks, A.blocks);
+  EXPECT_TRUE(C.blocks_consistent());
+  const CsrMatrix T = transpose(A);
+  EXPECT_EQ(T.rows, A.cols);
+  EXPECT_EQ(T.cols, A.rows);
+  EXPECT_EQ(dense(T), dense(A).transpose());
+}
+
+TEST(CsrMatrix, InconsistentBlocksAreDetected) {
+  CsrMatrix A;  // rows 0 and 1 on columns {0, 1}, row 2 on {2}, row 3 on {2, 3}
+  A.rows = A.cols = 4;
+  A.ptr = {0, 2, 4, 5, 7};
+  A.col = {0, 1, 0, 1, 2, 2, 3};
+  A.val.assign(7, 1.0);
+  A.blocks = {0, 2, 3, 4};
+  EXPECT_TRUE(A.blocks_consistent());
+  A.blocks = {0, 2, 4};  // rows 2 and 3 differ
+  EXPECT_FALSE(A.blocks_consistent());
+  A.blocks = {0, 2, 3};  // does not end at the last row
+  EXPECT_FALSE(A.blocks_consistent());
+  CsrMatrix tall;  // nine rows on the same column: one block too many rows
+  tall.rows = 9;
+  tall.cols = 1;
+  for (int i = 0; i <= 9; ++i) tall.ptr.push_back(i);
+  tall.col.assign(9, 0);
+  tall.val.assign(9, 1.0);
+  tall.blocks = {0, 9};
+  EXPECT_FALSE(tall.blocks_consistent());
+  tall.blocks = {0, 8, 9};
+  EXPECT_TRUE(tall.blocks_consistent());
+}
+
+}  // namespace
+}  // namespace topopt::fem

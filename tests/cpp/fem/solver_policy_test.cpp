@@ -1,0 +1,54 @@
+// The SIMP-time reuse rules, decision by decision.
+#include "fem/solver_policy.h"
+
+#include <gtest/gtest.h>
+
+namespace topopt::fem {
+namespace {
+
+TEST(FactorReuse, FactorisesWithoutAFactorOrWhenReuseIsOff) {
+  const FactorReuse on(true), off(false);
+  EXPECT_TRUE(on.factorise_on_update(false));
+  EXPECT_FALSE(on.factorise_on_update(true));
+  EXPECT_TRUE(off.factorise_on_update(false));
+  EXPECT_TRUE(off.factorise_on_update(true));
+}
+
+TEST(FactorReuse, TwoSolvesFactoriseDirectlyAfterAFailedRecycling) {
+  FactorReuse r(true);
+  EXPECT_FALSE(r.factorise_before_solve());
+  r.recycling_failed();
+  EXPECT_TRUE(r.factorise_before_solve());
+  EXPECT_TRUE(r.factorise_before_solve());
+  EXPECT_FALSE(r.factorise_before_solve());
+  EXPECT_FALSE(r.factorise_before_solve());
+}
+
+TEST(HierarchyReuse, KeptUntilTheIterationsGrowByHalf) {
+  HierarchyReuse r(true);
+  EXPECT_FALSE(r.keep(false));  // nothing built yet
+  r.set_up();
+  r.record(10);  // the baseline
+  EXPECT_TRUE(r.keep(true));
+  r.record(19);  // 1.5 * 10 + 4 = 19: not yet
+  EXPECT_TRUE(r.keep(true));
+  r.record(20);
+  EXPECT_FALSE(r.keep(true));
+  r.set_up();  // a new hierarchy, a new baseline
+  EXPECT_TRUE(r.keep(true));
+  r.record(30);
+  r.record(49);
+  EXPECT_TRUE(r.keep(true));
+  r.record(50);
+  EXPECT_FALSE(r.keep(true));
+}
+
+TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
+  HierarchyReuse r(false);
+  r.set_up();
+  r.record(10);
+  EXPECT_FALSE(r.keep(true));
+}
+
+}  // namespace
+}  // namespace topopt::fem
