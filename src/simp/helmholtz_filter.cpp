@@ -118,7 +118,7 @@ VecXd HelmholtzFilter::element_mean(const VecXd& nodal) const {
 VecXd HelmholtzFilter::solve(const VecXd& b, VecXd& warm) const {
   if (warm.size() != b.size()) warm = VecXd::Zero(b.size());
   fem::PcgParams pcg;
-  pcg.tolerance = 1e-10;  // the filter's transpose must match it closely for the gradients
+  pcg.tolerance = 1e-12;  // near round-off: the gradients (Fᵀ) must match the filter (F) closely
   pcg.max_iterations = 2000;
   const fem::PcgResult r =
       fem::pcg(fem::CsrOperator(A_, threads_), JacobiPreconditioner(inverse_diagonal_), b, warm, pcg, progress_);

@@ -57,9 +57,10 @@ TEST(HelmholtzFilter, PassesConstantsAndItsTransposeIsItsAdjoint) {
   const VecXd ones = VecXd::Ones(static_cast<long>(b.design.size()));
   EXPECT_LT((f.apply(ones) - ones).cwiseAbs().maxCoeff(), 1e-8);
   const VecXd x = VecXd::Random(ones.size()), y = VecXd::Random(ones.size());
-  EXPECT_NEAR(f.apply(x).dot(y), x.dot(f.apply_transpose(y)), 1e-8 * std::abs(f.apply(x).dot(y)) + 1e-10);
-  EXPECT_NEAR(f.length(), 3.0 / (2 * std::sqrt(3.0)), 1e-12);
+  const VecXd fx = f.apply(x);
   EXPECT_GT(f.last_iterations(), 0);
+  EXPECT_NEAR(fx.dot(y), x.dot(f.apply_transpose(y)), 1e-10 * std::abs(fx.dot(y)) + 1e-12);
+  EXPECT_NEAR(f.length(), 3.0 / (2 * std::sqrt(3.0)), 1e-12);
 }
 
 TEST(HelmholtzFilter, MatchesTheContinuumSolutionForACosine) {
@@ -82,9 +83,9 @@ TEST(HelmholtzFilter, MatchesTheContinuumSolutionForACosine) {
 TEST(HelmholtzFilter, AttenuatesLikeTheConeFilterOfTheSameRadius) {
   // Lazarov & Sigmund's match ℓ = r/(2√3): the amplitude left of a cosine of wavelength
   // 4r ... 10r by the two filters, away from the ends (where the explicit filter is cut)
-  const double length = 24, h = 0.5;
+  const double length = 24, h = 1;
   const Box b = box(length, h);
-  for (double r : {1.5, 2.5}) {
+  for (double r : {2.0, 3.0}) {
     DensityFilter cone(b.mesh, b.design, b.volume, {FilterKind::Cone, r, 0});
     HelmholtzFilter pde(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, r, 0});
     for (int m : {2, 4}) {
@@ -108,12 +109,12 @@ TEST(HelmholtzFilter, NonDesignElementsNeitherGiveNorTake) {
 }
 
 TEST(HelmholtzFilter, ItsMatrixDoesNotGrowWithTheRadius) {
-  const Box b = box(12, 0.5);
+  const Box b = box(12, 1);
   HelmholtzFilter small(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 1.0, 0});
   HelmholtzFilter large(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 6.0, 0});
   EXPECT_EQ(small.describe().substr(small.describe().find(" mm,")), large.describe().substr(large.describe().find(" mm,")));
-  DensityFilter explicit_large(b.mesh, b.design, b.volume, {FilterKind::Cone, 6.0, 0});
-  EXPECT_GT(explicit_large.mean_neighbours(), 500);  // what the PDE filter does not hold
+  DensityFilter explicit_large(b.mesh, b.design, b.volume, {FilterKind::Cone, 4.0, 0});
+  EXPECT_GT(explicit_large.mean_neighbours(), 300);  // what the PDE filter does not hold
 }
 
 TEST(FilterChoice, AutoTakesTheHelmholtzFilterWhenTheExplicitOneIsDenseOrTooLarge) {

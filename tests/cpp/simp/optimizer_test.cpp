@@ -10,6 +10,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "mesh/core/structured_box.h"
+#include "simp/density_filter.h"
 #include "simp/update.h"
 
 namespace topopt::simp {
