@@ -112,8 +112,9 @@ simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& 
   p.kind = simp::choose_filter_kind(requested.kind, automatic, pairs, static_cast<double>(design), budget);
   if (p.kind == simp::FilterKind::Helmholtz) {
     check_filter_radius(mesh, p.radius, given, 0);  // the radius against the part only
+    p.like_gaussian = automatic;
     if (automatic && note)
-      *note = "filter: the Helmholtz (PDE) filter, as the explicit one would hold " + number(pairs) +
+      *note = "filter: the Helmholtz (PDE) filter in place of the Gaussian one, which would hold " + number(pairs) +
               " neighbour pairs (" + number(pairs / std::max<long>(1, design)) + " per element)";
   } else {
     check_filter_radius(mesh, p.radius, given, memory_bytes);

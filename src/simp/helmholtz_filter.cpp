@@ -44,7 +44,9 @@ Eigen::Matrix4d element_matrix(const Eigen::Matrix<double, 4, 3>& p, double leng
 
 HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
                                  const FilterParams& params, const Progress& progress)
-    : length_(params.radius / (2.0 * std::sqrt(3.0))), threads_(thread_count(params.threads)), progress_(progress) {
+    : length_(helmholtz_length(params.radius, params.like_gaussian)),
+      threads_(thread_count(params.threads)),
+      progress_(progress) {
   if (!(params.radius > 0) || !std::isfinite(params.radius))
     throw Error(ErrorCode::InvalidParameter, "the Helmholtz filter needs a positive, finite radius (mm)");
   volume_.resize(static_cast<long>(design.size()));
@@ -91,7 +93,8 @@ void HelmholtzFilter::assemble(const TetMesh& mesh, const std::vector<int>& desi
       const int row = element_nodes_[4 * i + a];
       const int* begin = A_.col.data() + A_.ptr[row];
       const int* end = A_.col.data() + A_.ptr[row + 1];
-      for (int b = 0; b < 4; ++b) A_.val[std::lower_bound(begin, end, element_nodes_[4 * i + b]) - A_.col.data()] += Ae(a, b);
+      for (int b = 0; b < 4; ++b)
+        A_.val[std::lower_bound(begin, end, element_nodes_[4 * i + b]) - A_.col.data()] += Ae(a, b);
     }
   }
   inverse_diagonal_.resize(n);

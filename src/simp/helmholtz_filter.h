@@ -6,8 +6,8 @@
 // K the stiffness (Laplacian) and M the consistent mass of the design tets, T x the load of
 // the element densities (each element gives V_e/4 to its nodes). Since M 1 = T 1 and K 1 = 0,
 // constants pass unchanged. The boundary condition keeps the non-design solids out (they
-// neither give nor take, as with the explicit filter). ℓ = r/(2√3) for the user's radius r
-// (Lazarov & Sigmund's match to the cone of radius r).
+// neither give nor take, as with the explicit filter). ℓ from the user's radius r by
+// helmholtz_length (filter.h).
 //
 // Memory is linear in the mesh (about 15 matrix entries per node) whatever the radius: the
 // explicit filter holds every pair of elements within r, which at a 2 mm radius on a fine
@@ -26,8 +26,8 @@ namespace topopt::simp {
 class HelmholtzFilter final : public Filter {
  public:
   /// mesh, design (#D), volume (#T): as make_filter; params.radius > 0 (mm).
-  HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                  const FilterParams& params, const Progress& progress = {});
+  HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params,
+                  const Progress& progress = {});
 
   VecXd apply(const VecXd& x) const override;
   VecXd apply_transpose(const VecXd& g) const override;
@@ -43,7 +43,7 @@ class HelmholtzFilter final : public Filter {
  private:
   void assemble(const TetMesh& mesh, const std::vector<int>& design);
   VecXd nodal_load(const VecXd& per_element) const;  // Σ over each node's elements of value/4
-  VecXd element_mean(const VecXd& nodal) const;       // each element's mean of its four nodes
+  VecXd element_mean(const VecXd& nodal) const;      // each element's mean of its four nodes
   VecXd solve(const VecXd& b, VecXd& warm) const;
 
   double length_ = 0;

@@ -112,7 +112,8 @@ TEST(HelmholtzFilter, ItsMatrixDoesNotGrowWithTheRadius) {
   const Box b = box(12, 1);
   HelmholtzFilter small(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 1.0, 0});
   HelmholtzFilter large(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 6.0, 0});
-  EXPECT_EQ(small.describe().substr(small.describe().find(" mm,")), large.describe().substr(large.describe().find(" mm,")));
+  EXPECT_EQ(small.describe().substr(small.describe().find(" mm,")),
+            large.describe().substr(large.describe().find(" mm,")));
   DensityFilter explicit_large(b.mesh, b.design, b.volume, {FilterKind::Cone, 4.0, 0});
   EXPECT_GT(explicit_large.mean_neighbours(), 300);  // what the PDE filter does not hold
 }
