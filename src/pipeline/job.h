@@ -19,6 +19,7 @@ namespace topopt::pipeline {
 /// The "optimization" section (docs/optimization.md).
 struct OptimizeSettings {
   simp::SimpParams simp;  ///< the solver's tolerance 1e-5 unless given
+  bool filter_automatic = true;  ///< "filter": "auto" (the default): chosen_filter decides the kind
   double threshold = -1;  ///< iso-value of the result shape; < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
   result::HygieneParams hygiene;  ///< loose pieces out, closed voids filled (fill_voids)

@@ -74,8 +74,11 @@ OptimizeSettings parse_optimization(const json& section) {
   if (!(p.law.penalty >= 1 && p.law.penalty <= 10)) f.bad("penalty", "must lie in [1, 10] (3 is usual)");
   p.law.e_min = f.number("emin", 1e-9);
   if (!(p.law.e_min > 0 && p.law.e_min < 0.1)) f.bad("emin", "must lie in (0, 0.1)");
-  p.filter.kind = f.choice("filter", "gaussian", {"gaussian", "cone"}) == "cone" ? simp::FilterKind::Cone
-                                                                                 : simp::FilterKind::Gaussian;
+  const std::string filter = f.choice("filter", "auto", {"auto", "gaussian", "cone", "helmholtz"});
+  s.filter_automatic = filter == "auto";
+  p.filter.kind = filter == "cone"        ? simp::FilterKind::Cone
+                  : filter == "helmholtz" ? simp::FilterKind::Helmholtz
+                                          : simp::FilterKind::Gaussian;
   p.filter.radius = f.number("filter_radius", 0);
   if (p.filter.radius < 0) f.bad("filter_radius", "must be positive (mm), or 0 for 1.5 x the mean edge length");
   p.sensitivity_filter = f.boolean("sensitivity_filter", false);

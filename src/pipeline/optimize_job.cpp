@@ -107,13 +107,15 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // the weight of the design tets follows their density (gravity_of below)
   const Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases);
   check_loads_reach_the_part(loads, supports, job.load_cases);
-  check_filter_radius(mesh, simp::filter_radius(mesh, set.simp.filter), set.simp.filter.radius > 0,
-                      physical_memory_bytes());
+  simp::SimpParams simp = set.simp;
+  std::string filter_note;
+  simp.filter = chosen_filter(mesh, set.simp.filter, set.filter_automatic, physical_memory_bytes(), &filter_note);
+  if (!filter_note.empty()) progress.info(filter_note);
   std::vector<double> weights;
   for (const auto& lc : job.load_cases) weights.push_back(lc.weight);
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, set.simp, progress, on_iteration,
+  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, simp, progress, on_iteration,
                           fem::gravity_of(job.load_cases));
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");

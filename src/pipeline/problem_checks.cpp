@@ -9,13 +9,14 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "simp/optimizer.h"
 
 namespace topopt::pipeline {
 namespace {
 
-/// Bytes per filter pair while DensityFilter is built: its neighbour lists (16), two triplet
-/// lists (32), two sparse matrices (24) and a sparse matrix's temporary (12), rounded up.
-constexpr double kBytesPerPair = 90;
+/// Bytes per filter pair of the explicit filter: its one sparse matrix's column index and
+/// value (12), rounded up for the per-thread scratch while it is built.
+constexpr double kBytesPerPair = 16;
 
 /// A figure as a user reads it: 3 significant digits, no exponent below a million.
 std::string number(double v) {
@@ -92,10 +93,33 @@ void check_filter_radius(const TetMesh& mesh, double radius, bool given, double 
   const std::string need = "the density filter of radius " + number(radius) + " mm would hold about " + number(pairs) +
                            " neighbour pairs (" + number(pairs * kBytesPerPair / 1e9) +
                            " GB), more than this machine's memory allows: ";
+  const std::string pde = ", or \"filter\": \"helmholtz\" (its memory does not grow with the radius)";
   if (given)
     throw Error(ErrorCode::TooLarge,
-                need + "give 'optimization.filter_radius' at most " + number(radius * fits / bins) + " mm");
-  throw Error(ErrorCode::TooLarge, need + "use a coarser mesh size (the automatic radius is 1.5 mean edges)");
+                need + "give 'optimization.filter_radius' at most " + number(radius * fits / bins) + " mm" + pde);
+  throw Error(ErrorCode::TooLarge, need + "use a coarser mesh size (the automatic radius is 1.5 mean edges)" + pde);
+}
+
+simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& requested, bool automatic,
+                                 double memory_bytes, std::string* note) {
+  simp::FilterParams p = requested;
+  p.radius = simp::filter_radius(mesh, requested);
+  const bool given = requested.radius > 0;
+  long design = 0;
+  for (long t = 0; t < mesh.T.rows(); ++t) design += mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0;
+  const double pairs = estimated_filter_pairs(mesh, p.radius);
+  const double budget = memory_bytes > 0 ? 0.5 * memory_bytes / kBytesPerPair : 1e300;
+  p.kind = simp::choose_filter_kind(requested.kind, automatic, pairs, static_cast<double>(design), budget);
+  if (p.kind == simp::FilterKind::Helmholtz) {
+    check_filter_radius(mesh, p.radius, given, 0);  // the radius against the part only
+    p.like_gaussian = automatic;
+    if (automatic && note)
+      *note = "filter: the Helmholtz (PDE) filter in place of the Gaussian one, which would hold " + number(pairs) +
+              " neighbour pairs (" + number(pairs / std::max<long>(1, design)) + " per element)";
+  } else {
+    check_filter_radius(mesh, p.radius, given, memory_bytes);
+  }
+  return p;
 }
 
 double physical_memory_bytes() {

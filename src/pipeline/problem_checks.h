@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/types.h"
+#include "simp/filter.h"
 #include "fem/boundary_conditions.h"
 
 namespace topopt::pipeline {
@@ -31,6 +32,14 @@ std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int 
 /// while the filter is built); both name the largest radius to use, or a coarser mesh when
 /// the radius was the automatic one.
 void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes);
+
+/// The filter a job runs with (radius resolved): the kind it names, or for "auto" (automatic)
+/// simp::choose_filter_kind's choice from the estimated neighbour pairs and half of
+/// `memory_bytes`. An explicit kind is checked by check_filter_radius; the Helmholtz filter
+/// only for a radius beyond the part. `note` (may be null) gets a line saying what was chosen
+/// and why when "auto" chose the Helmholtz filter.
+simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& requested, bool automatic,
+                                 double memory_bytes, std::string* note);
 
 /// The machine's physical memory in bytes (0 when unknown: no memory check).
 double physical_memory_bytes();

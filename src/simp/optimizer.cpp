@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "simp/density_filter.h"
 #include "simp/update.h"
 
 namespace topopt::simp {
@@ -61,9 +62,8 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   design_volume_ = vd_.sum();
   FilterParams fp = params.filter;
   fp.radius = filter_radius(mesh, fp);
-  filter_ = std::make_unique<DensityFilter>(mesh, design_, volume, fp);
-  progress.info("filter: radius " + std::to_string(fp.radius) + " mm, " + std::to_string(filter_->mean_neighbours()) +
-                " neighbours per element");
+  filter_ = make_filter(mesh, design_, volume, fp, progress);
+  progress.info("filter: " + filter_->describe());
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())

@@ -11,7 +11,7 @@
 #include "common/types.h"
 #include "fem/elasticity.h"
 #include "simp/continuation.h"
-#include "simp/density_filter.h"
+#include "simp/filter.h"
 #include "simp/simp_law.h"
 
 namespace topopt::simp {
@@ -85,7 +85,7 @@ class ComplianceProblem {
   VecXd vd_;
   VecXd volume_weights_;  // without projection the volume is linear in x: w·x
   double design_volume_ = 0;
-  std::unique_ptr<DensityFilter> filter_;
+  std::unique_ptr<Filter> filter_;
   std::unique_ptr<fem::Elasticity> fe_;
   Eigen::MatrixXd loads_;     // as given: with every tet's full weight
   Eigen::Matrix3Xd gravity_;  // 3 x #cases, empty without self-weight

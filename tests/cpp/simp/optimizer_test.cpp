@@ -10,6 +10,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "mesh/core/structured_box.h"
+#include "simp/density_filter.h"
 #include "simp/update.h"
 
 namespace topopt::simp {
@@ -72,6 +73,8 @@ TEST(Simp, ComplianceGradientMatchesFiniteDifferencesThroughTheFilter) {
   check_gradient(p, 1);
   p.filter.kind = FilterKind::Cone;
   check_gradient(p, 2);
+  p.filter.kind = FilterKind::Helmholtz;
+  check_gradient(p, 3);
 }
 
 TEST(Simp, GradientWithSelfWeight) {

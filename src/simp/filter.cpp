@@ -1,0 +1,29 @@
+// make_filter: the one place that builds the filter kind the parameters name (see filter.h).
+#include "simp/filter.h"
+
+#include <cmath>
+
+#include "simp/density_filter.h"
+#include "simp/helmholtz_filter.h"
+
+namespace topopt::simp {
+
+double helmholtz_length(double radius, bool like_gaussian) {
+  return like_gaussian ? radius / (3.0 * std::sqrt(2.0)) : radius / (2.0 * std::sqrt(3.0));
+}
+
+FilterKind choose_filter_kind(FilterKind requested, bool automatic, double pairs, double design_elements,
+                              double pairs_budget) {
+  if (!automatic) return requested;
+  const bool dense = pairs > kHelmholtzAboveNeighbours * design_elements;
+  return dense || pairs > pairs_budget ? FilterKind::Helmholtz : FilterKind::Gaussian;
+}
+
+std::unique_ptr<Filter> make_filter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
+                                    const FilterParams& params, const Progress& progress) {
+  if (params.kind == FilterKind::Helmholtz && params.radius > 0)
+    return std::make_unique<HelmholtzFilter>(mesh, design, volume, params, progress);
+  return std::make_unique<DensityFilter>(mesh, design, volume, params);
+}
+
+}  // namespace topopt::simp

@@ -1,0 +1,130 @@
+// The Helmholtz (PDE) filter: constants pass, its transpose is its adjoint, it matches the
+// continuum solution of −ℓ²∇²ρ̃ + ρ̃ = x for a cosine field, it attenuates like the explicit
+// cone filter of the matching radius, non-design elements are left out, memory is linear.
+#include "simp/helmholtz_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mesh/core/structured_box.h"
+#include "simp/density_filter.h"
+
+namespace topopt::simp {
+namespace {
+
+struct Box {
+  TetMesh mesh;
+  std::vector<int> design;
+  VecXd volume;
+  MatX3d centre;
+};
+
+/// A box of `length` mm along z (and 4 × 4 mm across) in cells of about h mm, all design
+/// unless `pad` (the top 2 mm of z kept solid).
+Box box(double length, double h, bool pad = false) {
+  mesh::StructuredBoxParams p;
+  p.size = {4, 4, length};
+  p.cells = {static_cast<int>(std::lround(4 / h)), static_cast<int>(std::lround(4 / h)),
+             static_cast<int>(std::lround(length / h))};
+  if (pad) p.nondesign = {{0, 0, length - 2, 4, 4, length}};
+  Box b;
+  b.mesh = mesh::structured_box_mesh(p);
+  for (long t = 0; t < b.mesh.T.rows(); ++t)
+    if (b.mesh.domain[t] == 0) b.design.push_back(static_cast<int>(t));
+  b.volume = tet_volumes(b.mesh);
+  const MatX3d all = tet_centroids(b.mesh);
+  b.centre.resize(static_cast<long>(b.design.size()), 3);
+  for (size_t i = 0; i < b.design.size(); ++i) b.centre.row(static_cast<long>(i)) = all.row(b.design[i]);
+  return b;
+}
+
+/// The amplitude A of a filtered field ≈ A cos(k z) over the elements at least `margin` from
+/// both ends (least squares).
+double amplitude(const VecXd& field, const Box& b, double k, double length, double margin) {
+  double num = 0, den = 0;
+  for (long i = 0; i < field.size(); ++i) {
+    const double z = b.centre(i, 2);
+    if (z < margin || z > length - margin) continue;
+    num += field[i] * std::cos(k * z), den += std::cos(k * z) * std::cos(k * z);
+  }
+  return num / den;
+}
+
+TEST(HelmholtzFilter, PassesConstantsAndItsTransposeIsItsAdjoint) {
+  const Box b = box(12, 1, true);
+  HelmholtzFilter f(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 3.0, 0});
+  const VecXd ones = VecXd::Ones(static_cast<long>(b.design.size()));
+  EXPECT_LT((f.apply(ones) - ones).cwiseAbs().maxCoeff(), 1e-8);
+  const VecXd x = VecXd::Random(ones.size()), y = VecXd::Random(ones.size());
+  const VecXd fx = f.apply(x);
+  EXPECT_GT(f.last_iterations(), 0);
+  EXPECT_NEAR(fx.dot(y), x.dot(f.apply_transpose(y)), 1e-10 * std::abs(fx.dot(y)) + 1e-12);
+  EXPECT_NEAR(f.length(), 3.0 / (2 * std::sqrt(3.0)), 1e-12);
+}
+
+TEST(HelmholtzFilter, MatchesTheContinuumSolutionForACosine) {
+  // cos(k z) with k = mπ/L meets the zero-flux condition at z = 0 and z = L, so the filtered
+  // field of the continuum is cos(k z) / (1 + ℓ²k²) exactly; linear tets are O(h²) from it
+  const double length = 20, h = 0.5;
+  const Box b = box(length, h);
+  const double k = 2 * M_PI / length;
+  VecXd x(static_cast<long>(b.design.size()));
+  for (long i = 0; i < x.size(); ++i) x[i] = std::cos(k * b.centre(i, 2));
+  for (double r : {2.0, 5.0, 10.0}) {
+    HelmholtzFilter f(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, r, 0});
+    const double exact = 1 / (1 + f.length() * f.length() * k * k);
+    const VecXd y = f.apply(x);
+    EXPECT_NEAR(amplitude(y, b, k, length, 0), exact, 0.01 * exact) << "radius " << r;
+    for (long i = 0; i < y.size(); ++i) ASSERT_NEAR(y[i], exact * std::cos(k * b.centre(i, 2)), 0.02) << i;
+  }
+}
+
+TEST(HelmholtzFilter, AttenuatesLikeTheConeFilterOfTheSameRadius) {
+  // Lazarov & Sigmund's match ℓ = r/(2√3): the amplitude left of a cosine of wavelength
+  // 4r ... 10r by the two filters, away from the ends (where the explicit filter is cut)
+  const double length = 24, h = 1;
+  const Box b = box(length, h);
+  for (double r : {2.0, 3.0}) {
+    DensityFilter cone(b.mesh, b.design, b.volume, {FilterKind::Cone, r, 0});
+    HelmholtzFilter pde(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, r, 0});
+    for (int m : {2, 4}) {
+      const double k = m * M_PI / length;
+      VecXd x(static_cast<long>(b.design.size()));
+      for (long i = 0; i < x.size(); ++i) x[i] = std::cos(k * b.centre(i, 2));
+      const double a_cone = amplitude(cone.apply(x), b, k, length, r), a_pde = amplitude(pde.apply(x), b, k, length, r);
+      EXPECT_LT(a_pde, 1.0);
+      EXPECT_NEAR(a_pde, a_cone, 0.03) << "radius " << r << ", k " << k;
+    }
+  }
+}
+
+TEST(HelmholtzFilter, NonDesignElementsNeitherGiveNorTake) {
+  // a void design beside a solid pad stays void: the pad is not part of the equation
+  const Box b = box(12, 1, true);
+  HelmholtzFilter f(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 4.0, 0});
+  const VecXd zero = VecXd::Zero(static_cast<long>(b.design.size()));
+  EXPECT_EQ(f.apply(zero).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT(f.unknowns(), b.mesh.V.rows());  // the pad's own nodes are not unknowns
+}
+
+TEST(HelmholtzFilter, ItsMatrixDoesNotGrowWithTheRadius) {
+  const Box b = box(12, 1);
+  HelmholtzFilter small(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 1.0, 0});
+  HelmholtzFilter large(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 6.0, 0});
+  EXPECT_EQ(small.describe().substr(small.describe().find(" mm,")),
+            large.describe().substr(large.describe().find(" mm,")));
+  DensityFilter explicit_large(b.mesh, b.design, b.volume, {FilterKind::Cone, 4.0, 0});
+  EXPECT_GT(explicit_large.mean_neighbours(), 300);  // what the PDE filter does not hold
+}
+
+TEST(FilterChoice, AutoTakesTheHelmholtzFilterWhenTheExplicitOneIsDenseOrTooLarge) {
+  EXPECT_EQ(choose_filter_kind(FilterKind::Cone, false, 1e12, 1e3, 1e6), FilterKind::Cone);
+  EXPECT_EQ(choose_filter_kind(FilterKind::Gaussian, true, 50e3, 1e3, 1e9), FilterKind::Gaussian);
+  EXPECT_EQ(choose_filter_kind(FilterKind::Gaussian, true, 1e3 * (kHelmholtzAboveNeighbours + 1), 1e3, 1e9),
+            FilterKind::Helmholtz);
+  EXPECT_EQ(choose_filter_kind(FilterKind::Gaussian, true, 50e3, 1e3, 1e4), FilterKind::Helmholtz);
+}
+
+}  // namespace
+}  // namespace topopt::simp
