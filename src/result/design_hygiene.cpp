@@ -108,18 +108,26 @@ std::string at(const Point& x) {
   return s.str();
 }
 
-/// Sets piece c (labels #T) to void, and the design tets around it that are not solid either
-/// (their densities would otherwise hold a ghost of the piece in the node densities).
-void remove_piece(const TetMesh& mesh, const VecXi& label, int c, std::vector<char>& solid, VecXd& out) {
+/// Per tet (#T): whether it has a node on a tet labelled c (labels #T) — the piece itself and
+/// the tets around it.
+std::vector<char> touching_label(const TetMesh& mesh, const VecXi& label, int c) {
   std::vector<char> on_piece(mesh.V.rows(), 0);
   for (long t = 0; t < mesh.T.rows(); ++t)
     if (label[t] == c)
       for (int k = 0; k < 4; ++k) on_piece[mesh.T(t, k)] = 1;
+  std::vector<char> touches(mesh.T.rows(), 0);
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    for (int k = 0; k < 4; ++k) touches[t] |= on_piece[mesh.T(t, k)];
+  return touches;
+}
+
+/// Sets piece c (labels #T) to void, and the design tets around it that are not solid either
+/// (their densities would otherwise hold a ghost of the piece in the node densities).
+void remove_piece(const TetMesh& mesh, const VecXi& label, int c, std::vector<char>& solid, VecXd& out) {
+  const std::vector<char> touches = touching_label(mesh, label, c);
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (mesh.domain[t] != 0 || (solid[t] && label[t] != c)) continue;
-    bool touches = false;
-    for (int k = 0; k < 4; ++k) touches |= on_piece[mesh.T(t, k)] != 0;
-    if (touches) out[t] = 0, solid[t] = 0;
+    if (touches[t]) out[t] = 0, solid[t] = 0;
   }
 }
 
@@ -175,15 +183,9 @@ void remove_pieces(const TetMesh& mesh, const std::vector<char>& anchors, std::v
 /// (the solid tets of its wall may hold low densities that would leave a smaller cavity in
 /// the node densities).
 void fill_void(const TetMesh& mesh, const VecXi& label, int c, std::vector<char>& solid, VecXd& out) {
-  std::vector<char> on_void(mesh.V.rows(), 0);
+  const std::vector<char> touches = touching_label(mesh, label, c);
   for (long t = 0; t < mesh.T.rows(); ++t)
-    if (label[t] == c)
-      for (int k = 0; k < 4; ++k) on_void[mesh.T(t, k)] = 1;
-  for (long t = 0; t < mesh.T.rows(); ++t) {
-    bool touches = false;
-    for (int k = 0; k < 4; ++k) touches |= on_void[mesh.T(t, k)] != 0;
-    if (touches && mesh.domain[t] == 0) out[t] = 1, solid[t] = 1;
-  }
+    if (touches[t] && mesh.domain[t] == 0) out[t] = 1, solid[t] = 1;
 }
 
 /// Fills (or counts) the void pieces that touch no boundary face of the mesh.

@@ -502,6 +502,36 @@ std::vector<std::pair<double, size_t>> tets_below(const std::vector<Vec3>& P, co
 
 }  // namespace
 
+namespace {
+
+/// One sweep of cavity refills over the tets of `order` (worst first): each not yet touched
+/// and with no locked node gets the best refill (gain in radius ratio below `bad`) among its
+/// candidate cavities, and with `wide` the wider ones too. Returns the refills applied.
+long refill_sweep(TetSweep& s, std::vector<Tet>& tets, const std::vector<std::pair<double, size_t>>& order, double bad,
+                  bool wide) {
+  long done = 0;
+  for (const auto& [r0, t] : order) {
+    if (s.touched[t]) continue;
+    bool skip = false;
+    for (int x : tets[t]) skip |= s.locked[x] != 0;
+    if (skip) continue;
+    std::vector<std::vector<int>> options = candidate_cavities(s, static_cast<int>(t));
+    if (wide)
+      for (std::vector<int>& c : wide_cavities(s, static_cast<int>(t))) options.push_back(std::move(c));
+    CavityStar best;
+    for (std::vector<int>& cavity : options) {
+      CavityStar star = plan_refill_cavity(s, std::move(cavity), bad);
+      if (!star.empty() && star.gain > best.gain) best = std::move(star);
+    }
+    if (best.empty()) continue;
+    apply(s, best);
+    ++done;
+  }
+  return done;
+}
+
+}  // namespace
+
 long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floor, int sweeps,
                        const Progress& progress) {
   long done = 0;
@@ -511,22 +541,7 @@ long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floo
     const std::vector<std::pair<double, size_t>> order = tets_below(P, tets, floor);
     if (order.empty()) break;
     TetSweep s(P, tets);
-    for (const auto& [r0, t] : order) {
-      if (s.touched[t]) continue;
-      bool skip = false;
-      for (int x : tets[t]) skip |= s.locked[x] != 0;
-      if (skip) continue;
-      CavityStar best;
-      std::vector<std::vector<int>> options = candidate_cavities(s, static_cast<int>(t));
-      for (std::vector<int>& c : wide_cavities(s, static_cast<int>(t))) options.push_back(std::move(c));
-      for (std::vector<int>& cavity : options) {
-        CavityStar star = plan_refill_cavity(s, std::move(cavity), bad);
-        if (!star.empty() && star.gain > best.gain) best = std::move(star);
-      }
-      if (best.empty()) continue;
-      apply(s, best);
-      ++done;
-    }
+    done += refill_sweep(s, tets, order, bad, true);
     if (s.pending.empty()) break;
     s.end();
   }
@@ -538,27 +553,7 @@ long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, doub
   for (int sweep = 0; sweep < 3; ++sweep) {
     TetSweep s(P, tets);
     // worst first: a replacement locks its nodes for the rest of the sweep
-    std::vector<std::pair<double, size_t>> order;
-    for (size_t t = 0; t < tets.size(); ++t)
-      if (tets[t][0] >= 0) {
-        const double r = rho(P, tets[t]);
-        if (r < bad) order.push_back({r, t});
-      }
-    std::sort(order.begin(), order.end());
-    for (const auto& [r0, t] : order) {
-      if (s.touched[t]) continue;
-      bool skip = false;
-      for (int x : tets[t]) skip |= s.locked[x] != 0;
-      if (skip) continue;
-      CavityStar best;
-      for (std::vector<int>& cavity : candidate_cavities(s, static_cast<int>(t))) {
-        CavityStar star = plan_refill_cavity(s, std::move(cavity), bad);
-        if (!star.empty() && star.gain > best.gain) best = std::move(star);
-      }
-      if (best.empty()) continue;
-      apply(s, best);
-      ++done;
-    }
+    done += refill_sweep(s, tets, tets_below(P, tets, bad), bad, false);
     if (s.pending.empty()) break;
     s.end();
   }
