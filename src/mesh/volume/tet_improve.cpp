@@ -122,7 +122,7 @@ bool make_positive(const std::vector<Vec3>& P, Tet& t) {
 }
 
 /// The worst radius ratio of the tets `ts`, or -1 when one of them is not positive.
-double worst_positive(const std::vector<Vec3>& P, const std::vector<Tet>& tets, const NodeStars::Range& ts) {
+double worst_positive(const std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts) {
   double w = 1;
   for (int q : ts) {
     const Tet& x = tets[q];
@@ -135,11 +135,11 @@ double worst_positive(const std::vector<Vec3>& P, const std::vector<Tet>& tets, 
 }  // namespace
 
 TetSweep::TetSweep(std::vector<Vec3>& P_, std::vector<Tet>& tets_)
-    : P(P_), tets(tets_), stars(P_.size(), tets_), touched(tets_.size(), 0), locked(P_.size(), 0) {}
+    : P(P_), tets(tets_), stars(node_stars(P_.size(), tets_)), touched(tets_.size(), 0), locked(P_.size(), 0) {}
 
 void TetSweep::tets_with(int u, int w, int x, std::vector<int>& out) const {
   out.clear();
-  for (int t : stars.of(u))
+  for (int t : stars.row(u))
     if (has(tets[t], w) && (x < 0 || has(tets[t], x))) out.push_back(t);
 }
 
@@ -229,8 +229,8 @@ void apply(TetSweep& s, const TetReplacement& r) {
   for (int rt : r.old_tets) s.touched[rt] = 1;
 }
 
-NodeMove plan_smooth_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v) {
-  const NodeStars::Range ts = stars.of(v);
+NodeMove plan_smooth_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
+  const Adjacency::Row ts = stars.row(v);
   Vec3 sum = Vec3::Zero();
   int n = 0;
   double worst = 1;
@@ -249,8 +249,8 @@ NodeMove plan_smooth_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, co
   return m;
 }
 
-NodeMove plan_search_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v) {
-  const NodeStars::Range ts = stars.of(v);
+NodeMove plan_search_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
+  const Adjacency::Row ts = stars.row(v);
   double len = 0;
   int cnt = 0;
   for (int q : ts)
@@ -395,7 +395,7 @@ long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad) {
   return flips;
 }
 
-void smooth_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, const NodeStars& stars, int first_new,
+void smooth_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int first_new,
                   int iterations) {
   for (int it = 0; it < iterations; ++it)
     for (int v = first_new; v < static_cast<int>(P.size()); ++v) {
@@ -404,7 +404,7 @@ void smooth_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Node
     }
 }
 
-void search_nodes_of_bad_tets(std::vector<Vec3>& P, const std::vector<Tet>& tets, const NodeStars& stars, int first_new,
+void search_nodes_of_bad_tets(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int first_new,
                               double bad) {
   std::vector<char> seen(P.size(), 0);
   for (const Tet& t : tets) {
@@ -437,7 +437,7 @@ std::vector<std::vector<int>> candidate_cavities(const TetSweep& s, int t) {
     for (int c : layer)
       for (const auto& o : kTetFace) {  // the tets across c's faces
         const int a = s.tets[c][o[0]], b = s.tets[c][o[1]], d = s.tets[c][o[2]];
-        for (int q : s.stars.of(a))
+        for (int q : s.stars.row(a))
           if (q != c && has(s.tets[q], b) && has(s.tets[q], d)) more.push_back(q);
       }
     layer.insert(layer.end(), more.begin(), more.end());
@@ -463,13 +463,13 @@ std::vector<std::vector<int>> wide_cavities(const TetSweep& s, int t) {
     options.push_back(std::move(c));
   };
   for (int i = 0; i < 4; ++i) {
-    const NodeStars::Range star = s.stars.of(v[i]);
+    const Adjacency::Row star = s.stars.row(v[i]);
     add(std::vector<int>(star.begin(), star.end()));
   }
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j) {
-      std::vector<int> both(s.stars.of(v[i]).begin(), s.stars.of(v[i]).end());
-      both.insert(both.end(), s.stars.of(v[j]).begin(), s.stars.of(v[j]).end());
+      std::vector<int> both(s.stars.row(v[i]).begin(), s.stars.row(v[i]).end());
+      both.insert(both.end(), s.stars.row(v[j]).begin(), s.stars.row(v[j]).end());
       add(std::move(both));
     }
   std::vector<int> layer{t};
@@ -477,7 +477,7 @@ std::vector<std::vector<int>> wide_cavities(const TetSweep& s, int t) {
     for (int c : std::vector<int>(layer))
       for (const auto& o : kTetFace) {
         const int a = s.tets[c][o[0]], b = s.tets[c][o[1]], d = s.tets[c][o[2]];
-        for (int q : s.stars.of(a))
+        for (int q : s.stars.row(a))
           if (q != c && has(s.tets[q], b) && has(s.tets[q], d)) layer.push_back(q);
       }
     std::sort(layer.begin(), layer.end());
@@ -566,7 +566,7 @@ void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, c
     progress.check_cancel("volume meshing (quality)");
     if (params.flip_below > 0) flip_bad_tets(P, tets, params.flip_below);
     if (params.smoothing_iterations > 0 && static_cast<int>(P.size()) > first_new) {
-      const NodeStars stars(P.size(), tets);
+      const Adjacency stars = node_stars(P.size(), tets);
       smooth_nodes(P, tets, stars, first_new, params.smoothing_iterations);
       search_nodes_of_bad_tets(P, tets, stars, first_new, params.sliver_below);
     }
@@ -578,7 +578,7 @@ void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, c
     if (insert_points_at_slivers(P, tets, params.sliver_below) == 0) break;
     if (params.flip_below > 0) {
       flip_bad_tets(P, tets, params.sliver_below);
-      search_nodes_of_bad_tets(P, tets, NodeStars(P.size(), tets), first_new, params.sliver_below);
+      search_nodes_of_bad_tets(P, tets, node_stars(P.size(), tets), first_new, params.sliver_below);
     }
   }
   if (params.sliver_floor > 0) remove_tets_below(P, tets, params.sliver_floor, 4, progress);

@@ -35,7 +35,7 @@ struct TetSweep {
   TetSweep(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets);
   std::vector<Eigen::Vector3d>& P;
   std::vector<Tet>& tets;
-  const NodeStars stars;
+  const Adjacency stars;
   std::vector<char> touched;  ///< #T (grows): a tet rewritten, added or retired in this sweep
   std::vector<char> locked;   ///< #P at the start: a node of a changed tet; not used again
   std::vector<char> retired;  ///< per tet (sized by the first refill): removed by it, still readable
@@ -89,11 +89,11 @@ struct NodeMove {
 /// Smoothing (check-only): v to the centroid of the other nodes of its tets (each counted once
 /// per tet), when every tet around stays positive and the worst radius ratio around does not
 /// drop. stars: the current stars of tets.
-NodeMove plan_smooth_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v);
+NodeMove plan_smooth_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v);
 /// Compass search (check-only): steps of a tenth of v's mean edge along ±x, ±y, ±z while the
 /// worst radius ratio around v rises (halved when no direction helps, 40 tries), every tet
 /// staying positive; the best position found when it is better.
-NodeMove plan_search_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int v);
+NodeMove plan_search_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v);
 /// Makes move m (P[m.v] = m.to).
 void apply(std::vector<Eigen::Vector3d>& P, const NodeMove& m);
 
@@ -126,11 +126,11 @@ constexpr double kSliverShare = 0.25;
 /// once per sweep, up to 4 sweeps while any flip happens). Returns the number of changes.
 long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
 /// `iterations` sweeps of smooth_node over the nodes from first_new on.
-void smooth_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars, int first_new,
+void smooth_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int first_new,
                   int iterations);
 /// search_node on the nodes from first_new on of the tets below `bad`, each node once, in the
 /// order of the tets.
-void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const NodeStars& stars,
+void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars,
                               int first_new, double bad);
 /// Sliver removal by point insertion: each tet below `bad`, worst first, is taken out with the
 /// best of its candidate cavities (the tets around each of its edges, it with its face

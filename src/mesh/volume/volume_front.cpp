@@ -154,7 +154,7 @@ class FrontFill {
   /// The new tets around the stuck front's nodes, widened by one ring of nodes every third
   /// round, go back to the front.
   void reopen_stuck_region(int round) {
-    const NodeStars stars(P_.size(), tets_);
+    const Adjacency stars = node_stars(P_.size(), tets_);
     std::vector<char> in_region(P_.size(), 0);
     std::vector<int> region;
     for (int id : front_.alive_faces())
@@ -163,13 +163,13 @@ class FrontFill {
     for (int ring = 0; ring < (round - 1) / 3; ++ring) {
       const size_t n = region.size();
       for (size_t i = 0; i < n; ++i)
-        for (int t : stars.of(region[i]))
+        for (int t : stars.row(region[i]))
           for (int x : tets_[t])
             if (!in_region[x]) in_region[x] = 1, region.push_back(x);
     }
     std::vector<int> doomed;
     for (int v : region)
-      for (int t : stars.of(v)) doomed.push_back(t);
+      for (int t : stars.row(v)) doomed.push_back(t);
     std::sort(doomed.begin(), doomed.end());
     doomed.erase(std::unique(doomed.begin(), doomed.end()), doomed.end());
     for (int t : doomed) {

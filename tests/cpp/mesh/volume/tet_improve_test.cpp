@@ -178,7 +178,7 @@ struct DisplacedStar {
   std::vector<Tet> tets;
   Points P = octahedron_star({0.3, 0.2, 0.1}, tets);
   const Points P0 = P;
-  const NodeStars stars{P.size(), tets};
+  const Adjacency stars = node_stars(P.size(), tets);
 };
 
 TEST(TetImprove, SmoothNodeMovesToTheCentroidOfItsNeighbours) {
