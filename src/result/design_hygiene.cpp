@@ -9,6 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "common/adjacency.h"
 #include "common/face_key.h"
 #include "result/iso_surface.h"
 
@@ -251,17 +252,12 @@ std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, dou
   return solid;
 }
 
-VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count) {
-  const long nt = mesh.T.rows(), nv = mesh.V.rows();
-  // the masked tets around each node (compressed rows)
-  std::vector<int> start(nv + 1, 0), around;
-  for (long t = 0; t < nt; ++t)
-    for (int k = 0; k < 4 && mask[t]; ++k) ++start[mesh.T(t, k) + 1];
-  for (long v = 0; v < nv; ++v) start[v + 1] += start[v];
-  around.resize(start[nv]);
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (long t = 0; t < nt; ++t)
-    for (int k = 0; k < 4 && mask[t]; ++k) around[fill[mesh.T(t, k)]++] = static_cast<int>(t);
+namespace {
+
+/// Labels the masked tets (#T) by connected piece, 0 .. count-1 (unmasked: -1), by flood fill;
+/// each_neighbour(t, visit) calls visit(n) for the tets n next to tet t.
+template <class EachNeighbour>
+VecXi flood_labels(long nt, const std::vector<char>& mask, int& count, const EachNeighbour& each_neighbour) {
   VecXi label = VecXi::Constant(nt, -1);
   count = 0;
   std::vector<int> stack;
@@ -272,34 +268,35 @@ VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& c
     while (!stack.empty()) {
       const int t = stack.back();
       stack.pop_back();
-      for (int k = 0; k < 4; ++k)
-        for (int i = start[mesh.T(t, k)]; i < start[mesh.T(t, k) + 1]; ++i)
-          if (label[around[i]] < 0) label[around[i]] = count, stack.push_back(around[i]);
+      each_neighbour(t, [&](int n) {
+        if (mask[n] && label[n] < 0) label[n] = count, stack.push_back(n);
+      });
     }
     ++count;
   }
   return label;
 }
 
+}  // namespace
+
+VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count) {
+  // the masked tets around each node
+  const Adjacency around = group_pairs(static_cast<int>(mesh.V.rows()), [&](auto emit) {
+    for (long t = 0; t < mesh.T.rows(); ++t)
+      if (mask[t])
+        for (int k = 0; k < 4; ++k) emit(mesh.T(t, k), static_cast<int>(t));
+  });
+  return flood_labels(mesh.T.rows(), mask, count, [&](int t, const auto& visit) {
+    for (int k = 0; k < 4; ++k)
+      for (int n : around.row(mesh.T(t, k))) visit(n);
+  });
+}
+
 VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count) {
-  VecXi label = VecXi::Constant(neighbours.rows(), -1);
-  count = 0;
-  std::vector<int> stack;
-  for (long s = 0; s < neighbours.rows(); ++s) {
-    if (!mask[s] || label[s] >= 0) continue;
-    label[s] = count;
-    stack.assign(1, static_cast<int>(s));
-    while (!stack.empty()) {
-      const int t = stack.back();
-      stack.pop_back();
-      for (int k = 0; k < 4; ++k) {
-        const int n = neighbours(t, k);
-        if (n >= 0 && mask[n] && label[n] < 0) label[n] = count, stack.push_back(n);
-      }
-    }
-    ++count;
-  }
-  return label;
+  return flood_labels(neighbours.rows(), mask, count, [&](int t, const auto& visit) {
+    for (int k = 0; k < 4; ++k)
+      if (neighbours(t, k) >= 0) visit(neighbours(t, k));
+  });
 }
 
 double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std::vector<char>& solid,
