@@ -149,4 +149,13 @@ VecXd values_arg(const pyb::handle& value, const char* name, long expected, cons
   return values;
 }
 
+TetMesh tet_mesh_arg(const pyb::handle& nodes, const pyb::handle& tets, const pyb::handle& domain) {
+  TetMesh mesh;
+  mesh.V = points_arg(nodes, "nodes", "#V");
+  mesh.T = index_arg<4>(tets, "tets", mesh.V.rows(), "nodes");
+  mesh.domain = tags_arg(domain, "domain", mesh.T.rows(), "tet", 0, true);
+  if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+  return mesh;
+}
+
 }  // namespace topopt::py

@@ -40,4 +40,8 @@ VecXi tags_arg(const pybind11::handle& value, const char* name, long expected, c
 /// (NaN and infinities named as such).
 VecXd values_arg(const pybind11::handle& value, const char* name, long expected, const char* per, double lo, double hi);
 
+/// A tet mesh from the arguments "nodes" (#V by 3), "tets" (#T by 4 indices into nodes) and
+/// "domain" (#T tags >= 0; None or empty: every tet design), each checked as above.
+TetMesh tet_mesh_arg(const pybind11::handle& nodes, const pybind11::handle& tets, const pybind11::handle& domain);
+
 }  // namespace topopt::py

@@ -27,11 +27,7 @@ void bind_extract_surface(pyb::module_& m) {
       [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
          const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fraction_arg,
          const pyb::object& smoothing_arg) {
-        TetMesh mesh;
-        mesh.V = points_arg(nodes_arg, "nodes", "#V");
-        mesh.T = index_arg<4>(tets_arg, "tets", mesh.V.rows(), "nodes");
-        mesh.domain = tags_arg(domain_arg, "domain", mesh.T.rows(), "tet", 0, true);
-        if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+        const TetMesh mesh = tet_mesh_arg(nodes_arg, tets_arg, domain_arg);
         const double any = std::numeric_limits<double>::max();  // densities stored by FreeCAD may pass 1 by rounding
         const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
         const double threshold = number_arg(threshold_arg, "threshold", -any, any);
@@ -62,11 +58,7 @@ void bind_design_report(pyb::module_& m) {
       "design_report",
       [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
          const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fill_voids_arg) {
-        TetMesh mesh;
-        mesh.V = points_arg(nodes_arg, "nodes", "#V");
-        mesh.T = index_arg<4>(tets_arg, "tets", mesh.V.rows(), "nodes");
-        mesh.domain = tags_arg(domain_arg, "domain", mesh.T.rows(), "tet", 0, true);
-        if (mesh.domain.size() == 0) mesh.domain = VecXi::Zero(mesh.T.rows());
+        const TetMesh mesh = tet_mesh_arg(nodes_arg, tets_arg, domain_arg);
         const double any = std::numeric_limits<double>::max();
         const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
         const double threshold = number_arg(threshold_arg, "threshold", 0, 1);

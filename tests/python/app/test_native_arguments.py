@@ -73,6 +73,20 @@ class Arguments(unittest.TestCase):
             self.refused("tets[3, 2] = %d but there are 8 nodes (indices 0 to 7)" % value, native.extract_surface,
                          self.nodes, self.with_tet_index(value), self.domain, self.dens, 0.5)
 
+    def test_design_report(self):
+        # the whole cube solid: one piece, no void, nothing to warn about; bad arguments refused
+        report = native.design_report(self.nodes, self.tets, self.domain, self.dens, 0.5)
+        self.assertEqual(report["pieces"], 1)
+        self.assertEqual(report["voids_filled"], 0)
+        self.assertEqual(report["warnings"], [])
+        for value in (9999, -1):
+            self.refused("tets[3, 2] = %d but there are 8 nodes (indices 0 to 7)" % value, native.design_report,
+                         self.nodes, self.with_tet_index(value), self.domain, self.dens, 0.5)
+        self.refused("the threshold must lie strictly between 0 and 1", native.design_report, self.nodes, self.tets,
+                     self.domain, self.dens, 1.0)
+        self.refused("fill_voids must be True or False", native.design_report, self.nodes, self.tets, self.domain,
+                     self.dens, 0.5, fill_voids="yes")
+
     def test_solve_indices(self):
         r = native.solve(self.nodes, self.tets, self.tris, self.faces, self.domain, JOB)
         self.assertGreater(r["compliance"][0], 0)
