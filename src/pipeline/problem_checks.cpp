@@ -74,7 +74,15 @@ std::vector<double> filter_pairs_within(const TetMesh& mesh, double radius, int 
 
 double estimated_filter_pairs(const TetMesh& mesh, double radius) { return filter_pairs_within(mesh, radius, 1)[0]; }
 
-void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes) {
+namespace {
+
+/// Bins of the radius in which the filter's pairs are counted (filter_pairs_within).
+constexpr int kRadiusBins = 200;
+
+/// The neighbour pairs an explicit filter may hold: half of `memory_bytes` (unknown: no limit).
+double pairs_budget(double memory_bytes) { return memory_bytes > 0 ? 0.5 * memory_bytes / kBytesPerPair : 1e300; }
+
+void check_radius_within_part(const TetMesh& mesh, double radius, bool given) {
   const Eigen::RowVector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
   const double diagonal = (hi - lo).norm();
   if (given && radius > diagonal)
@@ -82,22 +90,31 @@ void check_filter_radius(const TetMesh& mesh, double radius, bool given, double 
                 "job file: 'optimization.filter_radius' (" + number(radius) + " mm) is larger than the part (its " +
                     "diagonal is " + number(diagonal) + " mm), so the filter would blur the whole design into one " +
                     "grey: give about twice the mesh size, or the thinnest member you want");
-  if (!(memory_bytes > 0)) return;
-  const int bins = 200;
-  const std::vector<double> within = filter_pairs_within(mesh, radius, bins);
+}
+
+/// Throws TooLarge when the pairs within the radius (`within`: filter_pairs_within with
+/// kRadiusBins) exceed `budget`, naming the largest radius that fits or a coarser mesh.
+void check_filter_memory(const std::vector<double>& within, double radius, bool given, double budget) {
   const double pairs = within.back();
-  const double budget = 0.5 * memory_bytes / kBytesPerPair;
   if (pairs <= budget) return;
   int fits = 0;  // the largest radius k/bins * radius whose pairs fit
-  while (fits < bins && within[fits] <= budget) ++fits;
+  while (fits < kRadiusBins && within[fits] <= budget) ++fits;
   const std::string need = "the density filter of radius " + number(radius) + " mm would hold about " + number(pairs) +
                            " neighbour pairs (" + number(pairs * kBytesPerPair / 1e9) +
                            " GB), more than this machine's memory allows: ";
   const std::string pde = ", or \"filter\": \"helmholtz\" (its memory does not grow with the radius)";
   if (given)
-    throw Error(ErrorCode::TooLarge,
-                need + "give 'optimization.filter_radius' at most " + number(radius * fits / bins) + " mm" + pde);
+    throw Error(ErrorCode::TooLarge, need + "give 'optimization.filter_radius' at most " +
+                                         number(radius * fits / kRadiusBins) + " mm" + pde);
   throw Error(ErrorCode::TooLarge, need + "use a coarser mesh size (the automatic radius is 1.5 mean edges)" + pde);
+}
+
+}  // namespace
+
+void check_filter_radius(const TetMesh& mesh, double radius, bool given, double memory_bytes) {
+  check_radius_within_part(mesh, radius, given);
+  if (!(memory_bytes > 0)) return;
+  check_filter_memory(filter_pairs_within(mesh, radius, kRadiusBins), radius, given, pairs_budget(memory_bytes));
 }
 
 simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& requested, bool automatic,
@@ -105,19 +122,20 @@ simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& 
   simp::FilterParams p = requested;
   p.radius = simp::filter_radius(mesh, requested);
   const bool given = requested.radius > 0;
+  check_radius_within_part(mesh, p.radius, given);
   long design = 0;
   for (long t = 0; t < mesh.T.rows(); ++t) design += mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0;
-  const double pairs = estimated_filter_pairs(mesh, p.radius);
-  const double budget = memory_bytes > 0 ? 0.5 * memory_bytes / kBytesPerPair : 1e300;
+  // counted once: the pairs decide the kind and, for an explicit filter, its memory check
+  const std::vector<double> within = filter_pairs_within(mesh, p.radius, kRadiusBins);
+  const double pairs = within.back(), budget = pairs_budget(memory_bytes);
   p.kind = simp::choose_filter_kind(requested.kind, automatic, pairs, static_cast<double>(design), budget);
-  if (p.kind == simp::FilterKind::Helmholtz) {
-    check_filter_radius(mesh, p.radius, given, 0);  // the radius against the part only
+  if (p.kind != simp::FilterKind::Helmholtz) {
+    check_filter_memory(within, p.radius, given, budget);
+  } else {
     p.like_gaussian = automatic;
     if (automatic && note)
       *note = "filter: the Helmholtz (PDE) filter in place of the Gaussian one, which would hold " + number(pairs) +
               " neighbour pairs (" + number(pairs / std::max<long>(1, design)) + " per element)";
-  } else {
-    check_filter_radius(mesh, p.radius, given, memory_bytes);
   }
   return p;
 }
