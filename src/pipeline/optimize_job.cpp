@@ -117,6 +117,7 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   const auto t0 = std::chrono::steady_clock::now();
   r.simp = simp::optimize(mesh, job.material, supports, loads, weights, simp, progress, on_iteration,
                           fem::gravity_of(job.load_cases));
+  if (const std::string w = not_crisp_warning(r.simp, simp); !w.empty()) progress.warn(w);
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
   r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold,

@@ -145,4 +145,20 @@ double physical_memory_bytes() {
   return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
 }
 
+std::string not_crisp_warning(const simp::SimpResult& result, const simp::SimpParams& params) {
+  if (result.converged || result.history.empty()) return {};
+  const simp::IterationRecord& last = result.history.back();
+  const bool short_of_beta = params.projection.enabled && last.beta < params.projection.beta_max;
+  const double grey_limit = 0.03;  // issue 19: a crisp design has at most 3 % grey volume
+  if (!short_of_beta && last.grey <= grey_limit) return {};
+  std::ostringstream m;
+  m << std::setprecision(3) << "the optimisation stopped at its iteration cap (" << params.max_iterations
+    << ") before the design was crisp: ";
+  if (short_of_beta) m << "the projection reached β = " << last.beta << " of " << params.projection.beta_max << ", ";
+  m << 100 * last.grey << " % of the design volume is grey (0.1 < ρ < 0.9); the result surface cuts through "
+    << "material the optimiser had not decided on. Raise 'optimization.max_iterations' (MaxIterations in the "
+    << "study) and run again";
+  return m.str();
+}
+
 }  // namespace topopt::pipeline

@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "common/types.h"
-#include "simp/filter.h"
 #include "fem/boundary_conditions.h"
+#include "simp/filter.h"
+#include "simp/optimizer.h"
 
 namespace topopt::pipeline {
 
@@ -43,5 +44,11 @@ simp::FilterParams chosen_filter(const TetMesh& mesh, const simp::FilterParams& 
 
 /// The machine's physical memory in bytes (0 when unknown: no memory check).
 double physical_memory_bytes();
+
+/// After SIMP: a warning (empty when none) when the run stopped at its iteration cap before
+/// the design was crisp — the projection short of its final β, or more than 3 % of the design
+/// volume grey in the last iteration — naming both figures and the key to raise
+/// ('optimization.max_iterations', the study's MaxIterations in FreeCAD).
+std::string not_crisp_warning(const simp::SimpResult& result, const simp::SimpParams& params);
 
 }  // namespace topopt::pipeline

@@ -78,5 +78,31 @@ TEST(ProblemChecks, FilterRadiusLargerThanThePartOrThanMemory) {
   EXPECT_GT(physical_memory_bytes(), 1e8);
 }
 
+TEST(ProblemChecks, IterationCapBeforeTheDesignIsCrispIsNamed) {
+  const TetMesh m = beam();
+  const fem::Material mat;
+  const fem::Supports supports = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const Eigen::MatrixXd loads = fem::make_loads(m, mat, {force_on(2, {0, 0, -100})});
+  simp::SimpParams p;
+  p.max_iterations = 4;  // β starts at 1: four iterations cannot reach 32
+  simp::SimpResult capped = simp::optimize(m, mat, supports, loads, {}, p);
+  ASSERT_FALSE(capped.converged);
+  ASSERT_LT(capped.history.back().beta, p.projection.beta_max);
+  const std::string w = not_crisp_warning(capped, p);
+  for (const char* part :
+       {"iteration cap (4)", "of 32", "% of the design volume is grey", "'optimization.max_iterations'"})
+    EXPECT_NE(w.find(part), std::string::npos) << part << " missing from: " << w;
+  // a run that converged, or one at full β with little grey, is not warned about
+  simp::SimpResult settled = capped;
+  settled.converged = true;
+  EXPECT_EQ(not_crisp_warning(settled, p), "");
+  simp::SimpResult sharp = capped;
+  sharp.history.back().beta = p.projection.beta_max;
+  sharp.history.back().grey = 0.01;
+  EXPECT_EQ(not_crisp_warning(sharp, p), "");
+  sharp.history.back().grey = 0.2;  // at full β but still grey
+  EXPECT_NE(not_crisp_warning(sharp, p).find("20 % of the design volume is grey"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace topopt::pipeline
