@@ -11,22 +11,10 @@ element is what simp::kHelmholtzAboveNeighbours is set from.
 usage: bench/simp/filters.py [--build build] [--size 1.0] [--iterations 15] [--radii 1.5,2.5,3.5,5]
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, re, resource, subprocess, sys, time
+import argparse, json, os, re, sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DATA = os.environ.get("TOPOPT_SHARED_DATA", os.path.join(ROOT, "..", "shared", "data"))
-
-
-def run(cmd, env=None):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode:
-        sys.exit(" ".join(cmd) + "\n" + p.stdout + p.stderr)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return p.stdout + p.stderr, cpu, wall, after.ru_maxrss / 1024.0
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from benchlib import DATA, ROOT, run  # noqa: E402
 
 
 def main():
