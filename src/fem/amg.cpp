@@ -110,22 +110,22 @@ std::vector<int> aggregate_nodes(const Adjacency& strong, const std::vector<int>
   return agg;
 }
 
-/// Orthonormalises the six rigid modes restricted to the m rows `rows` of one aggregate
-/// (modified Gram-Schmidt, twice for stability): B = Q R with Q's columns appended to `Q`
-/// (m values each) and R (kept by 6, row-major) appended to `R`. Modes that depend on the
-/// others on this aggregate (a lone node cannot tell rotations from translations) drop out.
-/// Returns kept, the number of columns of Q.
-int orthonormal_modes(const int* rows, int m, const std::vector<double>& modes, std::vector<double>& Q,
+/// Orthonormalises the k near-null modes (k <= kMaxModes) restricted to the m rows `rows` of
+/// one aggregate (modified Gram-Schmidt, twice for stability): B = Q R with Q's columns
+/// appended to `Q` (m values each) and R (kept by k, row-major) appended to `R`. Modes that
+/// depend on the others on this aggregate (a lone node cannot tell rotations from
+/// translations) drop out. Returns kept, the number of columns of Q.
+int orthonormal_modes(const int* rows, int m, int k, const std::vector<double>& modes, std::vector<double>& Q,
                       std::vector<double>& R) {
   Q.clear();
-  double Rm[6][6] = {};
+  double Rm[kMaxModes][kMaxModes] = {};
   std::vector<double> v(m);
   int kept = 0;
-  for (int j = 0; j < 6; ++j) {
+  for (int j = 0; j < k; ++j) {
     double norm0 = 0;
-    for (int i = 0; i < m; ++i) v[i] = modes[6 * rows[i] + j], norm0 += v[i] * v[i];
+    for (int i = 0; i < m; ++i) v[i] = modes[k * rows[i] + j], norm0 += v[i] * v[i];
     norm0 = std::sqrt(norm0);
-    double coef[6] = {};
+    double coef[kMaxModes] = {};
     for (int pass = 0; pass < 2; ++pass)
       for (int q = 0; q < kept; ++q) {
         double s = 0;
@@ -143,32 +143,32 @@ int orthonormal_modes(const int* rows, int m, const std::vector<double>& modes, 
       ++kept;
     }
   }
-  for (int q = 0; q < kept; ++q) R.insert(R.end(), Rm[q], Rm[q] + 6);
+  for (int q = 0; q < kept; ++q) R.insert(R.end(), Rm[q], Rm[q] + k);
   return kept;
 }
 
 /// The tentative prolongator Pt (rows by #coarse dofs): on each aggregate, the orthonormalised
-/// rigid modes (orthonormal_modes), one coarse dof per kept mode. `agg_rows`: the rows of each
-/// aggregate. Sets coarse_ptr (the coarse dofs of each aggregate, offsets) and coarse_modes
-/// (#coarse dofs by 6: the modes on the coarse level, R of each aggregate).
-CsrMatrix tentative_prolongator(const Adjacency& agg_rows, int rows, const std::vector<double>& modes,
+/// near-null modes (k of them, orthonormal_modes), one coarse dof per kept mode. `agg_rows`: the
+/// rows of each aggregate. Sets coarse_ptr (the coarse dofs of each aggregate, offsets) and
+/// coarse_modes (#coarse dofs by k: the modes on the coarse level, R of each aggregate).
+CsrMatrix tentative_prolongator(const Adjacency& agg_rows, int rows, int k, const std::vector<double>& modes,
                                 std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes) {
   coarse_ptr.assign(1, 0);
   coarse_modes.clear();
-  std::vector<int> pt_col(rows * 6, -1);  // up to 6 entries a row, row-major
-  std::vector<double> pt_val(rows * 6, 0.0);
+  std::vector<int> pt_col(static_cast<size_t>(rows) * k, -1);  // up to k entries a row, row-major
+  std::vector<double> pt_val(static_cast<size_t>(rows) * k, 0.0);
   std::vector<int> pt_count(rows, 0);
   std::vector<double> Q;
   for (int a = 0; a < agg_rows.rows(); ++a) {
     const int m = agg_rows.size(a);
     const int* arows = agg_rows.begin(a);
-    const int kept = orthonormal_modes(arows, m, modes, Q, coarse_modes);
+    const int kept = orthonormal_modes(arows, m, k, modes, Q, coarse_modes);
     const int c0 = coarse_ptr.back();
     for (int q = 0; q < kept; ++q)
       for (int i = 0; i < m; ++i) {
         const int r = arows[i];
-        pt_col[6 * r + pt_count[r]] = c0 + q;
-        pt_val[6 * r + pt_count[r]] = Q[q * m + i];
+        pt_col[static_cast<size_t>(k) * r + pt_count[r]] = c0 + q;
+        pt_val[static_cast<size_t>(k) * r + pt_count[r]] = Q[q * m + i];
         ++pt_count[r];
       }
     coarse_ptr.push_back(c0 + kept);
@@ -178,7 +178,9 @@ CsrMatrix tentative_prolongator(const Adjacency& agg_rows, int rows, const std::
   Pt.cols = coarse_ptr.back();
   Pt.ptr.assign(rows + 1, 0);
   for (int i = 0; i < rows; ++i) {
-    for (int k = 0; k < pt_count[i]; ++k) Pt.col.push_back(pt_col[6 * i + k]), Pt.val.push_back(pt_val[6 * i + k]);
+    for (int e = 0; e < pt_count[i]; ++e)
+      Pt.col.push_back(pt_col[static_cast<size_t>(k) * i + e]),
+          Pt.val.push_back(pt_val[static_cast<size_t>(k) * i + e]);
     Pt.ptr[i + 1] = static_cast<int>(Pt.col.size());
   }
   return Pt;
@@ -208,6 +210,7 @@ CsrMatrix smoothed_prolongator(const CsrMatrix& A, const CsrMatrix& Pt, const st
 struct SmoothedAggregationAmg::Impl {
   AmgParams params;
   int threads = 1;
+  int modes_count = 6;       // near-null modes per row: 6 rigid-body modes, 1 for a scalar problem
   std::deque<Level> levels;  // a deque: levels point at their own matrices
   Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> coarse;
   mutable Eigen::VectorXd coarse_b, coarse_x;
@@ -218,8 +221,8 @@ struct SmoothedAggregationAmg::Impl {
   void inverse_diagonal(Level& L) const;
   void factor_coarsest();
   /// The tentative prolongator Pt from level matrix A (rows grouped into nodes by node_ptr,
-  /// rigid modes `modes`, #rows by 6) to the next level, whose node offsets and modes it sets:
-  /// strength graph, aggregation, rigid modes orthonormalised per aggregate. Returns false if
+  /// near-null modes `modes`, #rows by `modes_count`) to the next level, whose node offsets and
+  /// modes it sets: strength graph, aggregation, modes orthonormalised per aggregate. Returns false if
   /// A does not coarsen any more (the next level would keep 80 % of the unknowns or more).
   bool coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
@@ -308,7 +311,7 @@ bool SmoothedAggregationAmg::Impl::coarsen(const CsrMatrix& A, const std::vector
       if (agg[k] >= 0)
         for (int i = node_ptr[k]; i < node_ptr[k + 1]; ++i) emit(agg[k], i);
   });
-  Pt = tentative_prolongator(agg_rows, A.rows, modes, coarse_ptr, coarse_modes);
+  Pt = tentative_prolongator(agg_rows, A.rows, modes_count, modes, coarse_ptr, coarse_modes);
   return Pt.cols > 0 && Pt.cols < A.rows * 0.8;
 }
 
@@ -370,17 +373,19 @@ SmoothedAggregationAmg::SmoothedAggregationAmg(SmoothedAggregationAmg&&) noexcep
 SmoothedAggregationAmg& SmoothedAggregationAmg::operator=(SmoothedAggregationAmg&&) noexcept = default;
 
 void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& node_ptr,
-                                   const std::vector<double>& rigid_modes, const AmgParams& params) {
+                                   const std::vector<double>& near_null, const AmgParams& params) {
   Impl& m = *impl_;
   m.params = params;
   m.threads = thread_count(params.threads);
-  if (node_ptr.empty() || node_ptr.back() != A.rows || rigid_modes.size() != 6 * static_cast<size_t>(A.rows))
-    throw Error(ErrorCode::Internal, "AMG setup: node offsets or rigid modes do not match the matrix");
+  m.modes_count = A.rows > 0 ? static_cast<int>(near_null.size() / A.rows) : 0;
+  if (node_ptr.empty() || node_ptr.back() != A.rows || m.modes_count < 1 || m.modes_count > kMaxModes ||
+      near_null.size() != static_cast<size_t>(m.modes_count) * A.rows)
+    throw Error(ErrorCode::Internal, "AMG setup: node offsets or near-null modes do not match the matrix");
   if (!A.blocks_consistent())
     throw Error(ErrorCode::Internal, "AMG setup: the matrix's row blocks do not share their columns");
   m.levels.clear();
   std::vector<int> nodes = node_ptr, coarse_nodes;
-  std::vector<double> modes = rigid_modes, coarse_modes;
+  std::vector<double> modes = near_null, coarse_modes;
   m.levels.emplace_back();
   m.levels[0].A = &A;
   for (;;) {

@@ -1,7 +1,9 @@
 // Smoothed-aggregation algebraic multigrid (Vaněk, Mandel, Brezina 1996) for linear
 // elasticity, used as the preconditioner of conjugate gradients (fem/pcg.h): the "strong
 // preconditioner" of the iterative solver, and SIMP's solver of choice where a Cholesky factor
-// is too slow or too big (see fem/linear_solver.h for how the default is chosen).
+// is too slow or too big (see fem/linear_solver.h for how the default is chosen). The same
+// hierarchy serves scalar problems (one row per node, the constant as near-null mode): the
+// Helmholtz density filter on fine meshes (simp/helmholtz_filter.h).
 //
 // Per level: a strength graph on nodes (blocks of rows that belong together: a mesh node's
 // free dofs on the finest level, an aggregate's coarse dofs below), greedy aggregation, a
@@ -20,6 +22,9 @@
 #include "fem/pcg.h"
 
 namespace topopt::fem {
+
+/// The most near-null modes a hierarchy carries (elasticity's six rigid-body motions).
+constexpr int kMaxModes = 6;
 
 struct AmgParams {
   /// Strength of connection θ between nodes i, j: ||A_ij||_F² > θ² ||A_ii||_F ||A_jj||_F.
@@ -50,10 +55,12 @@ class SmoothedAggregationAmg final : public Preconditioner {
   /// A: n by n, symmetric positive definite, full storage.
   /// node_ptr: #nodes+1 offsets; the rows of node k are node_ptr[k] .. node_ptr[k+1]-1
   ///   (a mesh node's free dofs, so rows must be numbered node by node).
-  /// rigid_modes: n by 6, row-major: the six rigid-body motions (three translations, three
-  ///   rotations about a central point, lengths scaled to about 1) sampled at each row's dof.
+  /// near_null: n by k, row-major, 1 <= k <= kMaxModes: the motions A leaves (nearly)
+  ///   unstrained, sampled at each row — for elasticity the six rigid-body motions (three
+  ///   translations, three rotations about a central point, lengths scaled to about 1); for a
+  ///   scalar diffusion-type problem (the Helmholtz filter) the constant, k = 1.
   /// Throws Error(NoSupport) if the coarsest matrix is not positive definite.
-  void setup(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& rigid_modes,
+  void setup(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& near_null,
              const AmgParams& params = {});
 
   /// The finest matrix (the one given to setup, same pattern) got new values: refreshes what

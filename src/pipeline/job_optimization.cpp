@@ -62,9 +62,9 @@ void parse_stopping(const Fields& f, simp::SimpParams& p) {
 
 OptimizeSettings parse_optimization(const json& section) {
   const Fields f(section, "optimization",
-                 {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "sensitivity_filter", "heaviside",
-                  "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
-                  "solver_tolerance", "smoothing_iterations", "fill_voids"},
+                 {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver",
+                  "sensitivity_filter", "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective",
+                  "threshold", "solver", "solver_tolerance", "smoothing_iterations", "fill_voids"},
                  "{\"volume_fraction\": 0.3}");
   OptimizeSettings s;
   simp::SimpParams& p = s.simp;
@@ -81,6 +81,11 @@ OptimizeSettings parse_optimization(const json& section) {
                                           : simp::FilterKind::Gaussian;
   p.filter.radius = f.number("filter_radius", 0);
   if (p.filter.radius < 0) f.bad("filter_radius", "must be positive (mm), or 0 for 1.5 x the mean edge length");
+  const std::string hs = f.choice("helmholtz_solver", "auto", {"auto", "jacobi", "multigrid"},
+                                  "how the Helmholtz filter's CG is preconditioned");
+  p.filter.helmholtz_solver = hs == "jacobi"      ? simp::HelmholtzSolver::Jacobi
+                              : hs == "multigrid" ? simp::HelmholtzSolver::Multigrid
+                                                  : simp::HelmholtzSolver::Auto;
   p.sensitivity_filter = f.boolean("sensitivity_filter", false);
   parse_heaviside(f, p.projection);
   p.update = f.choice("update", "oc", {"oc", "mma"}, "optimality criteria or the method of moving asymptotes") == "mma"

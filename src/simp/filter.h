@@ -22,6 +22,11 @@ enum class FilterKind {
   Helmholtz  ///< PDE filter of length helmholtz_length(r, ...)
 };
 
+/// How the Helmholtz filter solves its equation: conjugate gradients preconditioned by Jacobi
+/// or by a V-cycle of the smoothed-aggregation multigrid (fem/amg.h, scalar), or the choice of
+/// helmholtz_uses_multigrid.
+enum class HelmholtzSolver { Auto, Jacobi, Multigrid };
+
 struct FilterParams {
   FilterKind kind = FilterKind::Gaussian;
   double radius = 0;  ///< mm; <= 0 means no filtering (identity)
@@ -29,6 +34,7 @@ struct FilterParams {
   /// Helmholtz only: it stands in for the Gaussian filter of the same radius ("auto"), so its
   /// length matches the Gaussian's instead of the cone's (helmholtz_length).
   bool like_gaussian = false;
+  HelmholtzSolver helmholtz_solver = HelmholtzSolver::Auto;  ///< Helmholtz only
 };
 
 /// The length ℓ of the Helmholtz filter for a radius r (mm): r/(2√3), Lazarov & Sigmund's match

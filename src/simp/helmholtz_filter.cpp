@@ -40,7 +40,24 @@ Eigen::Matrix4d element_matrix(const Eigen::Matrix<double, 4, 3>& p, double leng
   return A;
 }
 
+/// Mean edge length of the design tets (mm): the h of (ℓ/h)².
+double mean_design_edge(const TetMesh& mesh, const std::vector<int>& design) {
+  if (design.empty()) return 0;
+  double sum = 0;
+  for (int t : design)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) sum += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm();
+  return sum / (6.0 * static_cast<double>(design.size()));
+}
+
 }  // namespace
+
+double helmholtz_multigrid_above() { return 4.0; }
+
+bool helmholtz_uses_multigrid(HelmholtzSolver solver, double length, double edge) {
+  if (solver != HelmholtzSolver::Auto) return solver == HelmholtzSolver::Multigrid;
+  return edge > 0 && (length / edge) * (length / edge) > helmholtz_multigrid_above();
+}
 
 HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
                                  const FilterParams& params, const Progress& progress)
@@ -52,6 +69,18 @@ HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& de
   volume_.resize(static_cast<long>(design.size()));
   for (size_t i = 0; i < design.size(); ++i) volume_[static_cast<long>(i)] = volume[design[i]];
   assemble(mesh, design);
+  mean_edge_ = mean_design_edge(mesh, design);
+  if (helmholtz_uses_multigrid(params.helmholtz_solver, length_, mean_edge_)) set_up_multigrid();
+}
+
+void HelmholtzFilter::set_up_multigrid() {
+  // one row per node, and the constant as the one mode the Laplacian leaves unstrained
+  std::vector<int> node_ptr(A_.rows + 1);
+  for (int i = 0; i <= A_.rows; ++i) node_ptr[i] = i;
+  fem::AmgParams p;
+  p.threads = threads_;
+  amg_ = std::make_unique<fem::SmoothedAggregationAmg>();
+  amg_->setup(A_, node_ptr, std::vector<double>(A_.rows, 1.0), p);
 }
 
 void HelmholtzFilter::assemble(const TetMesh& mesh, const std::vector<int>& design) {
@@ -123,8 +152,9 @@ VecXd HelmholtzFilter::solve(const VecXd& b, VecXd& warm) const {
   fem::PcgParams pcg;
   pcg.tolerance = 1e-12;  // near round-off: the gradients (Fᵀ) must match the filter (F) closely
   pcg.max_iterations = 2000;
-  const fem::PcgResult r =
-      fem::pcg(fem::CsrOperator(A_, threads_), JacobiPreconditioner(inverse_diagonal_), b, warm, pcg, progress_);
+  const fem::CsrOperator op(A_, threads_);
+  const fem::PcgResult r = amg_ ? fem::pcg(op, *amg_, b, warm, pcg, progress_)
+                                : fem::pcg(op, JacobiPreconditioner(inverse_diagonal_), b, warm, pcg, progress_);
   last_iterations_ = r.iterations;
   if (!r.converged) {
     std::ostringstream s;
@@ -150,8 +180,10 @@ VecXd HelmholtzFilter::filter_sensitivity(const VecXd& x, const VecXd& g) const 
 
 std::string HelmholtzFilter::describe() const {
   std::ostringstream s;
-  s << "Helmholtz (PDE) filter, length " << length_ << " mm, " << A_.rows << " nodes, "
-    << static_cast<double>(A_.nonzeros()) / std::max(1, A_.rows) << " entries per row";
+  s << "Helmholtz (PDE) filter, length " << length_ << " mm (" << length_ / std::max(mean_edge_, 1e-300)
+    << " mean edges), " << A_.rows << " nodes, " << static_cast<double>(A_.nonzeros()) / std::max(1, A_.rows)
+    << " entries per row, CG preconditioned by "
+    << (amg_ ? "multigrid (" + std::to_string(amg_->levels()) + " levels)" : std::string("Jacobi"));
   return s.str();
 }
 

@@ -11,17 +11,31 @@
 //
 // Memory is linear in the mesh (about 15 matrix entries per node) whatever the radius: the
 // explicit filter holds every pair of elements within r, which at a 2 mm radius on a fine
-// mesh is hundreds of pairs per element. Each application is a conjugate-gradient solve with
-// a Jacobi preconditioner, warm-started from the previous solution: ℓ²K + M is a mass matrix
-// with a Laplacian of relative weight (ℓ/h)², well conditioned for the radii users give (a
-// few mesh sizes), so CG needs tens of iterations (measured in bench/simp and in the log).
+// mesh is hundreds of pairs per element. Each application is a conjugate-gradient solve,
+// warm-started from the previous solution. ℓ²K + M is a mass matrix with a Laplacian of
+// relative weight (ℓ/h)²: for the radii of a few mesh sizes it is well conditioned and Jacobi
+// suffices; a fixed radius on a refined mesh makes (ℓ/h)² grow and Jacobi-CG's iterations with
+// ℓ/h, so there a V-cycle of our smoothed-aggregation multigrid (fem/amg.h, one row per node,
+// the constant as near-null mode) preconditions instead (helmholtz_uses_multigrid).
 #pragma once
 #include <vector>
 
+#include <memory>
+
+#include "fem/amg.h"
 #include "fem/csr_matrix.h"
 #include "simp/filter.h"
 
 namespace topopt::simp {
+
+/// Above this (ℓ/h)², h the mean edge length of the design tets, HelmholtzSolver::Auto
+/// preconditions with multigrid instead of Jacobi (see the definition for the measurement).
+double helmholtz_multigrid_above();
+
+/// Whether the Helmholtz filter of length `length` (mm) on design tets of mean edge `edge` (mm)
+/// preconditions with multigrid: as `solver` says, or for Auto when (ℓ/h)² exceeds
+/// helmholtz_multigrid_above().
+bool helmholtz_uses_multigrid(HelmholtzSolver solver, double length, double edge);
 
 class HelmholtzFilter final : public Filter {
  public:
@@ -39,9 +53,12 @@ class HelmholtzFilter final : public Filter {
   /// Unknowns (design nodes) and CG iterations of the last solve.
   int unknowns() const { return A_.rows; }
   int last_iterations() const { return last_iterations_; }
+  /// True when CG is preconditioned by multigrid (else Jacobi).
+  bool multigrid() const { return amg_ != nullptr; }
 
  private:
   void assemble(const TetMesh& mesh, const std::vector<int>& design);
+  void set_up_multigrid();
   VecXd nodal_load(const VecXd& per_element) const;  // Σ over each node's elements of value/4
   VecXd element_mean(const VecXd& nodal) const;      // each element's mean of its four nodes
   VecXd solve(const VecXd& b, VecXd& warm) const;
@@ -53,7 +70,9 @@ class HelmholtzFilter final : public Filter {
   VecXd volume_;                    // #D element volumes
   fem::CsrMatrix A_;                // ℓ² K + M on the design nodes
   VecXd inverse_diagonal_;
-  mutable VecXd forward_, backward_;  // the last solutions: warm starts for the next solve
+  std::unique_ptr<fem::SmoothedAggregationAmg> amg_;  // null: Jacobi
+  double mean_edge_ = 0;                              // of the design tets (mm)
+  mutable VecXd forward_, backward_;                  // the last solutions: warm starts for the next solve
   mutable int last_iterations_ = 0;
 };
 

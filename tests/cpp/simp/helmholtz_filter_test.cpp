@@ -112,10 +112,34 @@ TEST(HelmholtzFilter, ItsMatrixDoesNotGrowWithTheRadius) {
   const Box b = box(12, 1);
   HelmholtzFilter small(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 1.0, 0});
   HelmholtzFilter large(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 6.0, 0});
-  EXPECT_EQ(small.describe().substr(small.describe().find(" mm,")),
-            large.describe().substr(large.describe().find(" mm,")));
+  EXPECT_EQ(small.describe().substr(small.describe().find("edges), ")),
+            large.describe().substr(large.describe().find("edges), ")));
   DensityFilter explicit_large(b.mesh, b.design, b.volume, {FilterKind::Cone, 4.0, 0});
   EXPECT_GT(explicit_large.mean_neighbours(), 300);  // what the PDE filter does not hold
+}
+
+TEST(HelmholtzFilter, MultigridAndJacobiGiveTheSameFilter) {
+  // a radius of many mesh sizes: (ℓ/h)² well above the switch, so "auto" takes multigrid
+  const Box b = box(20, 0.5, true);
+  FilterParams p{FilterKind::Helmholtz, 8.0, 0};
+  HelmholtzFilter automatic(b.mesh, b.design, b.volume, p);
+  EXPECT_TRUE(automatic.multigrid());
+  EXPECT_NE(automatic.describe().find("preconditioned by multigrid"), std::string::npos) << automatic.describe();
+  p.helmholtz_solver = HelmholtzSolver::Jacobi;
+  HelmholtzFilter jacobi(b.mesh, b.design, b.volume, p);
+  EXPECT_FALSE(jacobi.multigrid());
+  const VecXd x = VecXd::Random(static_cast<long>(b.design.size())).cwiseAbs();
+  const VecXd a = automatic.apply(x), j = jacobi.apply(x);
+  EXPECT_LT((a - j).cwiseAbs().maxCoeff(), 1e-9 * j.cwiseAbs().maxCoeff());
+  EXPECT_LT(automatic.last_iterations(), jacobi.last_iterations());
+  const VecXd y = VecXd::Random(x.size());
+  EXPECT_NEAR(a.dot(y), x.dot(automatic.apply_transpose(y)), 1e-10 * std::abs(a.dot(y)));
+  // the rule: the Laplacian's weight (ℓ/h)² against helmholtz_multigrid_above()
+  const double above = helmholtz_multigrid_above();
+  EXPECT_FALSE(helmholtz_uses_multigrid(HelmholtzSolver::Auto, 0.9 * std::sqrt(above), 1.0));
+  EXPECT_TRUE(helmholtz_uses_multigrid(HelmholtzSolver::Auto, 1.1 * std::sqrt(above), 1.0));
+  EXPECT_TRUE(helmholtz_uses_multigrid(HelmholtzSolver::Multigrid, 0.1, 1.0));
+  EXPECT_FALSE(helmholtz_uses_multigrid(HelmholtzSolver::Jacobi, 10, 1.0));
 }
 
 TEST(FilterChoice, AutoTakesTheHelmholtzFilterWhenTheExplicitOneIsDenseOrTooLarge) {
