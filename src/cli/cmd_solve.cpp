@@ -19,7 +19,7 @@ int cmd_solve(const Args& args) {
               "  (displacements and von Mises stress per case) for ParaView. The job format is in\n"
               "  docs/job-format.md; the whole job is checked, and DIR made and tested, before any work.\n"
               "  --out-dir  output folder (default: the job's output.directory, or out/ beside it)\n"
-              "  --solver   direct (CHOLMOD sparse Cholesky, auto below 40 000 unknowns) or iterative\n"
+              "  --solver   direct (CHOLMOD sparse Cholesky, auto up to 20 000 unknowns) or iterative\n"
               "             (conjugate gradients with smoothed-aggregation multigrid, auto above)\n"
               "  --inp      also write the problem (first load case) as a CalculiX deck, to check\n"
               "             the result with: ccx -i <name without .inp>");
