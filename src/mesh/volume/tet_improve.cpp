@@ -267,6 +267,56 @@ NodeMove plan_search_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, co
   return m;
 }
 
+namespace {
+
+/// kPerturbDirections unit vectors spread evenly over the sphere (a Fibonacci lattice).
+std::array<Vec3, kPerturbDirections> sphere_directions() {
+  std::array<Vec3, kPerturbDirections> d;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < kPerturbDirections; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / kPerturbDirections, r = std::sqrt(1.0 - z * z);
+    d[i] = Vec3(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return d;
+}
+
+/// v's mean edge to the other nodes of its tets (0 when it has none).
+double mean_edge_at(const std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts, int v) {
+  double len = 0;
+  int cnt = 0;
+  for (int q : ts)
+    for (int x : tets[q])
+      if (x != v) len += (P[x] - P[v]).norm(), ++cnt;
+  return cnt ? len / cnt : 0.0;
+}
+
+}  // namespace
+
+NodeMove plan_perturb_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
+  const std::array<Vec3, kPerturbDirections> dirs = sphere_directions();
+  const Adjacency::Row ts = stars.row(v);
+  double step = 0.25 * mean_edge_at(P, tets, ts, v);
+  if (!(step > 0)) return {};
+  const Vec3 old = P[v];
+  const double before = worst_positive(P, tets, ts);
+  double best = before;
+  for (int it = 0; it < 12; ++it) {
+    const Vec3 here = P[v];
+    Vec3 to = here;
+    for (const Vec3& d : dirs) {
+      P[v] = here + step * d;
+      const double now = worst_positive(P, tets, ts);
+      if (now > best) best = now, to = P[v];
+    }
+    P[v] = to;
+    if (to == here) step *= 0.5;
+  }
+  NodeMove m{v, old, P[v], before, best};
+  P[v] = old;
+  if (!(best > before)) return {};
+  return m;
+}
+
 void apply(std::vector<Vec3>& P, const NodeMove& m) { P[m.v] = m.to; }
 
 namespace {
@@ -548,6 +598,41 @@ long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floo
   return done;
 }
 
+long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, int first_new, double floor) {
+  const Adjacency stars = node_stars(P.size(), tets);
+  std::vector<char> seen(P.size(), 0);
+  long moved = 0;
+  for (const auto& [r0, t] : tets_below(P, tets, floor))
+    for (int v : tets[t]) {
+      if (v < first_new || seen[v]) continue;
+      seen[v] = 1;
+      NodeMove m = plan_search_node(P, tets, stars, v);
+      if (m.empty()) m = plan_perturb_node(P, tets, stars, v);
+      if (m.empty()) continue;
+      mesh::apply(P, m);  // qualified: std::apply would be found by ADL too
+      ++moved;
+    }
+  return moved;
+}
+
+long remove_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
+                    const Progress& progress) {
+  long left = static_cast<long>(tets_below(P, tets, floor).size());
+  for (int round = 0; round < rounds && left > 0; ++round) {
+    progress.check_cancel("volume meshing (slivers)");
+    perturb_sliver_nodes(P, tets, first_new, floor);
+    flip_bad_tets(P, tets, floor);
+    remove_tets_below(P, tets, floor, 2, progress);
+    const long now = static_cast<long>(tets_below(P, tets, floor).size());
+    if (now >= left) {
+      left = now;
+      break;
+    }
+    left = now;
+  }
+  return left;
+}
+
 long insert_points_at_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad) {
   long done = 0;
   for (int sweep = 0; sweep < 3; ++sweep) {
@@ -581,7 +666,10 @@ void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, c
       search_nodes_of_bad_tets(P, tets, node_stars(P.size(), tets), first_new, params.sliver_below);
     }
   }
-  if (params.sliver_floor > 0) remove_tets_below(P, tets, params.sliver_floor, 4, progress);
+  if (params.sliver_floor > 0) {
+    remove_tets_below(P, tets, params.sliver_floor, 4, progress);
+    remove_slivers(P, tets, first_new, params.sliver_floor, params.sliver_rounds, progress);
+  }
 }
 
 }  // namespace topopt::mesh

@@ -94,6 +94,17 @@ NodeMove plan_smooth_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet
 /// worst radius ratio around v rises (halved when no direction helps, 40 tries), every tet
 /// staying positive; the best position found when it is better.
 NodeMove plan_search_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v);
+/// Perturbation (check-only), for a node the compass search left at a sliver: pattern search
+/// over kPerturbDirections directions spread evenly over the sphere (a Fibonacci lattice),
+/// steps from a quarter of v's mean edge, the best direction taken while it raises the worst
+/// radius ratio around v, the step halved when none does (12 tries), every tet staying
+/// positive; the best position found when it is better. Its many directions find the moves
+/// that lift the worst tet of a star where the compass's six do not (the perturbation of
+/// sliver nodes of Tournois et al., with directions laid out instead of drawn).
+NodeMove plan_perturb_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars,
+                           int v);
+/// Directions the perturbation tries per step.
+constexpr int kPerturbDirections = 32;
 /// Makes move m (P[m.v] = m.to).
 void apply(std::vector<Eigen::Vector3d>& P, const NodeMove& m);
 
@@ -138,6 +149,11 @@ void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector
 /// Returns the number of cavities re-filled.
 long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
 
+/// The nodes from first_new on of the tets below `floor`, worst tet first, each node once:
+/// moved by search_node, else by perturb_node, when that lifts the worst tet around it.
+/// Returns the number of nodes moved.
+long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor);
+
 /// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
 /// each is taken out with the best of wider cavities than insert_points_at_slivers tries —
 /// those, the star of each of its nodes, the stars of both ends of each of its edges, and
@@ -148,18 +164,28 @@ long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>&
 long remove_tets_below(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double floor, int sweeps,
                        const Progress& progress = {});
 
+/// Rounds at the tets below `floor` until none is left or a round removes none: the nodes
+/// of the slivers perturbed (perturb_sliver_nodes, nodes from first_new on), edge removal and
+/// 2-3 flips at them, and wider cavities re-filled (remove_tets_below, 2 sweeps; the points
+/// it adds are the next round's to move). Returns the number of tets below floor left.
+long remove_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
+                    const Progress& progress = {});
+
 struct TetImproveParams {
   double flip_below = 0.55;      ///< tets below this radius ratio get edge removal and 2-3 flips (0: none)
   int smoothing_iterations = 1;  ///< smooth_node sweeps per round
   int quality_rounds = 3;        ///< rounds of flips, smoothing and compass search
   double sliver_below = 0.4;     ///< compass search at tets below this each round, then point insertion (0: none)
-  /// Then tets below this get wider cavities (remove_tets_below, up to 4 sweeps; 0: none).
+  /// Then tets below this get wider cavities (remove_tets_below, up to 4 sweeps), then rounds of
+  /// perturbation of their nodes, flips and wider cavities (remove_slivers; 0: none).
   double sliver_floor = 0.1;
+  int sliver_rounds = 4;  ///< at most this many rounds of remove_slivers
 };
 
 /// The improvement after a fill: `quality_rounds` rounds of flips, smoothing of the nodes
 /// from first_new on and compass search at the bad tets; then up to three rounds of sliver
-/// insertion, each followed by flips and compass search; then remove_tets_below(sliver_floor).
+/// insertion, each followed by flips and compass search; then remove_tets_below(sliver_floor)
+/// and remove_slivers(sliver_floor, sliver_rounds).
 /// Nodes below first_new never move. Checks progress for cancellation between rounds.
 void improve_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new,
                   const TetImproveParams& params, const Progress& progress = {});

@@ -8,7 +8,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include <Eigen/Eigenvalues>
+
+#include "common/face_key.h"
+#include "common/tet_boundary.h"
+#include "mesh/core/conformity.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/tet_quality.h"
 
@@ -331,6 +337,135 @@ TEST(TetImprove, DriversSweepTheKernelsOverTheBadTets) {
     EXPECT_NEAR(volume(Q, tets), v0, 1e-14);
     for (int i = 0; i < 6; ++i) EXPECT_EQ(Q[i], Q0[i]);
   }
+}
+
+TEST(TetImprove, PerturbNodeFindsABetterPlaceForTheNodeOfAFlatTet) {
+  // node 6 at 0.02 below the octahedron's face x + y + z = 1 (over its centre): the tet on that
+  // face is a flat cap; the plan (P as it was) moves the node inwards and lifts the worst
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
+  P[6] = Vec3::Constant((1.0 - 0.02 * std::sqrt(3.0)) / 3);
+  const Points before = P;
+  EXPECT_LT(worst(P, tets), 0.1);
+  const NodeMove m = plan_perturb_node(P, tets, stars, 6);
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(P, before) << "the plan moved the node";
+  EXPECT_GT(m.after, 0.5);
+  EXPECT_LT(m.to.norm(), 0.5 * m.from.norm()) << "towards the centre";
+  apply(P, m);
+  EXPECT_NEAR(worst(P, tets), m.after, 1e-15);
+  // at the centre of the regular star every move lowers the worst tet
+  P[6] = Vec3::Zero();
+  EXPECT_TRUE(plan_perturb_node(P, tets, stars, 6).empty());
+}
+
+/// The classic shapes of tets with a small radius ratio (nodes 0-3, w the small length):
+/// flat cap (a node at height w over the centre of the opposite equilateral face), wedge (a
+/// short edge of length w, the opposite edge long and skew to it), needle (an equilateral
+/// base of circumradius w under an apex at distance 1) and sliver (four nodes near one circle,
+/// no short edge: a square warped by ±w).
+Points classic_bad_tet(const std::string& shape, double w) {
+  const double s = std::sqrt(3.0) / 2;
+  if (shape == "cap") return {{1, 0, 0}, {-0.5, s, 0}, {-0.5, -s, 0}, {0, 0, w}};
+  if (shape == "wedge") return {{-0.5 * w, 0, 0}, {0.5 * w, 0, 0}, {0, 1, 0.3}, {0, -1, 0.3}};
+  if (shape == "needle") return {{w, 0, 0}, {-0.5 * w, s * w, 0}, {-0.5 * w, -s * w, 0}, {0, 0, 1}};
+  return {{1, 0, w}, {0, 1, -w}, {-1, 0, w}, {0, -1, -w}};
+}
+
+/// Bad tet 0-3 of P embedded in a small mesh: seen along z (the direction in which its
+/// nodes spread least), its faces turned towards +z are joined to one apex over its centroid
+/// and the others to one apex under it (nodes 4, 5, at `height` × its longest edge): the
+/// bipyramid over its silhouette, conformal; every node on the mesh's boundary (none may move).
+std::vector<Tet> embedded(Points& P, double height) {
+  const Vec3 centre = (P[0] + P[1] + P[2] + P[3]) / 4;
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  double longest = 0;
+  for (int i = 0; i < 4; ++i) {
+    spread += (P[i] - centre) * (P[i] - centre).transpose();
+    for (int j = 0; j < i; ++j) longest = std::max(longest, (P[i] - P[j]).norm());
+  }
+  const Vec3 z = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvectors().col(0);
+  P.push_back(centre + height * longest * z);
+  P.push_back(centre - height * longest * z);
+  std::vector<Tet> tets = {positive(P, {0, 1, 2, 3})};
+  const Tet t = tets[0];
+  for (const auto& o : kTetFace) {  // kTetFace turns a face out of its tet
+    const Vec3 n = (P[t[o[1]]] - P[t[o[0]]]).cross(P[t[o[2]]] - P[t[o[0]]]);
+    tets.push_back({t[o[0]], t[o[1]], t[o[2]], n.dot(z) > 0 ? 4 : 5});
+  }
+  return tets;
+}
+
+MatX4i rows_of(const std::vector<Tet>& tets) {
+  MatX4i T(static_cast<long>(tets.size()), 4);
+  for (size_t t = 0; t < tets.size(); ++t)
+    T.row(static_cast<long>(t)) << tets[t][0], tets[t][1], tets[t][2], tets[t][3];
+  return T;
+}
+
+/// Checks that `tets` on P are valid (every tet positive: exact orientation, none flat) and
+/// conformal with `boundary` as their boundary, on the nodes they use (a refill may leave a
+/// node unused; the fill's output drops those).
+void expect_valid(const Points& P, const std::vector<Tet>& tets, const MatX3i& boundary, const std::string& what) {
+  TetMesh m;
+  m.V.resize(static_cast<long>(P.size()), 3);
+  std::vector<int> renum(P.size(), -1);
+  int used = 0;
+  for (const Tet& t : tets)
+    for (int x : t)
+      if (renum[x] < 0) m.V.row(used) = P[x].transpose(), renum[x] = used++;
+  m.V.conservativeResize(used, 3);
+  m.T = rows_of(tets);
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (int k = 0; k < 4; ++k) m.T(t, k) = renum[m.T(t, k)];
+  m.F = boundary;
+  for (long t = 0; t < m.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) m.F(t, k) = renum[m.F(t, k)];
+  m.domain = VecXi::Zero(m.T.rows());
+  m.face = VecXi::Ones(m.F.rows());
+  const ConformityReport c = check_conformity(m);
+  EXPECT_EQ(c.inverted_tets + c.flat_tets + c.overshared_faces + c.duplicate_nodes, 0) << what;
+  EXPECT_EQ(c.boundary_not_in_F + c.F_not_boundary + c.open_boundary_edges, 0) << what << ": the boundary changed";
+}
+
+TEST(TetImprove, RemoveSliversTakesOutTheClassicBadTetsKeepingTheMeshValid) {
+  // boundary-locked: the cap and the sliver embedded with every node fixed (edge removal,
+  // flips and refills take them out)
+  for (const std::string shape : {"cap", "sliver"}) {
+    Points P = classic_bad_tet(shape, 0.03);
+    std::vector<Tet> tets = embedded(P, 0.6);
+    const Points P0 = P;
+    const double v0 = volume(P, tets);
+    ASSERT_LT(worst(P, tets), 0.1) << shape;
+    const MatX3i boundary = boundary_triangles(rows_of(tets));
+    EXPECT_EQ(remove_slivers(P, tets, static_cast<int>(P.size()), 0.1, 4), 0) << shape;
+    EXPECT_GE(worst(P, tets), 0.1) << shape;
+    for (size_t i = 0; i < P0.size(); ++i) EXPECT_EQ(P[i], P0[i]) << shape << ": a node moved";
+    EXPECT_NEAR(volume(P, tets), v0, 1e-12 * v0) << shape;
+    expect_valid(P, tets, boundary, shape);
+  }
+  // with a free node: the octahedron star with its centre 0.03 from vertex 0 (the tets on
+  // that vertex are wedges: a short edge, the opposite one long) and 0.02 under the centre of
+  // a face (a flat cap); perturbation and compass search move the node away
+  for (const Vec3& x : std::vector<Vec3>{Vec3(0.97, 0, 0), Vec3::Constant((1.0 - 0.02 * std::sqrt(3.0)) / 3)}) {
+    std::vector<Tet> tets;
+    Points P = octahedron_star(x, tets);
+    const double v0 = volume(P, tets);
+    ASSERT_LT(worst(P, tets), 0.1);
+    const MatX3i boundary = boundary_triangles(rows_of(tets));
+    EXPECT_EQ(remove_slivers(P, tets, 6, 0.1, 4), 0);
+    EXPECT_GE(worst(P, tets), 0.1);
+    EXPECT_NEAR(volume(P, tets), v0, 1e-12);
+    expect_valid(P, tets, boundary, "free node");
+  }
+  // nothing below the floor: nothing changes
+  std::vector<Tet> regular;
+  Points Q = octahedron_star(Vec3::Zero(), regular);
+  const std::vector<Tet> before = regular;
+  const Points Q0 = Q;
+  EXPECT_EQ(remove_slivers(Q, regular, 6, 0.1, 4), 0);
+  EXPECT_EQ(regular, before);
+  EXPECT_EQ(Q, Q0);
 }
 
 }  // namespace
