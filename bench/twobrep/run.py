@@ -115,9 +115,11 @@ def gmsh_row(part, nd, size, tmp, limit):
     """Gmsh (python3-gmsh, 1 thread) with the product's settings (MeshSizeMax = size, MeshSizeMin =
     size / 10, 40 elements per 2π, Optimize): tets, time of generate(3), total volume error and
     the worst radius ratio; used where the product's Gmsh fallback stops at its time budget."""
-    sys.path.insert(0, os.path.join(ROOT, "bench", "volume"))
-    from run import quality_shares
+    import importlib.util
     import numpy as np
+    spec = importlib.util.spec_from_file_location("volume_bench", os.path.join(ROOT, "bench", "volume", "run.py"))
+    volume_bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(volume_bench)
     out = os.path.join(tmp, "g.json")
     script = os.path.join(tmp, "g.py")
     open(script, "w").write(GMSH_SCRIPT)
@@ -132,7 +134,7 @@ def gmsh_row(part, nd, size, tmp, limit):
     X = np.load(out + ".npy")
     P = X.reshape(-1, 3)
     T = np.arange(len(P)).reshape(-1, 4)
-    row["rr_min"] = quality_shares(P, T)[0]
+    row["rr_min"] = volume_bench.quality_shares(P, T)[0]
     row["conformity"] = None
     row["mesher"] = "python3-gmsh"
     return row

@@ -946,7 +946,7 @@ std::vector<ModelSurface::FaceAttempt> ModelSurface::face_attempts(int f) const 
 // improvement. Throws the front's Error when it cannot fill the face.
 void ModelSurface::mesh_face_once(int f, const FaceAttempt& a, const Progress& prog, FaceOut& out) const {
   FaceInput in = face_input(f, a.geo);
-  if (a.close_gaps) close_loop_gaps(in.loops);
+  if (a.close_gaps) close_loop_gaps(in);
   const Loops& L = in.loops;
   FaceFrontInput front;
   front.P.resize(static_cast<long>(L.uv.size()), 2);
@@ -979,8 +979,10 @@ void ModelSurface::mesh_face_once(int f, const FaceAttempt& a, const Progress& p
 // Loops whose edges' ends do not meet in the parameters (trimmed B-spline faces whose
 // parameter curves leave gaps wider than the merge tolerance of face_loops): a node's copies
 // that only end a segment and those that only start one are the two sides of such a gap,
-// and each such pair (nearest first) becomes one node. A seam's copies are balanced and stay.
-void ModelSurface::close_loop_gaps(Loops& L) {
+// and each such pair (nearest first) becomes one node, also in the constraint segments and
+// isolated nodes. A seam's copies are balanced and stay.
+void ModelSurface::close_loop_gaps(FaceInput& in) {
+  Loops& L = in.loops;
   const size_t n = L.uv.size();
   std::vector<int> balance(n, 0);
   for (const auto& sg : L.segs) ++balance[sg[0]], --balance[sg[1]];
@@ -1005,6 +1007,8 @@ void ModelSurface::close_loop_gaps(Loops& L) {
         balance[best] = 0;
       }
   for (auto& sg : L.segs) sg = {to[sg[0]], to[sg[1]]};
+  for (auto& sg : in.csegs) sg = {to[sg[0]], to[sg[1]]};
+  for (int& i : in.isolated) i = to[i];
 }
 
 // Face f's loops in its scaled parameters, then its constraint segments and nodes in the same

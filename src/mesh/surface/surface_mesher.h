@@ -261,7 +261,7 @@ class ModelSurface {
   void mesh_face(int f, const Progress& progress, FaceOut& out) const;
   std::vector<FaceAttempt> face_attempts(int f) const;
   void mesh_face_once(int f, const FaceAttempt& a, const Progress& progress, FaceOut& out) const;
-  static void close_loop_gaps(Loops& L);
+  static void close_loop_gaps(FaceInput& in);
   FaceInput face_input(int f, const FaceGeometry& g) const;
   void improve_on_surface(int f, const FaceGeometry& g, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const;
   void take_face_mesh(int f, const FaceOut& fo);

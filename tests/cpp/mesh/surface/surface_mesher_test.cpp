@@ -301,8 +301,8 @@ TopoDS_Shape bspline_block_with_hole() {
 /// A prism 5 high on a polygon with a 0.02 mm edge (a notch in its long side).
 TopoDS_Shape prism_with_short_edge() {
   BRepBuilderAPI_MakePolygon poly;
-  for (auto [x, y] : {std::pair{0.0, 0.0}, {20.0, 0.0}, {20.0, 10.0}, {10.02, 10.0}, {10.0, 10.005}, {0.0, 10.0}})
-    poly.Add(gp_Pnt(x, y, 0));
+  const std::vector<std::array<double, 2>> corners{{0, 0}, {20, 0}, {20, 10}, {10.02, 10}, {10, 10.005}, {0, 10}};
+  for (const auto& [x, y] : corners) poly.Add(gp_Pnt(x, y, 0));
   poly.Close();
   return BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), gp_Vec(0, 0, 5)).Shape();
 }
