@@ -11,6 +11,13 @@ best of --repeat runs.
 
 usage: bench/twobrep/run.py [--build build] [--repeat 2] [--cases rocker:0,rocker:1.4,...]
 (size 0 = the default, diagonal / 50). Prints a Markdown table for BENCHMARKS.md.
+
+With --shared JSON, it instead runs both meshers on every part of ../shared/data (the examples
+with their non-design solids, NIST 1-6 and 11, linkrods, CrankArm) at the default size, each
+pinned to one CPU (taskset -c 0; Gmsh runs with General.NumThreads 1), native then Gmsh per
+part in the same run, and keeps tets, mesh time, the largest volume error, the worst radius
+ratio and the native mesher's per-face size reasons (counts) in JSON (rows are kept, so a run
+can be resumed; --parts a,b re-runs only those). --shared-table JSON prints the ratio table.
 """
 import argparse, json, os, platform, subprocess, sys, tempfile
 
@@ -39,12 +46,154 @@ def run(topopt, name, size, mesher, repeat):
     return best
 
 
+def shared_parts():
+    """(name, part file, non-design file or None) for every part of ../shared/data."""
+    data = os.path.normpath(os.path.join(ROOT, "..", "shared", "data"))
+    out = [(n, os.path.join(data, "examples", n + ".step"), os.path.join(data, "examples", n + "_nondesign.step"))
+           for n in ("rocker", "cantilever", "bracket", "mount")]
+    out += [("NIST %d" % n, os.path.join(data, "nist", "NIST_MBE_PMI_%d.stp" % n), None) for n in (1, 2, 3, 4, 5, 6, 11)]
+    return out + [("linkrods", os.path.join(data, "occt", "linkrods.step"), None),
+                  ("CrankArm", os.path.join(data, "occt", "CrankArm.brep"), None)]
+
+
+def shared_row(topopt, part, nd, mesher, tmp):
+    """One `topopt mesh` of one part by one mesher on one CPU: its figures, or its error."""
+    stats = os.path.join(tmp, "s.json")
+    if os.path.exists(stats):
+        os.remove(stats)
+    cmd = ["taskset", "-c", "0", topopt, "mesh", "--mesher", mesher, "--part", part,
+           "--out", os.path.join(tmp, "m.msh"), "--stats", stats] + (["--non-design", nd] if nd else [])
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if not os.path.exists(stats):
+        return {"error": (p.stderr.strip().splitlines() or ["failed"])[-1][-300:]}
+    s = json.load(open(stats))
+    row = {"tets": s["tets"], "seconds": round(s["seconds"]["mesh"], 2),
+           "volume_error": s["conformity"]["max_volume_error"], "rr_min": s["quality"]["radius_ratio"]["min"],
+           "conformity": s["conformity"]["ok"], "mesher": s.get("mesher", mesher)}
+    reasons = {}
+    for f in s.get("face_sizes", []):
+        reasons[f["reason"]] = reasons.get(f["reason"], 0) + 1
+    if reasons:
+        row["face_reasons"] = reasons
+    return row
+
+
+GMSH_SCRIPT = r'''
+import json, sys, time
+import numpy as np
+import gmsh
+part, nd, size, out = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4]
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.option.setNumber("General.NumThreads", 1)
+a = gmsh.model.occ.importShapes(part)
+if nd:
+    b = gmsh.model.occ.importShapes(nd)
+    gmsh.model.occ.fragment(a, b)
+gmsh.model.occ.synchronize()
+brep = sum(gmsh.model.occ.getMass(3, t) for _, t in gmsh.model.getEntities(3))
+gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+gmsh.option.setNumber("Mesh.MeshSizeMin", size / 10)
+gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 40)
+gmsh.option.setNumber("Mesh.Optimize", 1)
+t = time.perf_counter()
+gmsh.model.mesh.generate(3)
+dt = time.perf_counter() - t
+tags, xyz, _ = gmsh.model.mesh.getNodes()
+P = np.zeros((int(tags.max()) + 1, 3))
+P[tags.astype(int)] = xyz.reshape(-1, 3)
+_, nt = gmsh.model.mesh.getElementsByType(4)
+T = nt.astype(int).reshape(-1, 4)
+A, B, C, D = (P[T[:, i]] for i in range(4))
+vol = np.abs(np.einsum("ij,ij->i", B - A, np.cross(C - A, D - A))).sum() / 6
+json.dump({"tets": len(T), "seconds": round(dt, 2), "volume_error": abs(vol - brep) / brep}, open(out, "w"))
+np.save(out + ".npy", np.hstack([P[T[:, i]] for i in range(4)]))
+'''
+
+
+def gmsh_row(part, nd, size, tmp, limit):
+    """Gmsh (python3-gmsh, 1 thread) with the product's settings (MeshSizeMax = size, MeshSizeMin =
+    size / 10, 40 elements per 2π, Optimize): tets, time of generate(3), total volume error and
+    the worst radius ratio; used where the product's Gmsh fallback stops at its time budget."""
+    import importlib.util
+    import numpy as np
+    spec = importlib.util.spec_from_file_location("volume_bench", os.path.join(ROOT, "bench", "volume", "run.py"))
+    volume_bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(volume_bench)
+    out = os.path.join(tmp, "g.json")
+    script = os.path.join(tmp, "g.py")
+    open(script, "w").write(GMSH_SCRIPT)
+    try:
+        subprocess.run(["taskset", "-c", "0", "/usr/bin/python3", script, part, nd or "", repr(size), out],
+                       capture_output=True, text=True, timeout=limit)
+    except subprocess.TimeoutExpired:
+        return {"error": "python3-gmsh did not finish in %d s" % limit}
+    if not os.path.exists(out):
+        return {"error": "python3-gmsh failed"}
+    row = json.load(open(out))
+    X = np.load(out + ".npy")
+    P = X.reshape(-1, 3)
+    T = np.arange(len(P)).reshape(-1, 4)
+    row["rr_min"] = volume_bench.quality_shares(P, T)[0]
+    row["conformity"] = None
+    row["mesher"] = "python3-gmsh"
+    return row
+
+
+def part_size(topopt, part):
+    info = json.loads(subprocess.run([topopt, "info", "--part", part, "--json"], capture_output=True, text=True,
+                                     check=True).stdout)
+    lo, hi = info["part"]["bbox"]["min"], info["part"]["bbox"]["max"]
+    return sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5 / 50
+
+
+def shared(args):
+    rows = json.load(open(args.shared)) if os.path.exists(args.shared) else {}
+    topopt = os.path.join(args.build, "topopt")
+    only = args.parts.split(",") if args.parts else None
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, part, nd in shared_parts():
+            if (only and name not in only) or (not only and name in rows):
+                continue
+            rows[name] = {m: shared_row(topopt, part, nd, m, tmp) for m in ("native", "gmsh")}
+            if "error" in rows[name]["gmsh"]:  # the product's budget: Gmsh through python3-gmsh instead
+                rows[name]["gmsh_cli_error"] = rows[name]["gmsh"]["error"]
+                rows[name]["gmsh"] = gmsh_row(part, nd, part_size(topopt, part), tmp, args.gmsh_limit)
+            print(name, json.dumps(rows[name]), file=sys.stderr, flush=True)
+            json.dump(rows, open(args.shared, "w"), indent=1)
+
+
+def shared_table(path):
+    rows = json.load(open(path))
+    print("| part | tets native / gmsh | ratio | time native / gmsh (s) | ratio | volume error native / gmsh |"
+          " worst radius ratio native / gmsh | faces by binding size rule (native) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, r in rows.items():
+        a, b = r["native"], r["gmsh"]
+        if "error" in a or "error" in b:
+            print("| %s | native: %s / gmsh: %s | | | | | | |" % (name, a.get("error", "ok")[-80:], b.get("error", "ok")[-80:]))
+            continue
+        why = ", ".join("%s %d" % kv for kv in sorted(a.get("face_reasons", {}).items()))
+        print("| %s | %d / %d | %.2f | %.2f / %.2f | %.2f | %.3f %% / %.3f %% | %.3f / %.3f | %s |" % (
+            name, a["tets"], b["tets"], a["tets"] / b["tets"], a["seconds"], b["seconds"],
+            a["seconds"] / max(b["seconds"], 1e-9), 100 * a["volume_error"], 100 * b["volume_error"],
+            a["rr_min"], b["rr_min"], why))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("--cases", default=DEFAULT_CASES)
+    ap.add_argument("--shared", help="JSON: both meshers on every shared part, one CPU each (see above)")
+    ap.add_argument("--parts", help="with --shared: only these parts (re-run)")
+    ap.add_argument("--gmsh-limit", type=int, default=900, help="with --shared: seconds for python3-gmsh")
+    ap.add_argument("--shared-table", help="print the ratio table of a --shared JSON")
     args = ap.parse_args()
+    if args.shared:
+        return shared(args)
+    if args.shared_table:
+        return shared_table(args.shared_table)
     topopt = os.path.join(args.build, "topopt")
     cpu = "?"
     try:

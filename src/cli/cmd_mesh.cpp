@@ -35,7 +35,8 @@ const char* kUsage =
     "           the diagonal, with a warning; a size asking for too many elements is refused)\n"
     "  --min-size  smallest element size in mm (default: size / 10)\n"
     "  --wall-layers N  (native) walls thinner than two sizes get about N layers across\n"
-    "  --stats  counts per domain, volumes, quality, conformity and time per stage (JSON)\n"
+    "  --stats  counts per domain, volumes, quality, conformity, time per stage (JSON) and, native,\n"
+    "           per face of the part its finest size and the rule that sets it (face_sizes)\n"
     "  --mesher native: the two-B-Rep advancing front (the 14 steps: no boolean of the part\n"
     "           with the non-design solids); gmsh: OCC fragments of both, meshed by Gmsh in a\n"
     "           separate process; auto (default): native, and gmsh with a warning where native fails\n"
@@ -124,6 +125,11 @@ void write_stats(const std::string& stats, const TetMesh& m, const mesh::Quality
   j["mesher"] = run.mesher;
   if (!run.fallback_reason.empty()) j["native_failed"] = run.fallback_reason;
   for (const auto& [stage, s] : run.seconds) j["seconds_per_stage"][stage] = s;
+  for (const mesh::FaceSize& f : run.face_sizes)
+    j["face_sizes"].push_back({{"face", "Face" + std::to_string(f.face)},
+                               {"size", f.size},
+                               {"face_size", f.face_size},
+                               {"reason", mesh::size_reason_name(f.reason)}});
   pipeline::write_replacing(stats, [&](const std::string& p) {
     std::ofstream f(p);
     f << j.dump(2) << "\n";

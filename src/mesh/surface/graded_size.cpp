@@ -50,13 +50,15 @@ double PointSizeField::size_at(const double* q, double h) const {
 
 // ============================================================================ SizeRaster
 
-SizeRaster::SizeRaster(const std::vector<std::array<double, 3>>& pts, double cap, double grade) : cap_(cap) {
+SizeRaster::SizeRaster(const std::vector<std::array<double, 3>>& pts, double cap, double grade)
+    : cap_(cap), smallest_(cap) {
   if (pts.empty()) return;
   double smin = cap, lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
   for (const auto& p : pts) {
     smin = std::min(smin, p[2]);
     for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
   }
+  smallest_ = smin;
   const double reach = (cap - smin) / grade;  // beyond it every point's size has grown to cap
   for (int k = 0; k < 2; ++k) lo_[k] = lo[k] - reach, hi[k] += reach;
   cell_ = std::max({0.5 * smin, (hi[0] - lo_[0]) / 511, (hi[1] - lo_[1]) / 511, 1e-12});

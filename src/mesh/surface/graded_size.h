@@ -42,10 +42,12 @@ class SizeRaster {
   double size_at(const double* q, double h) const;
   /// No points: the field is the cap everywhere.
   bool empty() const { return v_.empty(); }
+  /// The smallest size of the field (the cap when empty).
+  double smallest() const { return smallest_; }
 
  private:
   void chamfer(float straight, float diagonal);
-  double cap_ = 0, cell_ = 1, lo_[2] = {0, 0};
+  double cap_ = 0, smallest_ = 0, cell_ = 1, lo_[2] = {0, 0};
   long nx_ = 0, ny_ = 0;
   std::vector<float> v_;
 };

@@ -176,6 +176,7 @@ ModelSurface::ModelSurface(const brep::TopologyIndex& topo, std::vector<std::arr
   fixed_.resize(ne);
   edge_param_.resize(ne);
   edge_node_.resize(ne);
+  split_close_.assign(ne, 0);
   constraint_.resize(nf);
   face_extra_nodes_.resize(nf);
   face_given_.assign(nf, 0);
@@ -543,10 +544,11 @@ void ModelSurface::grade_vertex_sizes() {
 // The boundary of face f in its scaled parameters: local nodes (a seam's nodes appear twice,
 // at both ends of the period), their global numbers, directed segments with the face on
 // their left, and the B-Rep edge of each segment.
-ModelSurface::Loops ModelSurface::face_loops(int f) const {
+ModelSurface::Loops ModelSurface::face_loops(int f) const { return face_loops(f, geo_[f]); }
+
+ModelSurface::Loops ModelSurface::face_loops(int f, const FaceGeometry& g) const {
   Loops L;
   const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
-  const FaceGeometry& g = geo_[f];
   double u0, u1, v0, v1;
   BRepTools::UVBounds(fwd, u0, u1, v0, v1);
   const double tol = 1e-6 * std::hypot((u1 - u0) * g.su, (v1 - v0) * g.sv);
@@ -626,7 +628,8 @@ void ModelSurface::split_by_proximity(const Progress& progress) {
   const SharpCorners corners = sharp_corners();
   std::vector<char> stale(nf, 1);
   for (int round = 0; round < 10; ++round) {
-    PieceSplits splits{std::vector<std::vector<int>>(topo_.num_edges()), false};
+    PieceSplits splits{std::vector<std::vector<int>>(topo_.num_edges()), false,
+                       std::vector<char>(topo_.num_edges(), 0)};
     for (int f = 0; f < nf; ++f) {
       if (!stale[f] || face_given_[f]) continue;
       progress.check_cancel("surface meshing");
@@ -637,6 +640,7 @@ void ModelSurface::split_by_proximity(const Progress& progress) {
       mark_close_pieces(L, boxes, corners, splits);
     }
     if (!splits.any) break;
+    for (int e = 0; e < topo_.num_edges(); ++e) split_close_[e] |= splits.close[e];
     split_pieces(splits.pieces, stale);
   }
 }
@@ -713,8 +717,8 @@ ModelSurface::SharpCorners ModelSurface::sharp_corners() const {
 
 // Marks segment s of the loops L for a split at its middle (on the edge free_piece names),
 // unless it is a needle corner's piece (and does not cross) or already at the floor length.
-void ModelSurface::mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners,
-                              PieceSplits& splits) const {
+void ModelSurface::mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners, PieceSplits& splits,
+                              bool close) const {
   const auto [e, piece] = free_piece(L.seg_edge[s], L.seg_piece[s]);
   if (e < 0) return;
   const bool needle = (piece == 0 && corners.needle_end[e][0]) ||
@@ -722,7 +726,7 @@ void ModelSurface::mark_piece(const Loops& L, int s, bool crossing, const SharpC
   if (!crossing && needle) return;
   const auto& ids = edge_node_[e];
   const double l3 = std::sqrt(sqdist(nodes_[ids[piece]], nodes_[ids[piece + 1]]));
-  if (l3 > hmin_ / 8) splits.pieces[e].push_back(piece), splits.any = true;
+  if (l3 > hmin_ / 8) splits.pieces[e].push_back(piece), splits.any = true, splits.close[e] |= close ? 1 : 0;
 }
 
 // Pieces longer than 1.5 times the face's size field at their middle (finer features nearby
@@ -763,8 +767,8 @@ void ModelSurface::mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, 
                              : std::min({point_segment_distance(A, C, D), point_segment_distance(B, C, D),
                                          point_segment_distance(C, A, B), point_segment_distance(D, A, B)});
       if (d >= gap || (!cross && near_cusp(L, i, j, corners.cusp))) continue;
-      if (cross || len[i] >= 0.7 * len[j]) mark_piece(L, i, cross, corners, splits);
-      if (cross || len[j] >= 0.7 * len[i]) mark_piece(L, j, cross, corners, splits);
+      if (cross || len[i] >= 0.7 * len[j]) mark_piece(L, i, cross, corners, splits, true);
+      if (cross || len[j] >= 0.7 * len[i]) mark_piece(L, j, cross, corners, splits, true);
     }
   }
 }
@@ -814,6 +818,72 @@ void ModelSurface::split_pieces(std::vector<std::vector<int>>& split, std::vecto
       stale[f] = changed[*e];
 }
 
+const char* size_reason_name(SizeReason r) {
+  switch (r) {
+    case SizeReason::MaxSize:
+      return "max size";
+    case SizeReason::Curvature:
+      return "curvature";
+    case SizeReason::MinSize:
+      return "min size";
+    case SizeReason::Neighbour:
+      return "gradation from a neighbour";
+    case SizeReason::ShortEdge:
+      return "short edge";
+    case SizeReason::Proximity:
+      return "proximity";
+    case SizeReason::WallThickness:
+      return "wall thickness";
+    case SizeReason::NonDesign:
+      return "non-design solid";
+  }
+  return "?";
+}
+
+std::vector<FaceSize> ModelSurface::face_sizes() const {
+  std::vector<FaceSize> out;
+  for (int f = 0; f < topo_.num_faces(); ++f) out.push_back(face_size_reason(f));
+  return out;
+}
+
+// Face f's own size and its rule, then the finer candidates: a thin wall's size, boundary
+// pieces below 0.7 of the own size (short edge: the piece is a whole edge; proximity: its
+// edge was split for two close loops; non-design: it ends at a node another model fixed;
+// otherwise graded from a neighbour) and the constraint segments.
+FaceSize ModelSurface::face_size_reason(int f) const {
+  FaceSize r;
+  r.face = f + 1;
+  r.size = r.face_size = face_size_[f];
+  if (geo_[f].kmax > 0 && params_.max_angle / geo_[f].kmax < h_)
+    r.reason = params_.max_angle / geo_[f].kmax <= hmin_ ? SizeReason::MinSize : SizeReason::Curvature;
+  auto consider = [&r](double size, SizeReason why) {
+    if (size < r.size) r.size = size, r.reason = why;
+  };
+  if (!thin_size_[f].empty()) consider(thin_size_[f].smallest(), SizeReason::WallThickness);
+  const double fine = 0.7 * face_size_[f];
+  auto length = [&](int a, int b) { return std::sqrt(sqdist(nodes_[a], nodes_[b])); };
+  for (const int* e = topo_.face_edges.begin(f); e != topo_.face_edges.end(f); ++e) {
+    const std::vector<int>& ids = edge_node_[*e];
+    if (topo_.edge_degenerate[*e] || ids.size() < 2) continue;
+    std::unordered_set<int> fixed;
+    for (const auto& fx : fixed_[*e]) fixed.insert(fx.second);
+    for (size_t i = 0; i + 1 < ids.size(); ++i) {
+      const double l = length(ids[i], ids[i + 1]);
+      if (l >= fine) continue;
+      SizeReason why = SizeReason::Neighbour;
+      if (ids.size() == 2)
+        why = SizeReason::ShortEdge;
+      else if (fixed.count(ids[i]) || fixed.count(ids[i + 1]) || edge_kind_[*e] == EdgeKind::Given)
+        why = SizeReason::NonDesign;
+      else if (split_close_[*e])
+        why = SizeReason::Proximity;
+      consider(l, why);
+    }
+  }
+  for (const auto& c : constraint_[f]) consider(length(c[0], c[1]), SizeReason::NonDesign);
+  return r;
+}
+
 void ModelSurface::constrain_face(int f, int a, int b) {
   if (a == b) return;
   for (const auto& s : constraint_[f])
@@ -835,9 +905,48 @@ void ModelSurface::alias_face(int f, int src, bool reversed) { face_alias_[f] = 
 
 // Step 9 / 11 for one face: the front fills the face's loops in its scaled parameters,
 // honouring the constraint segments and nodes, then the triangles are improved on the
-// surface (constraint nodes and segments fixed).
+// surface (constraint nodes and segments fixed). A face the front cannot fill is retried
+// (face_attempts); the error kept is the first attempt's, with the others' named.
 void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
-  const FaceInput in = face_input(f);
+  const std::vector<FaceAttempt> attempts = face_attempts(f);
+  std::string first_error, tried;
+  for (const FaceAttempt& a : attempts) {
+    try {
+      mesh_face_once(f, a, prog, out);
+      out.attempt = a.name;
+      return;
+    } catch (const Error& err) {
+      if (err.code() == ErrorCode::Cancelled) throw;
+      if (first_error.empty()) first_error = err.what();
+      tried += std::string(tried.empty() ? "" : ", ") + a.name;
+    }
+  }
+  out.error = first_error + " (tried: " + tried + ")";
+}
+
+// The ways a face is filled, in order (params.face_attempts picks some, for tests): its loops
+// as measured; with the gaps between their edges' ends closed; in isotropic parameters (the
+// mean of the two scales, for faces whose scaling varies much); in the unscaled parameters
+// with the gaps closed.
+std::vector<ModelSurface::FaceAttempt> ModelSurface::face_attempts(int f) const {
+  const FaceGeometry& g = geo_[f];
+  const double iso = std::sqrt(g.su * g.sv);
+  const std::vector<FaceAttempt> all{{"as measured", g, false},
+                                     {"loop gaps closed", g, true},
+                                     {"isotropic scaling", {iso, iso, g.kmax}, true},
+                                     {"unscaled parameters", {1, 1, g.kmax}, true}};
+  if (params_.face_attempts.empty()) return all;
+  std::vector<FaceAttempt> some;
+  for (int k : params_.face_attempts)
+    if (k >= 0 && k < static_cast<int>(all.size())) some.push_back(all[k]);
+  return some;
+}
+
+// One attempt at face f: its input in the attempt's parameters, the front, then the surface
+// improvement. Throws the front's Error when it cannot fill the face.
+void ModelSurface::mesh_face_once(int f, const FaceAttempt& a, const Progress& prog, FaceOut& out) const {
+  FaceInput in = face_input(f, a.geo);
+  if (a.close_gaps) close_loop_gaps(in);
   const Loops& L = in.loops;
   FaceFrontInput front;
   front.P.resize(static_cast<long>(L.uv.size()), 2);
@@ -851,32 +960,64 @@ void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
   FaceFrontParams fp = params_.front;
   // size: the face's, but near boundary and constraint pieces finer than that (split by
   // proximity, from a finer neighbour, or from the other model) it grows from their length
-  // at the gradation rate, and inside thin walls from half their thickness
+  // at the gradation rate, and inside thin walls from half their thickness (its raster is in
+  // the measured scaling: q mapped back there)
   const double hf = face_size_[f];
   std::vector<std::array<int, 2>> all_segs = L.segs;
   all_segs.insert(all_segs.end(), in.csegs.begin(), in.csegs.end());
   const PointSizeField fine(fine_points(L.uv, all_segs, hf), hf, grade_);
   const SizeRaster& thin = thin_size_[f];
-  fp.size = [hf, &fine, &thin](const double* q) { return thin.size_at(q, fine.size_at(q, hf)); };
-  FaceFrontResult r;
-  try {
-    r = fill_face(front, fp, prog);
-  } catch (const Error& err) {
-    if (err.code() == ErrorCode::Cancelled) throw;
-    out.error = err.what();
-    return;
-  }
-  improve_on_surface(f, in, r, out);
+  const double back[2] = {geo_[f].su / a.geo.su, geo_[f].sv / a.geo.sv};
+  fp.size = [hf, &fine, &thin, back](const double* q) {
+    const double qm[2] = {q[0] * back[0], q[1] * back[1]};
+    return thin.size_at(qm, fine.size_at(q, hf));
+  };
+  FaceFrontResult r = fill_face(front, fp, prog);
+  improve_on_surface(f, a.geo, in, r, out);
+}
+
+// Loops whose edges' ends do not meet in the parameters (trimmed B-spline faces whose
+// parameter curves leave gaps wider than the merge tolerance of face_loops): a node's copies
+// that only end a segment and those that only start one are the two sides of such a gap,
+// and each such pair (nearest first) becomes one node, also in the constraint segments and
+// isolated nodes. A seam's copies are balanced and stay.
+void ModelSurface::close_loop_gaps(FaceInput& in) {
+  Loops& L = in.loops;
+  const size_t n = L.uv.size();
+  std::vector<int> balance(n, 0);
+  for (const auto& sg : L.segs) ++balance[sg[0]], --balance[sg[1]];
+  std::unordered_map<int, std::vector<int>> copies;  // global node -> its unbalanced local copies
+  for (size_t l = 0; l < n; ++l)
+    if (balance[l] != 0) copies[L.global[l]].push_back(static_cast<int>(l));
+  std::vector<int> to(n);
+  for (size_t l = 0; l < n; ++l) to[l] = static_cast<int>(l);
+  for (auto& [gid, ls] : copies)
+    for (int a : ls)
+      if (balance[a] > 0) {
+        int best = -1;
+        double dbest = 1e300;
+        for (int b : ls)
+          if (balance[b] < 0 && to[b] == b) {
+            const double d = std::hypot(L.uv[a][0] - L.uv[b][0], L.uv[a][1] - L.uv[b][1]);
+            if (d < dbest) dbest = d, best = b;
+          }
+        if (best < 0) continue;
+        to[best] = a;
+        balance[a] += balance[best];
+        balance[best] = 0;
+      }
+  for (auto& sg : L.segs) sg = {to[sg[0]], to[sg[1]]};
+  for (auto& sg : in.csegs) sg = {to[sg[0]], to[sg[1]]};
+  for (int& i : in.isolated) i = to[i];
 }
 
 // Face f's loops in its scaled parameters, then its constraint segments and nodes in the same
 // local numbering: a boundary node takes its local copy (the one nearest the segment's other
 // end on a seam), any other node its parameters by projection onto the surface (appended to
 // the loops' nodes).
-ModelSurface::FaceInput ModelSurface::face_input(int f) const {
+ModelSurface::FaceInput ModelSurface::face_input(int f, const FaceGeometry& g) const {
   const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
-  const FaceGeometry& g = geo_[f];
-  FaceInput in{face_loops(f), {}, {}};
+  FaceInput in{face_loops(f, g), {}, {}};
   std::vector<std::array<double, 2>>& uv = in.loops.uv;
   std::vector<int>& global = in.loops.global;
   std::unordered_map<int, std::vector<int>> locals;
@@ -935,10 +1076,11 @@ ModelSurface::FaceInput ModelSurface::face_input(int f) const {
 // Local optimisation of the front's triangles r judged on the surface; the face's input
 // nodes stay, constraint segments are locked, and triangles collapsed on an apex keep their
 // edges. Leaves the face's mesh in `out`.
-void ModelSurface::improve_on_surface(int f, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const {
+void ModelSurface::improve_on_surface(int f, const FaceGeometry& g, const FaceInput& in, FaceFrontResult& r,
+                                      FaceOut& out) const {
   const TopoDS_Face fwd = TopoDS::Face(topo_.faces(f + 1).Oriented(TopAbs_FORWARD));
   BRepAdaptor_Surface s(fwd, Standard_False);
-  const double su = geo_[f].su, sv = geo_[f].sv;
+  const double su = g.su, sv = g.sv;
   SurfaceEval eval = [&s, su, sv](const double* q, double* x, double* du, double* dv) {
     gp_Pnt p;
     gp_Vec a, b;
@@ -993,6 +1135,7 @@ void ModelSurface::take_face_mesh(int f, const FaceOut& fo) {
     reasons_.push_back(fo.error);
     return;
   }
+  if (fo.attempt != face_attempts(f).front().name) retried_.push_back({f + 1, fo.attempt});
   const long nin = static_cast<long>(fo.global.size());
   std::vector<int> to_global(fo.X.rows(), -1);
   for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];

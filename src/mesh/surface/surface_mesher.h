@@ -38,6 +38,10 @@ struct SurfaceMeshParams {
   int optimize_rounds = 3;  ///< flip + smoothing rounds judged on the surface (0: none)
   int threads = 0;          ///< faces meshed in parallel; 0 = all cores
   FaceFrontParams front;    ///< the face engine's settings (its size is set per face)
+  /// Which ways of filling a face are tried, in order, until one closes (empty: all): 0 its
+  /// loops as measured, 1 with gaps between its edges' ends closed, 2 in isotropic
+  /// parameters, 3 in unscaled parameters (tests pick one to exercise it).
+  std::vector<int> face_attempts;
 };
 
 struct SurfaceMesh {
@@ -46,6 +50,26 @@ struct SurfaceMesh {
   VecXi face;                     ///< #F: the face's number, 1-based as FreeCAD's FaceN
   std::vector<int> failed_faces;  ///< faces that could not be meshed (1-based), with reasons below
   std::vector<std::string> reasons;
+};
+
+/// The rule that sets the size on a face where the face is finest (topopt mesh --stats,
+/// "face_sizes"): the model's size, the face's curvature (max_angle per element), the
+/// smallest size (curvature asked for less), a boundary piece made finer for a neighbour (a
+/// finer face or a curved edge next to it, graded from there), an edge shorter than the size,
+/// two loops of the face close to each other (proximity), a thin wall (wall_layers), or the
+/// segments a non-design solid put on the face.
+enum class SizeReason { MaxSize, Curvature, MinSize, Neighbour, ShortEdge, Proximity, WallThickness, NonDesign };
+
+/// "max size", "curvature", "min size", "gradation from a neighbour", "short edge",
+/// "proximity", "wall thickness", "non-design solid".
+const char* size_reason_name(SizeReason r);
+
+/// Why a face's mesh is as fine as it is.
+struct FaceSize {
+  int face = 0;          ///< 1-based, FreeCAD's FaceN
+  double size = 0;       ///< the finest target size on the face (mm): its own or its finest boundary piece's
+  double face_size = 0;  ///< the face's own size (mm): the model's size or what its curvature allows
+  SizeReason reason = SizeReason::MaxSize;  ///< the rule that gives `size`
 };
 
 /// wall_layers from a user (CLI, job): an integer 0..4, else Error(InvalidParameter) saying so.
@@ -116,6 +140,13 @@ class ModelSurface {
   /// volume's size (BackgroundSize seeds), so the fill puts nodes inside the wall.
   const std::vector<std::array<double, 4>>& wall_points() const { return wall_points_; }
   const std::vector<std::string>& failure_reasons() const { return reasons_; }
+  /// Faces (1-based) the front closed only on a retry, with the way that closed them
+  /// (SurfaceMeshParams::face_attempts).
+  const std::vector<std::pair<int, std::string>>& retried_faces() const { return retried_; }
+  /// Per face (after mesh_edges and the face constraints): its finest size and the rule that
+  /// sets it (FaceSize). A boundary piece counts where it is below 0.7 of the face's own size
+  /// (finer pieces are what the face's fill grows from).
+  std::vector<FaceSize> face_sizes() const;
 
   /// Triangles of solid s (0-based), oriented out of it.
   std::vector<std::array<int, 3>> solid_triangles(int s) const;
@@ -164,10 +195,12 @@ class ModelSurface {
     std::vector<std::array<char, 2>> needle_end;
     std::unordered_set<int> cusp;
   };
-  /// Pieces to split in one proximity round: per edge, the pieces (may repeat); any marked.
+  /// Pieces to split in one proximity round: per edge, the pieces (may repeat); any marked;
+  /// per edge, whether a piece was marked because another loop of a face is close.
   struct PieceSplits {
     std::vector<std::vector<int>> pieces;
     bool any = false;
+    std::vector<char> close;
   };
   /// A face's boundary segments with their lengths and boxes, ordered by their lowest u.
   struct SegmentBoxes {
@@ -187,6 +220,13 @@ class ModelSurface {
     MatX3d X;                 ///< every node of the face's mesh
     MatX3i T;
     std::string error;
+    std::string attempt;  ///< the way of filling that closed the face (face_attempts)
+  };
+  /// One way of filling a face: the parameter scaling and whether loop gaps are closed.
+  struct FaceAttempt {
+    const char* name;
+    FaceGeometry geo;
+    bool close_gaps = false;
   };
 
   // construction: sizes of faces, edges and vertices
@@ -206,18 +246,24 @@ class ModelSurface {
   void split_by_proximity(const Progress& progress);
   std::pair<int, int> free_piece(int e, int piece) const;
   SharpCorners sharp_corners() const;
-  void mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners, PieceSplits& splits) const;
+  void mark_piece(const Loops& L, int s, bool crossing, const SharpCorners& corners, PieceSplits& splits,
+                  bool close = false) const;
   void mark_long_pieces(int f, const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
                         PieceSplits& splits) const;
   void mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
                          PieceSplits& splits) const;
   bool near_cusp(const Loops& L, int i, int j, const std::unordered_set<int>& cusp) const;
   void split_pieces(std::vector<std::vector<int>>& split, std::vector<char>& stale);
+  FaceSize face_size_reason(int f) const;
   // faces
   Loops face_loops(int f) const;
+  Loops face_loops(int f, const FaceGeometry& g) const;
   void mesh_face(int f, const Progress& progress, FaceOut& out) const;
-  FaceInput face_input(int f) const;
-  void improve_on_surface(int f, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const;
+  std::vector<FaceAttempt> face_attempts(int f) const;
+  void mesh_face_once(int f, const FaceAttempt& a, const Progress& progress, FaceOut& out) const;
+  static void close_loop_gaps(FaceInput& in);
+  FaceInput face_input(int f, const FaceGeometry& g) const;
+  void improve_on_surface(int f, const FaceGeometry& g, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const;
   void take_face_mesh(int f, const FaceOut& fo);
   void copy_aliased_face(int f);
   int new_node(double x, double y, double z);
@@ -238,6 +284,7 @@ class ModelSurface {
   std::vector<std::vector<std::pair<double, int>>> fixed_;  ///< (parameter, node) per edge
   std::vector<std::vector<double>> edge_param_;
   std::vector<std::vector<int>> edge_node_;
+  std::vector<char> split_close_;  ///< per edge: split because two loops of a face are close
   std::vector<std::vector<std::array<int, 2>>> constraint_;
   std::vector<std::vector<int>> face_extra_nodes_;
   std::vector<char> face_given_;
@@ -245,6 +292,7 @@ class ModelSurface {
   std::vector<std::vector<std::array<int, 3>>> face_tris_;
   std::vector<int> failed_;
   std::vector<std::string> reasons_;
+  std::vector<std::pair<int, std::string>> retried_;
 };
 
 /// The number of directed edges of the triangles T (#T by 3) not used exactly once each way

@@ -381,6 +381,7 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
   lap("steps 1-7: vertices and edges");
   progress.say("mesh", 0.05, "faces");
   step8_transfer_segments_to_part_faces(s);
+  if (run) run->face_sizes = s.part.face_sizes();
   step9_mesh_part_faces(s);
   step10_transfer_triangles(s);
   step11_mesh_nondesign_faces(s);
