@@ -505,15 +505,49 @@ VecXd Elasticity::element_energy(const VecXd& u) const {
   });
 }
 
+namespace {
+
+/// The stress λ tr(ε) I + 2μ ε of strain eps.
+Eigen::Matrix3d stress_of(const Eigen::Matrix3d& eps, double lambda, double mu) {
+  return lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * mu * eps;
+}
+
+/// von Mises of a stress tensor: √(3/2 s:s), s its deviator.
+double von_mises_of(const Eigen::Matrix3d& s) {
+  const Eigen::Matrix3d dev = s - s.trace() / 3 * Eigen::Matrix3d::Identity();
+  return std::sqrt(1.5 * dev.cwiseAbs2().sum());
+}
+
+}  // namespace
+
 VecXd Elasticity::von_mises(const VecXd& u) const {
   const Impl& m = *impl_;
   return m.per_element_strain(u, [&m](long t, const Eigen::Matrix3d& eps) {
-    Eigen::Matrix3d s = m.scale[t] * (m.lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * m.mu * eps);
-    double d = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) + (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
-                      (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
-               3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
-    return std::sqrt(d);
+    return m.scale[t] * von_mises_of(stress_of(eps, m.lambda, m.mu));
   });
+}
+
+VecXd Elasticity::solid_von_mises(const VecXd& u) const {
+  const Impl& m = *impl_;
+  return m.per_element_strain(
+      u, [&m](long t, const Eigen::Matrix3d& eps) { return von_mises_of(stress_of(eps, m.lambda, m.mu)); });
+}
+
+VecXd Elasticity::solid_von_mises_gradient(const VecXd& u, const VecXd& w) const {
+  const Impl& m = *impl_;
+  VecXd out = VecXd::Zero(u.size());
+  for (long t = 0; t < m.mesh.T.rows(); ++t) {
+    if (w[t] == 0) continue;
+    const Eigen::Matrix3d s = stress_of(element_strain(m.mesh, m.grad, t, u), m.lambda, m.mu);
+    const double vm = von_mises_of(s);
+    if (vm == 0) continue;
+    // dvm/dσ = 3/2 dev(σ)/vm; through σ = λ tr(ε) I + 2μ ε (dev is trace-free): dvm/dε = 3μ dev(σ)/vm;
+    // ε = sym(Σ_a u_a ⊗ g_a), so dvm/du_a = (dvm/dε) g_a
+    const Eigen::Matrix3d G = (3 * m.mu * w[t] / vm) * (s - s.trace() / 3 * Eigen::Matrix3d::Identity());
+    for (int a = 0; a < 4; ++a)
+      out.segment<3>(3 * m.mesh.T(t, a)) += G * Eigen::Map<const Eigen::Vector3d>(&m.grad[12 * t + 3 * a]);
+  }
+  return out;
 }
 
 int Elasticity::num_dofs() const { return 3 * static_cast<int>(impl_->mesh.V.rows()); }

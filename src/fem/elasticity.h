@@ -55,6 +55,15 @@ class Elasticity {
   /// to the stress as SIMP does (σ_e = scale_e · D ε_e).
   VecXd von_mises(const VecXd& u) const;
 
+  /// #T: von Mises stress (MPa) of each element's solid material for displacement u (3*#V),
+  /// σ0_e = D ε_e without the scale: the stress SIMP's relaxed stress scales.
+  VecXd solid_von_mises(const VecXd& u) const;
+
+  /// 3*#V: the gradient w.r.t. u of Σ_e w_e vm0_e(u), vm0 as solid_von_mises; w: #T weights.
+  /// An element with zero stress contributes nothing (vm0 is not differentiable there).
+  /// The adjoint load of an aggregated stress.
+  VecXd solid_von_mises_gradient(const VecXd& u, const VecXd& w) const;
+
   int num_dofs() const;
   const TetMesh& mesh() const;
 

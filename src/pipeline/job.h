@@ -16,11 +16,20 @@
 
 namespace topopt::pipeline {
 
+/// A displacement limit of the job ("displacement_limits"): the mean displacement of faces
+/// along a direction, |u| <= limit; its gauge is built on the mesh (optimize_job).
+struct DisplacementSpec {
+  std::string name;    ///< "displacement_limits[1] (Face7 along (0, 0, -1))"
+  fem::LoadSpec unit;  ///< a force of 1 N along the unit direction, on the faces
+  double limit = 0;    ///< mm, > 0
+};
+
 /// The "optimization" section (docs/optimization.md).
 struct OptimizeSettings {
-  simp::SimpParams simp;  ///< the solver's tolerance 1e-5 unless given
+  simp::SimpParams simp;  ///< the solver's tolerance 1e-5 unless given; responses without gauges
+  std::vector<DisplacementSpec> displacement_limits;
   bool filter_automatic = true;  ///< "filter": "auto" (the default): chosen_filter decides the kind
-  double threshold = -1;  ///< iso-value of the result shape; < 0: the one that meets the volume fraction
+  double threshold = -1;         ///< iso-value of the result shape; < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
   result::HygieneParams hygiene;  ///< loose pieces out, closed voids filled (fill_voids)
 };

@@ -1,5 +1,8 @@
 // The "optimization" section of a job (docs/optimization.md): every SIMP setting typed and
 // range-checked here, once.
+#include <cmath>
+#include <sstream>
+
 #include "common/error.h"
 #include "pipeline/job.h"
 #include "pipeline/job_fields.h"
@@ -58,13 +61,92 @@ void parse_stopping(const Fields& f, simp::SimpParams& p) {
   if (!(p.tol_objective > 0 && p.tol_objective < 1)) f.bad("tol_objective", "must lie in (0, 1)");
 }
 
+/// One entry of "displacement_limits": {"faces": ["Face7"], "direction": [0, 0, -1], "limit": 0.5}.
+DisplacementSpec parse_displacement_limit(const json& item, const std::string& where) {
+  const Fields f(item, where, {"faces", "direction", "limit"},
+                 "{\"faces\": [\"Face7\"], \"direction\": [0, 0, -1], \"limit\": 0.5}");
+  DisplacementSpec d;
+  d.unit.kind = fem::LoadSpec::Kind::Force;
+  const std::string form =
+      "must be a non-empty list of face names such as [\"Face7\"]: the faces whose mean "
+      "displacement is limited";
+  if (!f.has("faces") || !f.at("faces").is_array() || f.at("faces").empty()) f.bad("faces", form);
+  for (const auto& name : f.at("faces")) {
+    if (!name.is_string()) f.bad("faces", form);
+    parse_face_name(name.get<std::string>(), d.unit.faces, d.unit.nd_faces);
+  }
+  const std::array<double, 3> v = f.vec3("direction");
+  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(n > 0))
+    f.bad("direction", "must not be zero: give the direction of the displacement to limit, e.g. [0, 0, -1]");
+  d.unit.vector = {v[0] / n, v[1] / n, v[2] / n};
+  if (!f.has("limit")) f.bad("limit", "is missing: the largest displacement allowed along the direction, in mm");
+  d.limit = f.number("limit", 0);
+  if (!(d.limit > 0 && d.limit < 1e6)) f.bad("limit", "must lie in (0, 1e6) mm");
+  std::ostringstream s;
+  s << where << " (" << f.at("faces").dump() << " along (" << d.unit.vector[0] << ", " << d.unit.vector[1] << ", "
+    << d.unit.vector[2] << "))";
+  d.name = s.str();
+  return d;
+}
+
+/// "objective", "compliance_limit", "displacement_limits" and the stress limit's keys; the update defaults to MMA when
+/// they ask for more than compliance under a volume fraction, and "oc" is refused then.
+void parse_responses(const Fields& f, OptimizeSettings& s) {
+  simp::ResponseParams& r = s.simp.responses;
+  const std::string objective = f.choice("objective", "compliance", {"compliance", "mass", "frequency"},
+                                         "compliance: stiffest design of the volume fraction; mass: lightest design "
+                                         "within the limits; frequency: the highest first eigenfrequency of the volume "
+                                         "fraction");
+  r.objective = objective == "mass"        ? simp::Objective::Mass
+                : objective == "frequency" ? simp::Objective::Frequency
+                                           : simp::Objective::Compliance;
+  r.compliance_limit = f.number("compliance_limit", 0);
+  if (f.has("compliance_limit") && !(r.compliance_limit > 0 && r.compliance_limit < 1e15))
+    f.bad("compliance_limit", "must be a positive compliance in N·mm (Σ weight × Fᵀu), below 1e15");
+  if (f.has("compliance_limit") && r.objective != simp::Objective::Mass)
+    f.bad("compliance_limit", "goes with \"objective\": \"mass\" only");
+  if (f.has("displacement_limits")) {
+    const json& list = f.at("displacement_limits");
+    if (!list.is_array()) f.bad("displacement_limits", "must be a list of {\"faces\", \"direction\", \"limit\"}");
+    for (size_t i = 0; i < list.size(); ++i)
+      s.displacement_limits.push_back(
+          parse_displacement_limit(list[i], f.name("displacement_limits") + "[" + std::to_string(i) + "]"));
+  }
+  r.stress_limit = f.number("stress_limit", 0);
+  if (f.has("stress_limit") && !(r.stress_limit > 0 && r.stress_limit < 1e9))
+    f.bad("stress_limit",
+          "must be a positive von Mises stress in MPa, below 1e9 (e.g. the yield stress / a safety factor)");
+  r.stress_pnorm = f.number("stress_pnorm", r.stress_pnorm);
+  if (!(r.stress_pnorm >= 2 && r.stress_pnorm <= 64))
+    f.bad("stress_pnorm",
+          "must lie in [2, 64] (8 is usual; larger follows the largest stress closer but converges worse)");
+  r.stress_relaxation = f.number("stress_relaxation", r.stress_relaxation);
+  if (!(r.stress_relaxation > 0 && r.stress_relaxation <= 1))
+    f.bad("stress_relaxation", "must lie in (0, 1] (0.5 is usual: the exponent q of the relaxed stress ρ^q σ)");
+  if (r.objective == simp::Objective::Mass && r.compliance_limit <= 0 && s.displacement_limits.empty() &&
+      r.stress_limit <= 0)
+    f.bad("objective",
+          "\"mass\" needs a limit: add \"compliance_limit\" (N·mm), \"displacement_limits\" or \"stress_limit\" (MPa)");
+  const bool beyond =
+      r.objective != simp::Objective::Compliance || !s.displacement_limits.empty() || r.stress_limit > 0;
+  if (beyond && f.has("update") && s.simp.update == simp::UpdateKind::OC)
+    f.bad("update",
+          "must be \"mma\" with a mass objective, displacement limits or a stress limit (OC handles one volume "
+          "constraint only); leave it out to get MMA");
+  if (beyond) s.simp.update = simp::UpdateKind::MMA;
+}
+
 }  // namespace
 
 OptimizeSettings parse_optimization(const json& section) {
   const Fields f(section, "optimization",
                  {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver",
                   "sensitivity_filter", "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective",
-                  "threshold", "solver", "solver_tolerance", "smoothing_iterations", "fill_voids"},
+                  "threshold", "solver", "solver_tolerance", "smoothing_iterations", "fill_voids",
+                  // objectives and constraints (parse_responses)
+                  "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm",
+                  "stress_relaxation"},
                  "{\"volume_fraction\": 0.3}");
   OptimizeSettings s;
   simp::SimpParams& p = s.simp;
@@ -93,6 +175,7 @@ OptimizeSettings parse_optimization(const json& section) {
                  : simp::UpdateKind::OC;
   parse_solver(f, p.solver);
   parse_stopping(f, p);
+  parse_responses(f, s);
   s.threshold = f.number("threshold", -1);
   if (f.has("threshold") && !(s.threshold > 0 && s.threshold < 1))
     f.bad("threshold", "must lie strictly between 0 and 1, or be null for the one that keeps the volume fraction");

@@ -58,7 +58,11 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
                             {"change", h.change},
                             {"beta", h.beta},
                             {"grey", h.grey},
-                            {"seconds", h.seconds}});
+                            {"seconds", h.seconds},
+                            {"displacements", h.displacements},
+                            {"stress", h.stress},
+                            {"frequency", h.frequency},
+                            {"frequency_repeated", h.repeated}});
   std::ofstream f(path);
   f << j.dump(2) << "\n";
   if (!f) throw Error(ErrorCode::Io, "cannot write the iteration history (disk full?)");
@@ -113,6 +117,9 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   if (!filter_note.empty()) progress.info(filter_note);
   std::vector<double> weights;
   for (const auto& lc : job.load_cases) weights.push_back(lc.weight);
+  for (const DisplacementSpec& d : set.displacement_limits)
+    simp.responses.displacements.push_back(
+        {d.name, fem::make_loads(mesh, job.material, {fem::LoadCase{d.name, {d.unit}, 1}}).col(0), d.limit});
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
   r.simp = simp::optimize(mesh, job.material, supports, loads, weights, simp, progress, on_iteration,
@@ -120,7 +127,11 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   if (const std::string w = not_crisp_warning(r.simp, simp); !w.empty()) progress.warn(w);
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
-  r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold,
+  // the shape keeps the volume SIMP ended with (under a mass objective, what the limits left)
+  const double kept = simp.responses.objective == simp::Objective::Mass && !r.simp.history.empty()
+                          ? r.simp.history.back().volume_fraction
+                          : set.simp.volume_fraction;
+  r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold,
                              anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();

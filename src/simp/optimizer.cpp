@@ -8,6 +8,7 @@
 #include "common/blas_threads.h"
 #include "common/error.h"
 #include "simp/density_filter.h"
+#include "simp/responses/responses.h"
 #include "simp/update.h"
 
 namespace topopt::simp {
@@ -96,10 +97,9 @@ VecXd ComplianceProblem::physical(const VecXd& x) const {
 
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   const int num_design = static_cast<int>(design_.size());
-  VecXd rho_tilde, rho_bar;
-  forward(x, rho_tilde, rho_bar);
+  forward(x, rho_tilde_, rho_bar_);
   // ---- FE analysis
-  for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar[i]);
+  for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar_[i]);
   fe_->set_scale(scale_);
   // loads: the design tets' weight scaled by ρ̄ (loads_ holds it at ρ̄ = 1), spread to 4 nodes
   Eigen::MatrixXd F = loads_;
@@ -107,32 +107,45 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
     for (int i = 0; i < num_design; ++i)
       for (long k = 0; k < F.cols(); ++k)
         for (int a = 0; a < 4; ++a)
-          F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += (rho_bar[i] - 1) * quarter_mass_[i] * gravity_.col(k);
-  Eigen::MatrixXd U = fe_->solve(F, progress_);
+          F.block<3, 1>(3 * mesh_.T(design_[i], a), k) += (rho_bar_[i] - 1) * quarter_mass_[i] * gravity_.col(k);
+  U_ = fe_->solve(F, progress_);
   // ---- objective c = Σ w Fᵀ U and its sensitivities (w.r.t. ρ̄):
   // dc/dρ̄ = Σ w (2 uᵀ dF/dρ̄ − E'(ρ̄) uᵀ K₀ u) for each element
   double c = 0;
   VecXd dc_bar = VecXd::Zero(num_design);
   for (long k = 0; k < F.cols(); ++k) {
-    c += weights_[k] * F.col(k).dot(U.col(k));
-    if (!dc) continue;
-    VecXd energy = fe_->element_energy(U.col(k));
-    for (int i = 0; i < num_design; ++i)
-      dc_bar[i] -= weights_[k] * params_.law.derivative(rho_bar[i]) * energy[design_[i]];
-    if (gravity_.size())
-      for (int i = 0; i < num_design; ++i) {
-        Eigen::Vector3d u_sum = Eigen::Vector3d::Zero();
-        for (int a = 0; a < 4; ++a) u_sum += U.block<3, 1>(3 * mesh_.T(design_[i], a), k);
-        dc_bar[i] += weights_[k] * 2 * quarter_mass_[i] * gravity_.col(k).dot(u_sum);
-      }
+    c += weights_[k] * F.col(k).dot(U_.col(k));
+    if (dc) dc_bar += weights_[k] * (load_derivative(2 * U_.col(k), k) - stiffness_derivative(U_.col(k), U_.col(k)));
   }
-  if (dc) {
-    // ---- chain rule back through projection and filter
-    if (params_.projection.enabled)
-      for (int i = 0; i < num_design; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
-    *dc = params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar);
-  }
+  if (dc) *dc = chain(rho_tilde_, dc_bar);
   return c;
+}
+
+VecXd ComplianceProblem::chain(const VecXd& rho_tilde, VecXd d_bar) const {
+  if (params_.projection.enabled)
+    for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= proj_.derivative(rho_tilde[i]);
+  return params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar);
+}
+
+VecXd ComplianceProblem::stiffness_derivative(const VecXd& a, const VecXd& b) const {
+  // aᵀK0b per element by polarisation: ((a+b)ᵀK0(a+b) − (a−b)ᵀK0(a−b)) / 4
+  const bool same = &a == &b || a == b;
+  const VecXd energy =
+      same ? fe_->element_energy(a) : VecXd((fe_->element_energy(a + b) - fe_->element_energy(a - b)) / 4);
+  VecXd d(design_.size());
+  for (long i = 0; i < d.size(); ++i) d[i] = params_.law.derivative(rho_bar_[i]) * energy[design_[i]];
+  return d;
+}
+
+VecXd ComplianceProblem::load_derivative(const VecXd& w, long k) const {
+  VecXd d = VecXd::Zero(design_.size());
+  if (!gravity_.size()) return d;
+  for (long i = 0; i < d.size(); ++i) {
+    Eigen::Vector3d w_sum = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) w_sum += w.segment<3>(3 * mesh_.T(design_[i], a));
+    d[i] = quarter_mass_[i] * gravity_.col(k).dot(w_sum);
+  }
+  return d;
 }
 
 double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
@@ -143,10 +156,7 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
   VecXd rho_tilde, rho_bar;
   forward(x, rho_tilde, rho_bar);
   if (dv) {
-    VecXd g = vd_ / design_volume_;
-    if (params_.projection.enabled)
-      for (long i = 0; i < g.size(); ++i) g[i] *= proj_.derivative(rho_tilde[i]);
-    *dv = params_.sensitivity_filter ? g : filter_->apply_transpose(g);
+    *dv = chain(rho_tilde, vd_ / design_volume_);
   }
   return vd_.dot(rho_bar) / design_volume_;
 }
@@ -176,22 +186,17 @@ MoveLimits move_limits(const SimpParams& params, int num_design) {
 /// oscillates, or MMA; both keep what they need from earlier iterations.
 class DesignUpdate {
  public:
-  DesignUpdate(const SimpParams& params, int num_design)
-      : params_(params), mma_(num_design, 1, params.move), moves_(move_limits(params, num_design)) {}
+  DesignUpdate(const SimpParams& params, int num_design, int num_constraints)
+      : params_(params), mma_(num_design, num_constraints, params.move), moves_(move_limits(params, num_design)) {}
 
-  /// The next design from x (#D) with compliance c, volume fraction vol and their
-  /// sensitivities dc, dv (#D).
-  VecXd step(const ComplianceProblem& problem, const VecXd& x, double c, const VecXd& dc, double vol, const VecXd& dv) {
+  /// The next design from x (#D) with compliance sensitivities dc and volume ones dv (#D) for
+  /// OC, or the objective and constraints `mma` (responses/responses.h) for MMA.
+  VecXd step(const ComplianceProblem& problem, const VecXd& x, const VecXd& dc, const VecXd& dv, const MmaTerms& mma) {
     if (params_.update == UpdateKind::OC) {
       auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params_.volume_fraction; };
       return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess);
     }
-    // objective scaled to about 1 so MMA's regularisation terms are well sized
-    const double s = 1.0 / std::max(1e-300, std::abs(c));
-    VecXd f(1);
-    f[0] = vol / params_.volume_fraction - 1;
-    const Eigen::MatrixXd df = (dv / params_.volume_fraction).transpose();
-    return mma_.update(x, c * s, dc * s, f, df);
+    return mma_.update(x, mma.f0, mma.df0, mma.f, mma.df);
   }
 
   /// The problem changed (β raised): the oscillation history no longer applies.
@@ -214,6 +219,10 @@ void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult
   std::ostringstream msg;
   msg << "iteration " << rec.iteration << ": compliance " << rec.compliance << ", volume " << rec.volume_fraction
       << ", change " << rec.change;
+  for (double u : rec.displacements) msg << ", displacement " << u << " mm";
+  if (rec.stress > 0) msg << ", stress " << rec.stress << " MPa";
+  if (rec.frequency > 0)
+    msg << ", first eigenfrequency " << rec.frequency << " Hz" << (rec.repeated ? " (repeated)" : "");
   if (rec.beta != 1) msg << ", beta " << rec.beta << ", grey " << 100 * rec.grey << " %";
   progress.say("simp", static_cast<double>(rec.iteration) / max_iterations, msg.str());
 }
@@ -236,7 +245,9 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   SimpResult res;
   res.design = problem.design();
   const int num_design = static_cast<int>(res.design.size());
-  DesignUpdate update(params, num_design);
+  check_responses(params, 3 * mesh.V.rows());
+  Responses responses(params, material.density);
+  DesignUpdate update(params, num_design, responses.constraints(static_cast<int>(loads.cols())));
   Continuation schedule(params.projection, params.tol_change, params.tol_objective);
   VecXd x = VecXd::Constant(num_design, params.volume_fraction);
   for (int it = 1; it <= params.max_iterations; ++it) {
@@ -250,13 +261,24 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     // ---- filter (sensitivity filtering; the density filter is inside the chain rule)
     if (params.sensitivity_filter) dc = problem.filter_sensitivity(x, dc);
     // ---- update
-    const VecXd xnew = update.step(problem, x, c, dc, vol, dv);
-    IterationRecord rec{it, c, vol, (xnew - x).cwiseAbs().maxCoeff(), schedule.beta(), problem.grey_share(x), 0};
+    const MmaTerms mma = params.update == UpdateKind::MMA ? responses.terms(problem, c, dc, vol, dv) : MmaTerms{};
+    const VecXd xnew = update.step(problem, x, dc, dv, mma);
+    IterationRecord rec{it,
+                        c,
+                        vol,
+                        (xnew - x).cwiseAbs().maxCoeff(),
+                        schedule.beta(),
+                        problem.grey_share(x),
+                        0,
+                        mma.displacements,
+                        mma.stress,
+                        mma.frequency,
+                        mma.repeated};
     x = xnew;
     rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     report_iteration(rec, params.max_iterations, res, on_iteration, progress);
     // ---- continuation and convergence (judged at the final β only)
-    const NextStep next = schedule.next(c, rec.change);
+    const NextStep next = schedule.next(params.update == UpdateKind::MMA ? mma.objective : c, rec.change);
     if (next == NextStep::Converged) {
       res.converged = true;
       res.status = "converged after " + std::to_string(it) + " iterations";

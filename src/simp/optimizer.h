@@ -12,6 +12,7 @@
 #include "fem/elasticity.h"
 #include "simp/continuation.h"
 #include "simp/filter.h"
+#include "simp/responses/response_params.h"
 #include "simp/simp_law.h"
 
 namespace topopt::simp {
@@ -30,6 +31,7 @@ struct SimpParams {
   double tol_change = 0.01;     ///< stop when max |Δx| falls below this
   double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
+  ResponseParams responses;  ///< objective and limits beyond the volume fraction (responses/)
 };
 
 /// One iteration, as reported to the caller and kept in the history.
@@ -41,6 +43,14 @@ struct IterationRecord {
   double beta = 1;             ///< Heaviside sharpness (1 without projection)
   double grey = 0;             ///< share of the design volume with 0.1 < ρ̄ < 0.9
   double seconds = 0;          ///< wall time of this iteration
+  /// Per DisplacementLimit, the largest |u_d| over the load cases (mm); empty without limits.
+  std::vector<double> displacements;
+  /// With a stress limit: the largest relaxed von Mises stress ρ̄^q σ0 of the elements (MPa).
+  double stress = 0;
+  /// Frequency objective: the first eigenfrequency (Hz), and whether the second equals it
+  /// (within 0.1 %: the eigenvalue's gradient is then not defined).
+  double frequency = 0;
+  bool repeated = false;
 };
 
 struct SimpResult {
@@ -75,7 +85,20 @@ class ComplianceProblem {
   /// Sensitivities of compliance filtered by Sigmund's filter (when params ask for it).
   VecXd filter_sensitivity(const VecXd& x, const VecXd& dc) const;
   const std::vector<int>& design() const { return design_; }
-  double beta() const { return proj_.beta; }
+  /// The displacements U ((3*#V) by #cases) of the last compliance() call.
+  const Eigen::MatrixXd& displacements() const { return U_; }
+  /// #D: the physical densities ρ̄ of the last compliance() call.
+  const VecXd& physical_densities() const { return rho_bar_; }
+  /// The FE model (for adjoint solves with the stiffness of the last compliance() call).
+  fem::Elasticity& elasticity() { return *fe_; }
+  /// Chain rule: a sensitivity w.r.t. the physical densities ρ̄ (#D) of the last compliance()
+  /// call's x turned into one w.r.t. the design variables x (#D), through projection and filter.
+  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_tilde_, d_bar); }
+  /// #D: E'(ρ̄_i) a_iᵀ K0_i b_i for the densities of the last compliance() call; a, b: 3*#V
+  /// (the stiffness term of an adjoint sensitivity, −this for λ = a, u = b).
+  VecXd stiffness_derivative(const VecXd& a, const VecXd& b) const;
+  /// #D: wᵀ ∂F_k/∂ρ̄_i, the self-weight's share of load case k (zero without gravity); w: 3*#V.
+  VecXd load_derivative(const VecXd& w, long k) const;
   void set_beta(double b) { proj_.beta = b; }
 
  private:
@@ -94,6 +117,10 @@ class ComplianceProblem {
   Heaviside proj_;
   Progress progress_;
   VecXd scale_;
+  Eigen::MatrixXd U_;  // displacements of the last compliance() call
+  VecXd rho_tilde_;    // #D: its filtered densities
+  VecXd rho_bar_;      // #D: its physical densities
+  VecXd chain(const VecXd& rho_tilde, VecXd d_bar) const;
   void forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const;
 };
 

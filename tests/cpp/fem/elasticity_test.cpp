@@ -232,6 +232,37 @@ TEST(Elasticity, SymmetricHalfEqualsFullModel) {
   EXPECT_GT(Uh.cwiseAbs().maxCoeff(), 0);
 }
 
+TEST(Elasticity, SolidVonMisesAndItsGradient) {
+  // a uniaxial strain field: von Mises of σ = λ tr ε I + 2μ ε by hand, unscaled by set_scale
+  TetMesh m = box({3, 2, 2}, {3, 2, 2});
+  distort(m, 1.0, 0.2, 5);
+  const Material mat;
+  Elasticity fe(m, mat, Supports{});
+  fe.set_scale(VecXd::Constant(m.T.rows(), 0.25));
+  VecXd u(3 * m.V.rows());
+  for (long n = 0; n < m.V.rows(); ++n) u.segment<3>(3 * n) = Eigen::Vector3d(1e-3 * m.V(n, 0), 0, 0);
+  const double lambda = mat.young * mat.poisson / ((1 + mat.poisson) * (1 - 2 * mat.poisson));
+  const double mu = mat.young / (2 * (1 + mat.poisson));
+  const double sx = (lambda + 2 * mu) * 1e-3, sy = lambda * 1e-3;  // σ_yy = σ_zz
+  const VecXd vm = fe.solid_von_mises(u);
+  for (long t = 0; t < m.T.rows(); ++t) EXPECT_NEAR(vm[t], std::abs(sx - sy), 1e-9 * std::abs(sx - sy));
+  EXPECT_NEAR(fe.von_mises(u)[0], 0.25 * vm[0], 1e-12 * vm[0]);
+  // the gradient of Σ w_e vm_e against central differences at a random field
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> r(-1e-3, 1e-3);
+  for (long i = 0; i < u.size(); ++i) u[i] = r(rng);
+  VecXd w(m.T.rows());
+  for (long t = 0; t < w.size(); ++t) w[t] = 1 + std::abs(r(rng)) * 1e3;
+  const VecXd g = fe.solid_von_mises_gradient(u, w);
+  const double h = 1e-8;  // u ~ 1e-3: truncation ~ (h/u)² against round-off ~ 1e-16 u / h
+  for (long i : {0L, 7L, static_cast<long>(u.size() / 2), static_cast<long>(u.size() - 1)}) {
+    VecXd up = u, um = u;
+    up[i] += h, um[i] -= h;
+    const double fd = (w.dot(fe.solid_von_mises(up)) - w.dot(fe.solid_von_mises(um))) / (2 * h);
+    EXPECT_NEAR(g[i], fd, 1e-5 * std::abs(fd)) << "dof " << i;
+  }
+}
+
 TEST(Elasticity, SingularSystemsAreReportedNotSolved) {
   TetMesh m = box({4, 2, 2}, {2, 1, 1});
   Material mat;

@@ -208,6 +208,59 @@ TEST(Job, EveryRangeIsCheckedWithWhatToGive) {
                  ErrorCode::InvalidParameter, {"'load_cases[0].loads[0].value'", "MPa"});
 }
 
+TEST(Job, ObjectivesAndLimitsAreTypedAndChecked) {
+  const Job j = parse_job(R"({"optimization": {"objective": "mass", "compliance_limit": 250,
+      "displacement_limits": [{"faces": ["Face7", "NonDesign:Face2"], "direction": [0, 0, -2], "limit": 0.5}]}})",
+                          "/tmp");
+  const simp::ResponseParams& r = j.optimization.simp.responses;
+  EXPECT_EQ(r.objective, simp::Objective::Mass);
+  EXPECT_EQ(r.compliance_limit, 250);
+  EXPECT_EQ(j.optimization.simp.update, simp::UpdateKind::MMA);  // the default with a mass objective
+  ASSERT_EQ(j.optimization.displacement_limits.size(), 1u);
+  const DisplacementSpec& d = j.optimization.displacement_limits[0];
+  EXPECT_EQ(d.unit.faces, std::vector<int>{7});
+  EXPECT_EQ(d.unit.nd_faces, std::vector<int>{2});
+  EXPECT_DOUBLE_EQ(d.unit.vector[2], -1);  // normalised: a force of 1 N
+  EXPECT_EQ(d.limit, 0.5);
+  // the default stays compliance under the volume fraction, with OC
+  const Job plain = parse_job(R"({"optimization": {}})", "/tmp");
+  EXPECT_EQ(plain.optimization.simp.responses.objective, simp::Objective::Compliance);
+  EXPECT_EQ(plain.optimization.simp.update, simp::UpdateKind::OC);
+  expect_message(R"({"optimization": {"objective": "mass"}})", ErrorCode::InvalidParameter,
+                 {"'optimization.objective'", "compliance_limit", "displacement_limits"});
+  const Job fr = parse_job(R"({"optimization": {"objective": "frequency", "stress_limit": 200, "stress_pnorm": 12,
+      "stress_relaxation": 0.6}})",
+                           "/tmp");
+  EXPECT_EQ(fr.optimization.simp.responses.objective, simp::Objective::Frequency);
+  EXPECT_EQ(fr.optimization.simp.responses.stress_limit, 200);
+  EXPECT_EQ(fr.optimization.simp.responses.stress_pnorm, 12);
+  EXPECT_EQ(fr.optimization.simp.responses.stress_relaxation, 0.6);
+  EXPECT_EQ(fr.optimization.simp.update, simp::UpdateKind::MMA);
+  expect_message(R"({"optimization": {"stress_limit": 0}})", ErrorCode::InvalidParameter,
+                 {"'optimization.stress_limit' must be a positive von Mises stress in MPa"});
+  expect_message(R"({"optimization": {"stress_pnorm": 1}})", ErrorCode::InvalidParameter,
+                 {"'optimization.stress_pnorm' must lie in [2, 64]"});
+  expect_message(R"({"optimization": {"stress_relaxation": 0}})", ErrorCode::InvalidParameter,
+                 {"'optimization.stress_relaxation' must lie in (0, 1]"});
+  expect_message(R"({"optimization": {"objective": "weight"}})", ErrorCode::InvalidParameter,
+                 {"'optimization.objective'"});
+  expect_message(R"({"optimization": {"compliance_limit": 10}})", ErrorCode::InvalidParameter,
+                 {"'optimization.compliance_limit'", "\"objective\": \"mass\""});
+  expect_message(R"({"optimization": {"objective": "mass", "compliance_limit": -1}})", ErrorCode::InvalidParameter,
+                 {"'optimization.compliance_limit' must be a positive compliance"});
+  expect_message(R"({"optimization": {"objective": "mass", "compliance_limit": 1, "update": "oc"}})",
+                 ErrorCode::InvalidParameter, {"'optimization.update' must be \"mma\""});
+  expect_message(R"({"optimization": {"displacement_limits": [{"faces": ["Face1"], "direction": [0, 0, 0],
+                 "limit": 1}]}})",
+                 ErrorCode::InvalidParameter, {"'optimization.displacement_limits[0].direction' must not be zero"});
+  expect_message(R"({"optimization": {"displacement_limits": [{"faces": ["Face1"], "direction": [0, 0, 1]}]}})",
+                 ErrorCode::InvalidParameter, {"'optimization.displacement_limits[0].limit' is missing"});
+  expect_message(R"({"optimization": {"displacement_limits": [{"faces": [], "direction": [0, 0, 1], "limit": 1}]}})",
+                 ErrorCode::InvalidParameter, {"'optimization.displacement_limits[0].faces'"});
+  expect_message(R"({"optimization": {"displacement_limits": [{"face": ["Face1"]}]}})", ErrorCode::InvalidParameter,
+                 {"'optimization.displacement_limits[0].face'", "faces"});
+}
+
 TEST(Job, AForceNoPartCanCarryIsRefusedBeforeTheSolver) {
   // 1e308 N would overflow the solver's products and come back as "the structure is not held"
   expect_message(R"({"load_cases": [{"loads": [{"faces": ["Face1"], "vector": [0, 0, 1e308]}]}]})",

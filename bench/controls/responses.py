@@ -1,0 +1,154 @@
+#!/usr/bin/python3
+"""Objectives and constraints (issue 22, part B) on the cantilever and the bracket.
+
+For each example (suggested load cases of ../shared/data/README.md, steel) this script runs, in
+one go on one mesh size, with OMP_NUM_THREADS as given (default 1):
+- "compliance": the default, compliance at volume fraction 0.3 (the reference);
+- "mass | compliance": the lightest design whose compliance stays within 1.25 × the reference's;
+- "mass | stress": the lightest design whose largest (relaxed) von Mises stress stays within
+  twice the full part's (measured by a one-iteration run of the same job);
+- "frequency": the highest first eigenfrequency at volume fraction 0.3.
+Each row: final volume fraction, compliance, largest relaxed stress, first eigenfrequency (when
+computed), iterations, SIMP wall time and CPU time of the whole command; a picture of each
+result.stl (matplotlib, isometric) is written next to the outputs.
+
+usage: bench/controls/responses.py [--build build] [--work /tmp/topopt-bench-responses]
+                                   [--only cantilever,bracket] [--iterations 120]
+Prints Markdown for BENCHMARKS.md.
+"""
+import argparse, json, os, resource, struct, subprocess, sys, time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
+
+EXAMPLES = {
+    "cantilever": (2.0, {"supports": [{"type": "fixed", "faces": ["Face1"]}],
+                         "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["NonDesign:Face12"],
+                                                                   "vector": [0, 0, -1000]}]}]}),
+    # bolt bores Face10-13 fixed; pin bore Face7: 5000 N along +x, and separately along -z
+    "bracket": (3.0, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
+                      "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
+                                     {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
+}
+
+
+def run(cmd, threads):
+    """Runs a command; returns (wall s, CPU s of the child)."""
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode:
+        sys.exit(" ".join(cmd) + " failed:\n" + p.stdout[-3000:] + p.stderr[-3000:])
+    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def optimize(a, name, tag, optimization):
+    """One `topopt optimize` of example `name` with the given optimisation section."""
+    size, problem = EXAMPLES[name]
+    out = os.path.join(a.work, name + "_" + tag)
+    job = {"part": os.path.join(DATA, name + ".step"), "nondesign": os.path.join(DATA, name + "_nondesign.step"),
+           "mesh": {"size": size}, "material": {"E": 210000.0, "nu": 0.3}, "optimization": optimization,
+           "output": {"directory": out}}
+    job.update(problem)
+    path = out + ".json"
+    json.dump(job, open(path, "w"), indent=1)
+    wall, cpu = run([os.path.join(a.build, "topopt"), "optimize", path, "--quiet"], a.threads)
+    h = json.load(open(os.path.join(out, "history.json")))
+    return h, wall, cpu, out
+
+
+def read_stl(path):
+    """Triangles (n, 3, 3) of a binary or ASCII STL."""
+    data = open(path, "rb").read()
+    if data[:5] != b"solid" or b"facet" not in data[:300]:
+        n = struct.unpack("<I", data[80:84])[0]
+        return [[struct.unpack("<3f", data[84 + 50 * i + 12 + 12 * k:84 + 50 * i + 24 + 12 * k]) for k in range(3)]
+                for i in range(n)]
+    tris, cur = [], []
+    for line in data.decode().splitlines():
+        w = line.split()
+        if w and w[0] == "vertex":
+            cur.append(tuple(float(x) for x in w[1:4]))
+            if len(cur) == 3:
+                tris.append(cur)
+                cur = []
+    return tris
+
+
+def picture(stl, png, title):
+    """An isometric, shaded picture of the result surface."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    tris = np.array(read_stl(stl))
+    if len(tris) == 0:
+        return
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1)[:, None], 1e-30)
+    light = np.array([0.4, -0.5, 0.75])
+    shade = 0.35 + 0.65 * np.clip(n @ (light / np.linalg.norm(light)), 0, 1)
+    fig = plt.figure(figsize=(8, 6))
+    ax = fig.add_subplot(projection="3d")
+    ax.add_collection3d(Poly3DCollection(tris, facecolors=np.outer(shade, [0.55, 0.65, 0.85]), edgecolor="none"))
+    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
+    c, r = (lo + hi) / 2, (hi - lo).max() / 2
+    ax.set_xlim(c[0] - r, c[0] + r), ax.set_ylim(c[1] - r, c[1] + r), ax.set_zlim(c[2] - r, c[2] + r)
+    ax.view_init(elev=25, azim=-60)
+    ax.set_title(title)
+    ax.set_axis_off()
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--work", default="/tmp/topopt-bench-responses")
+    ap.add_argument("--only", default="cantilever,bracket")
+    ap.add_argument("--iterations", type=int, default=120)
+    ap.add_argument("--threads", type=int, default=1)
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    print("## Objectives and constraints (bench/controls/responses.py)\n")
+    print("Steel, MMA for every row but the reference (OC), Heaviside projection on, at most %d iterations, "
+          "OMP_NUM_THREADS=%d. Volume: share of the design domain; stress: the largest relaxed element von Mises "
+          "stress ρ̄^0.5 σ (MPa) of SIMP's last iteration; frequency: the first eigenfrequency (Hz).\n"
+          % (a.iterations, a.threads))
+    print("| example | run | limit | volume | compliance (N·mm) | stress (MPa) | frequency (Hz) | iterations | "
+          "SIMP (s) | CPU (s) | picture |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    base = {"max_iterations": a.iterations}
+    for name in a.only.split(","):
+        ref, wall, cpu, out = optimize(a, name, "compliance", dict(base, volume_fraction=0.3))
+        c_ref = ref["history"][-1]["compliance"]
+        probe, _, _, _ = optimize(a, name, "probe", {"objective": "mass", "stress_limit": 1.0, "volume_fraction": 0.999,
+                                                     "max_iterations": 1, "heaviside": False})
+        s_full = probe["history"][0]["stress"]
+        runs = [("compliance", "vf 0.3", ref, wall, cpu, out)]
+        for tag, limit, opt in (
+                ("mass_compliance", "c ≤ %.4g" % (1.25 * c_ref),
+                 dict(base, objective="mass", compliance_limit=1.25 * c_ref, volume_fraction=0.5)),
+                ("mass_stress", "σ ≤ %.4g (2 × full part)" % (2 * s_full),
+                 dict(base, objective="mass", stress_limit=2 * s_full, volume_fraction=0.6)),
+                ("frequency", "vf 0.3", dict(base, objective="frequency", volume_fraction=0.3))):
+            h, wall, cpu, out = optimize(a, name, tag, opt)
+            runs.append((tag, limit, h, wall, cpu, out))
+        for tag, limit, h, wall, cpu, out in runs:
+            last = h["history"][-1]
+            png = out + ".png"
+            picture(os.path.join(out, "result.stl"), png, "%s: %s" % (name, tag))
+            freq = "%.1f → %.1f" % (h["history"][0]["frequency"], last["frequency"]) if last.get("frequency") else "–"
+            stress = "%.1f" % last["stress"] if last.get("stress") else "–"
+            print("| %s | %s | %s | %.3f | %.4g | %s | %s | %d | %.1f | %.1f | %s |"
+                  % (name, tag, limit, last["volume"], last["compliance"], stress, freq, len(h["history"]),
+                     h["seconds"]["simp"], cpu, os.path.basename(png)))
+
+
+if __name__ == "__main__":
+    main()

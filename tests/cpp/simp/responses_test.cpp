@@ -1,0 +1,295 @@
+// Responses beyond compliance (simp/responses): the displacement of a face, the p-norm stress
+// and the first eigenvalue against finite differences; mass minimisation under a compliance, a
+// displacement or a stress limit, and the first eigenfrequency maximised, with MMA.
+#include "simp/responses/responses.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common/error.h"
+#include "fem/boundary_conditions.h"
+#include "mesh/core/structured_box.h"
+
+namespace topopt::simp {
+namespace {
+
+/// A 30 × 10 × 5 mm cantilever fixed at Face1 (x = 0) with a load pad at the far end, pulled
+/// down (−y, 100 N) and sideways (−z, 60 N) at Face2 in two load cases.
+struct Beam {
+  TetMesh mesh;
+  fem::Material mat;
+  fem::Supports supports;
+  Eigen::MatrixXd loads;
+};
+
+Beam beam(std::array<int, 3> cells) {
+  Beam b;
+  mesh::StructuredBoxParams p;
+  p.size = {30, 10, 5};
+  p.cells = cells;
+  p.nondesign = {{27.5, 0, 0, 30, 10, 5}};
+  b.mesh = mesh::structured_box_mesh(p);
+  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
+  const fem::LoadSpec push{fem::LoadSpec::Kind::Force, {2}, {0, 0, -60}, 0, {}};
+  b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}});
+  return b;
+}
+
+/// The limit on Face2's mean displacement along `direction`.
+DisplacementLimit tip_limit(const Beam& b, const std::array<double, 3>& direction, double limit) {
+  const fem::LoadSpec unit{fem::LoadSpec::Kind::Force, {2}, direction, 0, {}};
+  return {"Face2", fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"gauge", {unit}, 1}}).col(0), limit};
+}
+
+/// Central differences of face_displacement against its adjoint gradient at a random design.
+void check_displacement_gradient(SimpParams params, unsigned seed, const Eigen::Matrix3Xd& gravity = {}) {
+  Beam b = beam({6, 2, 2});
+  params.solver.recycle_factor = false;  // every solve to machine precision
+  Eigen::MatrixXd loads = b.loads;
+  for (long k = 0; k < gravity.cols(); ++k) {
+    const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {gravity(0, k), gravity(1, k), gravity(2, k)}, 0, {}};
+    loads.col(k) += fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"g", {weight}, 1}}).col(0);
+  }
+  ComplianceProblem prob(b.mesh, b.mat, b.supports, loads, {}, params, {}, gravity);
+  const DisplacementLimit gauge = tip_limit(b, {0, 0.6, -0.8}, 1);
+  const int nd = static_cast<int>(prob.design().size());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.2, 0.8);
+  VecXd x(nd);
+  for (int i = 0; i < nd; ++i) x[i] = uniform(rng);
+  prob.compliance(x);
+  Eigen::MatrixXd du;
+  const VecXd u0 = face_displacement(prob, gauge, &du);
+  ASSERT_GT(u0.cwiseAbs().minCoeff(), 0);
+  const double h = 1e-4;  // truncation ~h², the solver's round-off ~1e-13/h
+  for (int i : {0, nd / 3, nd / 2, nd - 1}) {
+    VecXd xp = x, xm = x;
+    xp[i] += h, xm[i] -= h;
+    prob.compliance(xp);
+    const VecXd up = face_displacement(prob, gauge);
+    prob.compliance(xm);
+    const VecXd um = face_displacement(prob, gauge);
+    for (long k = 0; k < u0.size(); ++k) {
+      const double fd = (up[k] - um[k]) / (2 * h);
+      EXPECT_NEAR(du(i, k), fd, 1e-4 * std::abs(fd) + 1e-9 * std::abs(u0[k])) << "variable " << i << ", case " << k;
+    }
+  }
+}
+
+TEST(Responses, DisplacementGradientMatchesFiniteDifferences) {
+  SimpParams p;
+  p.filter.radius = 6;
+  p.projection.beta_start = 4;  // a projection that bends the chain rule
+  check_displacement_gradient(p, 11);
+  p.filter.kind = FilterKind::Helmholtz;
+  p.projection.enabled = false;
+  check_displacement_gradient(p, 12);
+}
+
+TEST(Responses, DisplacementGradientWithSelfWeight) {
+  SimpParams p;
+  p.filter.radius = 6;
+  Eigen::Matrix3Xd g(3, 2);
+  g << 0, 3e8, -1e9, 0, 0, 5e8;
+  check_displacement_gradient(p, 13, g);
+}
+
+TEST(Responses, DisplacementIsTheFaceMeanAlongTheDirection) {
+  // the gauge of a unit force spread by area: a rigid translation t of every node reads d·t
+  Beam b = beam({6, 2, 2});
+  const DisplacementLimit gauge = tip_limit(b, {0, 0.6, -0.8}, 1);
+  VecXd t(3 * b.mesh.V.rows());
+  for (long n = 0; n < b.mesh.V.rows(); ++n) t.segment<3>(3 * n) = Eigen::Vector3d(2, 3, 5);
+  EXPECT_NEAR(gauge.gauge.dot(t), 0.6 * 3 - 0.8 * 5, 1e-12);
+}
+
+TEST(Responses, MassUnderAComplianceLimitFindsTheVolumeThatMeetsIt) {
+  // the compliance-optimal design at 40 % sets the limit; minimising the mass under that
+  // limit must then land near 40 % with the compliance at the limit
+  Beam b = beam({12, 4, 2});
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.projection.enabled = false;
+  p.update = UpdateKind::MMA;
+  p.max_iterations = 80;
+  const SimpResult reference = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const double limit = reference.history.back().compliance;
+  p.responses.objective = Objective::Mass;
+  p.responses.compliance_limit = limit;
+  p.volume_fraction = 0.6;  // the start
+  const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const IterationRecord& last = r.history.back();
+  EXPECT_LE(last.compliance, 1.01 * limit);
+  EXPECT_GE(last.compliance, 0.95 * limit);  // the limit is active: no material wasted
+  EXPECT_NEAR(last.volume_fraction, 0.4, 0.03);
+  EXPECT_LT(last.volume_fraction, r.history.front().volume_fraction);
+}
+
+TEST(Responses, MassUnderADisplacementLimitKeepsTheTipWithinIt) {
+  Beam b = beam({12, 4, 2});
+  SimpParams p;
+  p.filter.radius = 5;
+  p.projection.enabled = false;
+  p.update = UpdateKind::MMA;
+  p.max_iterations = 60;
+  p.volume_fraction = 0.5;
+  // the tip's deflection of the full block, doubled, as the limit
+  fem::Elasticity full(b.mesh, b.mat, b.supports);
+  const DisplacementLimit probe = tip_limit(b, {0, -1, 0}, 1);
+  const double solid = std::abs(probe.gauge.dot(full.solve(b.loads).col(0)));
+  p.responses.objective = Objective::Mass;
+  p.responses.displacements = {tip_limit(b, {0, -1, 0}, 2 * solid)};
+  const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const IterationRecord& last = r.history.back();
+  ASSERT_EQ(last.displacements.size(), 1u);
+  EXPECT_LE(last.displacements[0], 1.01 * 2 * solid);
+  EXPECT_GE(last.displacements[0], 0.9 * 2 * solid);  // active
+  // a uniform design would need ρ³ = 1/2 (ρ = 0.79) to keep within twice the solid's deflection
+  EXPECT_LT(last.volume_fraction, 0.75);
+}
+
+TEST(Responses, StressGradientMatchesFiniteDifferences) {
+  for (const bool gravity : {false, true}) {
+    Beam b = beam({6, 2, 2});
+    SimpParams p;
+    p.filter.radius = 6;
+    p.projection.beta_start = 2;
+    p.solver.recycle_factor = false;
+    p.responses.stress_limit = 50;
+    p.responses.stress_pnorm = 6;
+    Eigen::Matrix3Xd g;
+    Eigen::MatrixXd loads = b.loads;
+    if (gravity) {
+      g.resize(3, 2);
+      g << 0, 3e8, -1e9, 0, 0, 5e8;
+      for (long k = 0; k < 2; ++k) {
+        const fem::LoadSpec w{fem::LoadSpec::Kind::Gravity, {}, {g(0, k), g(1, k), g(2, k)}, 0, {}};
+        loads.col(k) += fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"g", {w}, 1}}).col(0);
+      }
+    }
+    ComplianceProblem prob(b.mesh, b.mat, b.supports, loads, {}, p, {}, g);
+    const int nd = static_cast<int>(prob.design().size());
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> uniform(0.2, 0.8);
+    VecXd x(nd);
+    for (int i = 0; i < nd; ++i) x[i] = uniform(rng);
+    prob.compliance(x);
+    Eigen::MatrixXd ds;
+    VecXd largest;
+    const VecXd s0 = pnorm_stress(prob, p.responses, &ds, &largest);
+    for (long k = 0; k < s0.size(); ++k) {
+      EXPECT_GE(s0[k], largest[k]);  // a p-norm of a sum bounds the largest term from above
+      EXPECT_GT(largest[k], 0);
+    }
+    const double h = 1e-5;
+    for (int i : {0, nd / 4, nd / 2, nd - 1}) {
+      VecXd xp = x, xm = x;
+      xp[i] += h, xm[i] -= h;
+      prob.compliance(xp);
+      const VecXd sp = pnorm_stress(prob, p.responses);
+      prob.compliance(xm);
+      const VecXd sm = pnorm_stress(prob, p.responses);
+      for (long k = 0; k < s0.size(); ++k) {
+        const double fd = (sp[k] - sm[k]) / (2 * h);
+        // a component below 1e-5 of the largest meets the solver's round-off over h (about
+        // 1e-14 s0 / h): there the floor is 1e-6 of the largest component
+        EXPECT_NEAR(ds(i, k), fd, 1e-4 * std::abs(fd) + 1e-6 * ds.col(k).cwiseAbs().maxCoeff())
+            << "variable " << i << ", case " << k;
+      }
+    }
+  }
+}
+
+TEST(Responses, MassUnderAStressLimitKeepsTheCrispDesignsStressWithinIt) {
+  // the limit is twice the largest stress of the full block: the lightest design under it is
+  // well below full, and its crisp version (solid or void, analysed anew) must hold the limit
+  Beam b = beam({16, 6, 2});
+  b.loads = b.loads.col(0).eval();  // the downward pull alone
+  const VecXd full = VecXd::Ones(b.mesh.T.rows());
+  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, full);
+  SimpParams p;
+  p.filter.radius = 4;
+  p.update = UpdateKind::MMA;
+  p.move = 0.1;
+  p.max_iterations = 200;
+  p.volume_fraction = 0.8;
+  p.responses.objective = Objective::Mass;
+  p.responses.stress_limit = 2 * solid;
+  const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, r.density);
+  EXPECT_LE(crisp, 1.05 * p.responses.stress_limit) << "solid block " << solid << " MPa";
+  EXPECT_LT(r.history.back().volume_fraction, 0.7);
+  EXPECT_GT(r.history.back().stress, 0);
+}
+
+TEST(Responses, EigenvalueGradientMatchesFiniteDifferences) {
+  Beam b = beam({6, 2, 2});
+  SimpParams p;
+  p.filter.radius = 6;
+  p.projection.beta_start = 2;
+  p.solver.recycle_factor = false;
+  p.responses.eigen_tolerance = 1e-13;
+  ComplianceProblem prob(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const int nd = static_cast<int>(prob.design().size());
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> uniform(0.2, 0.8);  // above Pedersen's 0.1 and below it
+  VecXd x(nd);
+  for (int i = 0; i < nd; ++i) x[i] = uniform(rng);
+  x[nd / 2] = 0.05;
+  prob.compliance(x);
+  Eigen::MatrixXd warm;
+  VecXd grad;
+  const fem::ModalResult m0 = first_eigenvalue(prob, b.mat.density, p.responses, warm, &grad);
+  ASSERT_FALSE(m0.first_repeated);
+  const double h = 1e-5;
+  for (int i : {0, nd / 4, nd / 2, nd - 1}) {
+    VecXd xp = x, xm = x;
+    xp[i] += h, xm[i] -= h;
+    prob.compliance(xp);
+    const double lp = first_eigenvalue(prob, b.mat.density, p.responses, warm).eigenvalues[0];
+    prob.compliance(xm);
+    const double lm = first_eigenvalue(prob, b.mat.density, p.responses, warm).eigenvalues[0];
+    const double fd = (lp - lm) / (2 * h);
+    EXPECT_NEAR(grad[i], fd, 1e-4 * std::abs(fd) + 1e-9 * m0.eigenvalues[0]) << "variable " << i;
+  }
+}
+
+TEST(Responses, FrequencyObjectiveRaisesTheFirstEigenfrequency) {
+  // the cantilever with its load pad as a tip mass: the uniform start at 40 % against the
+  // design that maximises the first eigenfrequency at the same volume
+  Beam b = beam({12, 4, 2});
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.update = UpdateKind::MMA;
+  p.max_iterations = 40;
+  p.projection.enabled = false;
+  p.responses.objective = Objective::Frequency;
+  const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  ASSERT_GE(r.history.size(), 5u);
+  EXPECT_GT(r.history.front().frequency, 0);
+  EXPECT_GT(r.history.back().frequency, 1.1 * r.history.front().frequency);
+  EXPECT_NEAR(r.history.back().volume_fraction, 0.4, 0.01);
+}
+
+TEST(Responses, RefusesWhatCannotRun) {
+  SimpParams p;
+  p.responses.objective = Objective::Mass;
+  p.update = UpdateKind::MMA;
+  EXPECT_THROW(check_responses(p, 30), Error);  // no limit
+  p.responses.compliance_limit = 10;
+  EXPECT_NO_THROW(check_responses(p, 30));
+  p.update = UpdateKind::OC;
+  EXPECT_THROW(check_responses(p, 30), Error);  // OC cannot
+  p.update = UpdateKind::MMA;
+  p.responses.displacements = {{"Face2", VecXd::Ones(30), -1}};
+  EXPECT_THROW(check_responses(p, 30), Error);  // negative limit
+  p.responses.displacements = {{"Face2", VecXd::Ones(12), 1}};
+  EXPECT_THROW(check_responses(p, 30), Error);  // gauge of another mesh
+}
+
+}  // namespace
+}  // namespace topopt::simp
