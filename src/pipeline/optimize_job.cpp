@@ -33,6 +33,7 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   json j;
   j["status"] = r.simp.status;
   j["converged"] = r.simp.converged;
+  j["ranks"] = r.ranks;
   j["threshold"] = r.threshold;
   j["seconds"] = {{"simp", r.seconds_simp}, {"surface", r.seconds_surface}};
   j["grey"] = r.simp.history.empty() ? 0.0 : r.simp.history.back().grey;
@@ -99,7 +100,8 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
 }
 
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress,
-                            const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+                            const std::function<void(const simp::IterationRecord&)>& on_iteration,
+                            const SimpRunner& runner) {
   const OptimizeSettings& set = job.optimization;
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
@@ -115,8 +117,8 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   for (const auto& lc : job.load_cases) weights.push_back(lc.weight);
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, simp, progress, on_iteration,
-                          fem::gravity_of(job.load_cases));
+  r.simp = (runner ? runner : SimpRunner(simp::optimize))(mesh, job.material, supports, loads, weights, simp, progress,
+                                                          on_iteration, fem::gravity_of(job.load_cases));
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
   r.surface = result_surface(mesh, r.simp.density, set.threshold, set.simp.volume_fraction, set.smooth, &r.threshold,

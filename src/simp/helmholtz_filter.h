@@ -16,12 +16,18 @@
 // with a Laplacian of relative weight (ℓ/h)², well conditioned for the radii users give (a
 // few mesh sizes), so CG needs tens of iterations (measured in bench/simp and in the log).
 #pragma once
+#include <Eigen/Dense>
 #include <vector>
 
 #include "fem/csr_matrix.h"
 #include "simp/filter.h"
 
 namespace topopt::simp {
+
+/// The element matrix ℓ² K_e + M_e of a linear tet with corners p (4 rows, mm) and length ℓ
+/// (mm): K_e = V Gᵀ G with G the 3 × 4 gradients of the shape functions, M_e = V/20 (1 + δ_ab).
+/// The serial filter and dist's parallel one assemble it.
+Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, double length);
 
 class HelmholtzFilter final : public Filter {
  public:
