@@ -36,7 +36,8 @@ int launched_rank();
 void write_stats_file(const std::string& path, const std::string& json_text);
 
 /// The figures of a serial run for --stats, in the shape of the distributed one's (one rank):
-/// {"ranks": 1, "per_rank": [{"rank": 0, "tets", "seconds_run", "peak_mb"}]}.
+/// {"ranks": 1, "per_rank": [{"rank": 0, "tets", "seconds_run", "cpu_seconds", "peak_mb"}]}
+/// (CPU time and peak memory of the whole process).
 std::string serial_stats_json(long tets, double seconds_run);
 
 /// Small argument reader shared by the sub-commands: `--name value` options, `--flag`

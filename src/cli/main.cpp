@@ -56,7 +56,13 @@ std::string serial_stats_json(long tets, double seconds_run) {
   getrusage(RUSAGE_SELF, &usage);
   nlohmann::json j;
   j["ranks"] = 1;
-  j["per_rank"] = {{{"rank", 0}, {"tets", tets}, {"seconds_run", seconds_run}, {"peak_mb", usage.ru_maxrss / 1e3}}};
+  const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                     1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  j["per_rank"] = {{{"rank", 0},
+                    {"tets", tets},
+                    {"seconds_run", seconds_run},
+                    {"cpu_seconds", cpu},
+                    {"peak_mb", usage.ru_maxrss / 1e3}}};
   return j.dump(2);
 }
 

@@ -130,8 +130,7 @@ void DistElasticity::Impl::create_solver() {
   PC pc;
   KSPGetPC(ksp, &pc);
   check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
-  check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, PETSC_DEFAULT, params.max_iterations),
-              "KSPSetTolerances");
+  check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
   check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
   check_petsc(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE), "KSPSetInitialGuessNonzero");
   check_petsc(KSPSetFromOptions(ksp), "KSPSetFromOptions");

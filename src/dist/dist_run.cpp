@@ -74,7 +74,7 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
   if (s.rank() == 0)
     progress.say("dist", -1,
                  "mesh distributed among " + std::to_string(s.size()) + " ranks (" + std::to_string(mine.tets) +
-                     " tets, " + std::to_string(mine.ghost_nodes) + " ghost nodes on rank 0)");
+                     " tets on rank 0)");
   t0 = std::chrono::steady_clock::now();
   Answer a;
   if (settings.command == Command::Solve) {
@@ -87,6 +87,7 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
   }
   mine.seconds_run = seconds_since(t0);
   mine.peak_bytes = peak_memory_bytes();
+  mine.cpu_seconds = cpu_seconds();
   a.stats = gather_stats(s, mine);
   return a;
 }
@@ -168,6 +169,7 @@ std::string stats_json(const std::vector<RankStats>& stats) {
                              {"ghost_nodes", r.ghost_nodes},
                              {"seconds_distribute", r.seconds_distribute},
                              {"seconds_run", r.seconds_run},
+                             {"cpu_seconds", r.cpu_seconds},
                              {"peak_mb", r.peak_bytes / 1e6}});
   return j.dump(2);
 }

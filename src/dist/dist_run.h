@@ -22,6 +22,7 @@ struct RankStats {
   double seconds_distribute = 0;  ///< partition and distribution of the mesh
   double seconds_run = 0;         ///< the solve, or SIMP
   double peak_bytes = 0;          ///< peak resident memory of the process so far
+  double cpu_seconds = 0;         ///< user + system CPU time of the process so far
 };
 
 /// Rank 0: solves the load cases ((3 #V) by #cases loads; supports at zero) on all ranks.
@@ -50,7 +51,7 @@ void serve_ranks(const MpiSession& session);
 void release_ranks(const MpiSession& session);
 
 /// The per-rank figures as JSON text: {"ranks": N, "per_rank": [{rank, tets, owned_nodes,
-/// ghost_nodes, seconds_distribute, seconds_run, peak_mb}, ...]}.
+/// ghost_nodes, seconds_distribute, seconds_run, cpu_seconds, peak_mb}, ...]}.
 std::string stats_json(const std::vector<RankStats>& stats);
 
 }  // namespace topopt::dist

@@ -56,7 +56,7 @@ fs::path make_job(const std::string& name) {
      "material": {"E": 200000, "nu": 0.3},
      "supports": [{"type": "fixed", "faces": ["Face1"]}],
      "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["Face2"], "vector": [0, 0, -100]}]}],
-     "optimization": {"volume_fraction": 0.4, "filter": "helmholtz", "filter_radius": 3, "max_iterations": 40,
+     "optimization": {"volume_fraction": 0.4, "filter": "helmholtz", "filter_radius": 3, "max_iterations": 20,
                       "solver_tolerance": 1e-9}})";
   return dir;
 }
