@@ -6,18 +6,39 @@
 
 #include "brep/foreign.h"
 
+namespace topopt::dist {
+class MpiSession;
+}
+
 namespace topopt::cli {
 
 using Args = std::vector<std::string>;
 
 int cmd_info(const Args& args);
 int cmd_mesh(const Args& args);
-int cmd_solve(const Args& args);
-int cmd_optimize(const Args& args);
+/// solve and optimize run on all MPI ranks when given the session (rank 0 calls them; a build
+/// with PETSc under mpirun), serially when it is null.
+int cmd_solve(const Args& args, const dist::MpiSession* session);
+int cmd_optimize(const Args& args, const dist::MpiSession* session);
 int cmd_surface(const Args& args);
 /// topopt worker REQUEST.json: one request of the FreeCAD workbench, run out of FreeCAD's process
 /// (JSON lines on stdout, results in files; see cmd_worker.cpp and worker_channel.h).
 int cmd_worker(const Args& args);
+
+/// The number of processes an MPI launcher started this one among (mpirun's
+/// OMPI_COMM_WORLD_SIZE, MPICH's PMI_SIZE, srun's SLURM_STEP_NUM_TASKS), 1 without one; and
+/// this process's rank among them (0 without one).
+int launched_ranks();
+int launched_rank();
+
+/// Writes the --stats file of solve and optimize (JSON text) under a temporary name and renames
+/// it; `path` empty: nothing.
+void write_stats_file(const std::string& path, const std::string& json_text);
+
+/// The figures of a serial run for --stats, in the shape of the distributed one's (one rank):
+/// {"ranks": 1, "per_rank": [{"rank": 0, "tets", "seconds_run", "cpu_seconds", "peak_mb"}]}
+/// (CPU time and peak memory of the whole process).
+std::string serial_stats_json(long tets, double seconds_run);
 
 /// Small argument reader shared by the sub-commands: `--name value` options, `--flag`
 /// switches and positionals. Unknown options are an error with the usage text.

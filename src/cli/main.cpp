@@ -1,16 +1,70 @@
 // build/topopt: meshing, analysis and topology optimisation from the shell.
+#include <sys/resource.h>
 #include <OSD.hxx>
 #include <Standard_Failure.hxx>
+
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "brep/occt_guard.h"
 #include "cli/commands.h"
 #include "common/error.h"
+#include "pipeline/output_files.h"
+#ifdef TOPOPT_WITH_PETSC
+#include "dist/dist_run.h"
+#include "dist/mpi_session.h"
+#endif
 
 namespace topopt::cli {
+
+namespace {
+/// The first of the environment variables `names` that holds a whole number, or `fallback`.
+int environment_number(std::initializer_list<const char*> names, int fallback) {
+  for (const char* name : names)
+    if (const char* v = std::getenv(name)) {
+      char* end = nullptr;
+      const long n = std::strtol(v, &end, 10);
+      if (end != v && *end == 0 && n >= 0) return static_cast<int>(n);
+    }
+  return fallback;
+}
+}  // namespace
+
+int launched_ranks() {
+  return std::max(1, environment_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "SLURM_STEP_NUM_TASKS"}, 1));
+}
+
+int launched_rank() { return environment_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK", "SLURM_PROCID"}, 0); }
+
+void write_stats_file(const std::string& path, const std::string& json_text) {
+  if (path.empty()) return;
+  pipeline::write_replacing(path, [&](const std::string& temporary) {
+    std::ofstream f(temporary);
+    f << json_text << "\n";
+    if (!f) throw Error(ErrorCode::Io, "cannot write --stats " + path + " (disk full?)");
+  });
+}
+
+std::string serial_stats_json(long tets, double seconds_run) {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  nlohmann::json j;
+  j["ranks"] = 1;
+  const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                     1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  j["per_rank"] = {{{"rank", 0},
+                    {"tets", tets},
+                    {"seconds_run", seconds_run},
+                    {"cpu_seconds", cpu},
+                    {"peak_mb", usage.ru_maxrss / 1e3}}};
+  return j.dump(2);
+}
 
 ArgReader::ArgReader(const Args& args, std::string usage)
     : args_(args), used_(args.size(), false), usage_(std::move(usage)) {
@@ -111,7 +165,8 @@ void print_error(const char* command, const topopt::Error& e) {
 
 /// Runs one sub-command; every failure becomes a message and an exit code. OCCT's failures
 /// (and access violations caught by its handler) are put in words by brep::occt_error.
-int run_command(int (*command)(const topopt::cli::Args&), const topopt::cli::Args& args, const char* name) {
+int run_command(const std::function<int(const topopt::cli::Args&)>& command, const topopt::cli::Args& args,
+                const char* name) {
   try {
     OCC_CATCH_SIGNALS
     return command(args);
@@ -131,6 +186,38 @@ int run_command(int (*command)(const topopt::cli::Args&), const topopt::cli::Arg
   }
 }
 
+/// mpirun -np N topopt COMMAND ...: solve and optimize on all ranks (rank 0 reads, meshes and
+/// writes; the others serve its runs); any other command, or a build without PETSc, is refused
+/// with a message from rank 0 and exit code 2 on every rank.
+int run_on_ranks(const char* name, const topopt::cli::Args& args) {
+  using namespace topopt::cli;
+  const bool distributable = !std::strcmp(name, "solve") || !std::strcmp(name, "optimize");
+#ifdef TOPOPT_WITH_PETSC
+  if (distributable) {
+    topopt::dist::MpiSession session;
+    if (session.rank() != 0) {
+      topopt::dist::serve_ranks(session);
+      return 0;
+    }
+    const bool solve = !std::strcmp(name, "solve");
+    const int code = run_command(
+        [&](const Args& a) { return solve ? cmd_solve(a, &session) : cmd_optimize(a, &session); }, args, name);
+    topopt::dist::release_ranks(session);
+    return code;
+  }
+#endif
+  if (launched_rank() == 0) {
+    if (!distributable)
+      std::cerr << "topopt " << name << ": only solve and optimize run on several MPI ranks; run '" << name
+                << "' without mpirun\n";
+    else
+      std::cerr << "topopt " << name << ": this topopt was built without MPI (PETSc was not found when it was "
+                << "built), so it cannot run on " << launched_ranks() << " ranks: run it without mpirun, or install "
+                << "petsc-dev (scripts/setup) and rebuild (scripts/build)\n";
+  }
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -139,9 +226,13 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
   }
-  const std::map<std::string, int (*)(const Args&)> commands{{"info", cmd_info},       {"mesh", cmd_mesh},
-                                                             {"solve", cmd_solve},     {"optimize", cmd_optimize},
-                                                             {"surface", cmd_surface}, {"worker", cmd_worker}};
+  const std::map<std::string, int (*)(const Args&)> commands{
+      {"info", cmd_info},
+      {"mesh", cmd_mesh},
+      {"solve", [](const Args& a) { return cmd_solve(a, nullptr); }},
+      {"optimize", [](const Args& a) { return cmd_optimize(a, nullptr); }},
+      {"surface", cmd_surface},
+      {"worker", cmd_worker}};
   auto it = commands.find(argv[1]);
   if (it == commands.end()) {
     std::cerr << "topopt: unknown command '" << argv[1] << "'\n" << kUsage;
@@ -152,5 +243,6 @@ int main(int argc, char** argv) {
   // No floating-point traps: the core relies on IEEE arithmetic. Foreign geometry is read in
   // child processes that reset these handlers (brep/foreign.h).
   OSD::SetSignal(Standard_False);
+  if (launched_ranks() > 1) return run_on_ranks(argv[1], Args(argv + 2, argv + argc));
   return run_command(it->second, Args(argv + 2, argv + argc), argv[1]);
 }

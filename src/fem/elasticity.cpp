@@ -26,6 +26,7 @@
 #include "common/error.h"
 #include "common/parallel.h"
 #include "common/stopwatch.h"
+#include "fem/tet_element.h"
 
 namespace topopt::fem {
 namespace {
@@ -44,27 +45,6 @@ std::array<LocalPair, kPairs> make_pairs() {
   return p;
 }
 const std::array<LocalPair, kPairs> kLocalPairs = make_pairs();
-
-/// Lamé parameters from E and ν.
-void lame(const Material& m, double& lambda, double& mu) {
-  lambda = m.young * m.poisson / ((1 + m.poisson) * (1 - 2 * m.poisson));
-  mu = m.young / (2 * (1 + m.poisson));
-}
-
-/// The 12 by 12 element stiffness of a linear tet with gradients g (4 by 3, row-major) and
-/// volume vol: K_ab,ij = vol (λ g_a,i g_b,j + μ g_a,j g_b,i + μ δ_ij g_a·g_b).
-inline void element_matrix(const double* g, double vol, double lambda, double mu, double* K) {
-  for (int a = 0; a < 4; ++a)
-    for (int b = 0; b < 4; ++b) {
-      const double* ga = g + 3 * a;
-      const double* gb = g + 3 * b;
-      double dot = ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          K[(3 * a + i) * 12 + 3 * b + j] =
-              vol * (lambda * ga[i] * gb[j] + mu * ga[j] * gb[i] + (i == j ? mu * dot : 0.0));
-    }
-}
 
 /// The node graph of tets T (#T by 4) on nv nodes: each node's neighbours through the tets,
 /// itself included, sorted.
@@ -127,20 +107,12 @@ void Elasticity::Impl::compute_geometry() {
   vol.assign(nt, 0.0);
   std::string bad;
   for (long e = 0; e < nt; ++e) {
-    Eigen::Matrix3d J;
-    for (int k = 0; k < 3; ++k) J.col(k) = (mesh.V.row(mesh.T(e, k + 1)) - mesh.V.row(mesh.T(e, 0))).transpose();
-    double det = J.determinant();
+    const double det = tet_gradients(mesh, e, &grad[12 * e]);
     if (!(det > 0)) {
       std::ostringstream s;
       s << "tet " << e << " has " << (det == 0 ? "zero" : "negative") << " volume (" << det / 6
         << " mm^3); the mesh must have positively oriented tets";
       throw Error(ErrorCode::InvalidParameter, s.str());
-    }
-    Eigen::Matrix3d Ji = J.inverse();  // row k: gradient of reference coordinate ξ_k
-    double* g = &grad[12 * e];
-    for (int c = 0; c < 3; ++c) {
-      g[c] = -(Ji(0, c) + Ji(1, c) + Ji(2, c));
-      for (int k = 0; k < 3; ++k) g[3 * (k + 1) + c] = Ji(k, c);
     }
     vol[e] = det / 6.0;
   }
@@ -368,7 +340,7 @@ void Elasticity::Impl::assemble() {
           double Ke[144];
           for (long k = b; k < e; ++k) {
             int t = list[k];
-            element_matrix(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+            element_stiffness(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
             const int* s = &slot[kPairs * static_cast<long>(t)];
             for (int p = 0; p < kPairs; ++p)
               if (s[p] >= 0) {
@@ -430,7 +402,7 @@ Eigen::MatrixXd Elasticity::Impl::free_loads(const Eigen::MatrixXd& loads) const
       any |= up[i] != 0;
     }
     if (!any) continue;
-    element_matrix(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+    element_stiffness(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
     for (int i = 0; i < 12; ++i) {
       int r = free_index[3 * mesh.T(t, i / 3) + i % 3];
       if (r < 0) continue;
@@ -473,16 +445,12 @@ Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& 
 }
 
 namespace {
-/// Strain ε = sym(∇u) of element t, with ∇u = Σ_a u_a ⊗ g_a over its four nodes.
-Eigen::Matrix3d element_strain(const TetMesh& mesh, const std::vector<double>& grad, long t, const VecXd& u) {
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (int a = 0; a < 4; ++a) {
-    const double* g = &grad[12 * t + 3 * a];
-    int n = mesh.T(t, a);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) H(i, j) += u[3 * n + i] * g[j];
-  }
-  return 0.5 * (H + H.transpose());
+/// Strain ε = sym(∇u) of element t under the displacements u (3#V).
+Eigen::Matrix3d strain_of(const TetMesh& mesh, const std::vector<double>& grad, long t, const VecXd& u) {
+  double ue[12];
+  for (int a = 0; a < 4; ++a)
+    for (int c = 0; c < 3; ++c) ue[3 * a + c] = u[3 * mesh.T(t, a) + c];
+  return element_strain(&grad[12 * t], ue);
 }
 }  // namespace
 
@@ -491,46 +459,27 @@ VecXd Elasticity::Impl::per_element_strain(const VecXd& u, const F& f) const {
   const long nt = mesh.T.rows();
   VecXd out(nt);
   parallel_for(nt, threads, [&](long b, long e) {
-    for (long t = b; t < e; ++t) out[t] = f(t, element_strain(mesh, grad, t, u));
+    for (long t = b; t < e; ++t) out[t] = f(t, strain_of(mesh, grad, t, u));
   });
   return out;
 }
 
 VecXd Elasticity::element_energy(const VecXd& u) const {
   const Impl& m = *impl_;
-  return m.per_element_strain(u, [&m](long t, const Eigen::Matrix3d& eps) {
-    // u^T K0 u = vol (λ (tr ε)² + 2μ ε:ε)
-    double tr = eps.trace();
-    return m.vol[t] * (m.lambda * tr * tr + 2 * m.mu * eps.cwiseAbs2().sum());
-  });
+  return m.per_element_strain(
+      u, [&m](long t, const Eigen::Matrix3d& eps) { return element_energy_of_strain(eps, m.vol[t], m.lambda, m.mu); });
 }
-
-namespace {
-
-/// The stress λ tr(ε) I + 2μ ε of strain eps.
-Eigen::Matrix3d stress_of(const Eigen::Matrix3d& eps, double lambda, double mu) {
-  return lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * mu * eps;
-}
-
-/// von Mises of a stress tensor: √(3/2 s:s), s its deviator.
-double von_mises_of(const Eigen::Matrix3d& s) {
-  const Eigen::Matrix3d dev = s - s.trace() / 3 * Eigen::Matrix3d::Identity();
-  return std::sqrt(1.5 * dev.cwiseAbs2().sum());
-}
-
-}  // namespace
 
 VecXd Elasticity::von_mises(const VecXd& u) const {
   const Impl& m = *impl_;
-  return m.per_element_strain(u, [&m](long t, const Eigen::Matrix3d& eps) {
-    return m.scale[t] * von_mises_of(stress_of(eps, m.lambda, m.mu));
-  });
+  return m.per_element_strain(
+      u, [&m](long t, const Eigen::Matrix3d& eps) { return von_mises_of_strain(eps, m.lambda, m.mu, m.scale[t]); });
 }
 
 VecXd Elasticity::solid_von_mises(const VecXd& u) const {
   const Impl& m = *impl_;
   return m.per_element_strain(
-      u, [&m](long t, const Eigen::Matrix3d& eps) { return von_mises_of(stress_of(eps, m.lambda, m.mu)); });
+      u, [&m](long t, const Eigen::Matrix3d& eps) { return von_mises_of_strain(eps, m.lambda, m.mu, 1.0); });
 }
 
 VecXd Elasticity::solid_von_mises_gradient(const VecXd& u, const VecXd& w) const {
@@ -538,8 +487,8 @@ VecXd Elasticity::solid_von_mises_gradient(const VecXd& u, const VecXd& w) const
   VecXd out = VecXd::Zero(u.size());
   for (long t = 0; t < m.mesh.T.rows(); ++t) {
     if (w[t] == 0) continue;
-    const Eigen::Matrix3d s = stress_of(element_strain(m.mesh, m.grad, t, u), m.lambda, m.mu);
-    const double vm = von_mises_of(s);
+    const Eigen::Matrix3d s = stress_of_strain(strain_of(m.mesh, m.grad, t, u), m.lambda, m.mu);
+    const double vm = von_mises_of_stress(s);
     if (vm == 0) continue;
     // dvm/dσ = 3/2 dev(σ)/vm; through σ = λ tr(ε) I + 2μ ε (dev is trace-free): dvm/dε = 3μ dev(σ)/vm;
     // ε = sym(Σ_a u_a ⊗ g_a), so dvm/du_a = (dvm/dε) g_a

@@ -140,14 +140,14 @@ void parse_responses(const Fields& f, OptimizeSettings& s) {
 }  // namespace
 
 OptimizeSettings parse_optimization(const json& section) {
-  const Fields f(section, "optimization",
-                 {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver",
-                  "sensitivity_filter", "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective",
-                  "threshold", "solver", "solver_tolerance", "smoothing_iterations", "fill_voids",
-                  // objectives and constraints (parse_responses)
-                  "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm",
-                  "stress_relaxation"},
-                 "{\"volume_fraction\": 0.3}");
+  const Fields f(
+      section, "optimization",
+      {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver", "sensitivity_filter",
+       "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
+       "solver_tolerance", "smoothing_iterations", "fill_voids",
+       // objectives and constraints (parse_responses)
+       "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation"},
+      "{\"volume_fraction\": 0.3}");
   OptimizeSettings s;
   simp::SimpParams& p = s.simp;
   p.volume_fraction = f.number("volume_fraction", 0.3);

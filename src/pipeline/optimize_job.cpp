@@ -33,6 +33,7 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   json j;
   j["status"] = r.simp.status;
   j["converged"] = r.simp.converged;
+  j["ranks"] = r.ranks;
   j["threshold"] = r.threshold;
   j["seconds"] = {{"simp", r.seconds_simp}, {"surface", r.seconds_surface}};
   j["grey"] = r.simp.history.empty() ? 0.0 : r.simp.history.back().grey;
@@ -103,7 +104,8 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
 }
 
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress,
-                            const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+                            const std::function<void(const simp::IterationRecord&)>& on_iteration,
+                            const SimpRunner& runner) {
   const OptimizeSettings& set = job.optimization;
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
@@ -122,8 +124,8 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
         {d.name, fem::make_loads(mesh, job.material, {fem::LoadCase{d.name, {d.unit}, 1}}).col(0), d.limit});
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  r.simp = simp::optimize(mesh, job.material, supports, loads, weights, simp, progress, on_iteration,
-                          fem::gravity_of(job.load_cases));
+  r.simp = (runner ? runner : SimpRunner(simp::optimize))(mesh, job.material, supports, loads, weights, simp, progress,
+                                                          on_iteration, fem::gravity_of(job.load_cases));
   if (const std::string w = not_crisp_warning(r.simp, simp); !w.empty()) progress.warn(w);
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");

@@ -15,6 +15,13 @@
 
 namespace topopt::pipeline {
 
+/// The SIMP run of optimize_job, with simp::optimize's arguments and answer: simp::optimize
+/// itself (serial) or the distributed one (dist/dist_run.h: optimize_on_ranks under mpirun).
+using SimpRunner =
+    std::function<simp::SimpResult(const TetMesh&, const fem::Material&, const fem::Supports&, const Eigen::MatrixXd&,
+                                   const std::vector<double>&, const simp::SimpParams&, const Progress&,
+                                   const std::function<void(const simp::IterationRecord&)>&, const Eigen::Matrix3Xd&)>;
+
 struct OptimizeResult {
   simp::SimpResult simp;
   double threshold = 0;
@@ -22,6 +29,7 @@ struct OptimizeResult {
   VecXd design;                ///< #T element densities after hygiene (what the surface is cut from)
   result::HygieneReport hygiene;
   double seconds_simp = 0, seconds_surface = 0;
+  int ranks = 1;  ///< MPI ranks SIMP ran on (1: serial)
 };
 
 /// Runs SIMP on `mesh` with the job's supports, loads and job.optimization, then extracts and
@@ -29,9 +37,10 @@ struct OptimizeResult {
 /// Error(InvalidParameter) for a load case that puts no force on the part or only loads
 /// supported nodes, or a filter radius larger than the part, and Error(TooLarge) for a
 /// filter that would not fit in memory (problem_checks.h); then what fem and simp throw
-/// (NoSupport, Cancelled).
+/// (NoSupport, Cancelled). runner: the SIMP run (empty: simp::optimize).
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
-                            const std::function<void(const simp::IterationRecord&)>& on_iteration = {});
+                            const std::function<void(const simp::IterationRecord&)>& on_iteration = {},
+                            const SimpRunner& runner = {});
 
 /// The nodes where a support (result::kAnchorSupport) or a force or pressure
 /// (result::kAnchorLoad) acts: #V flags, what the design must connect. Gravity acts

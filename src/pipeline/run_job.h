@@ -19,6 +19,10 @@ struct RunOptions {
   /// Make and test job.output.directory before meshing, and write density.vtu,
   /// history.csv, history.json and result.stl into it at the end.
   bool write_outputs = false;
+  /// The SIMP run (empty: serial simp::optimize; under mpirun dist's optimize_on_ranks) and
+  /// the number of ranks it runs on (history.json's "ranks").
+  SimpRunner simp;
+  int ranks = 1;
 };
 
 struct RunResult {

@@ -1,6 +1,7 @@
 // The analysis path shared by the CLI (`topopt solve`) and the Python module: the job's
 // supports and loads on a mesh (pipeline/job_mesh.h), the solve and the result files.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,11 +21,19 @@ struct SolveResult {
   double seconds_setup = 0, seconds_solve = 0;
 };
 
+/// A solve in place of fem::Elasticity's (dist/dist_run.h: solve_on_ranks under mpirun): given
+/// the mesh, material, supports and loads ((3 #V) by #cases), sets U (same shape) and each
+/// case's von Mises stress (#T, MPa).
+using AnalysisRunner =
+    std::function<void(const TetMesh&, const fem::Material&, const fem::Supports&, const Eigen::MatrixXd& loads,
+                       Eigen::MatrixXd& U, std::vector<VecXd>& von_mises)>;
+
 /// Solves every load case of `job` on `mesh` (one factorisation). `scale` (#T, optional):
-/// element stiffness factors. Throws Error(NoSupport) if the supports do not hold the part,
-/// Error(InvalidParameter) if the job has no load case.
+/// element stiffness factors (serial only); runner: the distributed solve (empty: serial).
+/// Throws Error(NoSupport) if the supports do not hold the part, Error(InvalidParameter) if the
+/// job has no load case.
 SolveResult solve_job(const Job& job, const TetMesh& mesh, const fem::SolverParams& solver = {},
-                      const VecXd& scale = VecXd(), const Progress& progress = {});
+                      const VecXd& scale = VecXd(), const Progress& progress = {}, const AnalysisRunner& runner = {});
 
 /// Writes into `dir` (prepared by prepare_output_folder): result.vtu (displacement and von
 /// Mises per case, domain) when job.output.vtu, result.inp (the problem as a CalculiX deck,

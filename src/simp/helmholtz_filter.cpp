@@ -26,9 +26,9 @@ class JacobiPreconditioner final : public fem::Preconditioner {
   const VecXd& inverse_diagonal_;
 };
 
-/// The element matrix ℓ² K_e + M_e of a linear tet with corners p (4 rows): K_e = V Gᵀ G with
-/// G the 3 × 4 gradients of the shape functions, M_e = V/20 (1 + δ_ab).
-Eigen::Matrix4d element_matrix(const Eigen::Matrix<double, 4, 3>& p, double length) {
+}  // namespace
+
+Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, double length) {
   Eigen::Matrix3d J;
   for (int k = 0; k < 3; ++k) J.row(k) = p.row(k + 1) - p.row(0);
   const double volume = std::abs(J.determinant()) / 6.0;
@@ -39,6 +39,8 @@ Eigen::Matrix4d element_matrix(const Eigen::Matrix<double, 4, 3>& p, double leng
   A += (volume / 20.0) * (Eigen::Matrix4d::Ones() + Eigen::Matrix4d::Identity());
   return A;
 }
+
+namespace {
 
 /// Mean edge length of the design tets (mm): the h of (ℓ/h)².
 double mean_design_edge(const TetMesh& mesh, const std::vector<int>& design) {
@@ -121,7 +123,7 @@ void HelmholtzFilter::assemble(const TetMesh& mesh, const std::vector<int>& desi
   for (size_t i = 0; i < design.size(); ++i) {
     Eigen::Matrix<double, 4, 3> p;
     for (int a = 0; a < 4; ++a) p.row(a) = mesh.V.row(mesh.T(design[i], a));
-    const Eigen::Matrix4d Ae = element_matrix(p, length_);
+    const Eigen::Matrix4d Ae = helmholtz_element_matrix(p, length_);
     for (int a = 0; a < 4; ++a) {
       const int row = element_nodes_[4 * i + a];
       const int* begin = A_.col.data() + A_.ptr[row];

@@ -18,9 +18,9 @@
 // ℓ/h, so there a V-cycle of our smoothed-aggregation multigrid (fem/amg.h, one row per node,
 // the constant as near-null mode) preconditions instead (helmholtz_uses_multigrid).
 #pragma once
-#include <vector>
-
+#include <Eigen/Dense>
 #include <memory>
+#include <vector>
 
 #include "fem/amg.h"
 #include "fem/csr_matrix.h"
@@ -36,6 +36,11 @@ double helmholtz_multigrid_above();
 /// preconditions with multigrid: as `solver` says, or for Auto when (ℓ/h)² exceeds
 /// helmholtz_multigrid_above().
 bool helmholtz_uses_multigrid(HelmholtzSolver solver, double length, double edge);
+
+/// The element matrix ℓ² K_e + M_e of a linear tet with corners p (4 rows, mm) and length ℓ
+/// (mm): K_e = V Gᵀ G with G the 3 × 4 gradients of the shape functions, M_e = V/20 (1 + δ_ab).
+/// The serial filter and dist's parallel one assemble it.
+Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, double length);
 
 class HelmholtzFilter final : public Filter {
  public:

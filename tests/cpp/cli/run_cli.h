@@ -14,9 +14,10 @@ struct CliResult {
   std::string out;  ///< stdout and stderr together
 };
 
-/// Runs `topopt <args>` through the shell (args are not quoted: keep paths simple).
-inline CliResult run_cli(const std::string& args) {
-  std::string cmd = std::string(TOPOPT_CLI) + " " + args + " 2>&1";
+/// Runs `topopt <args>` through the shell (args are not quoted: keep paths simple); launcher,
+/// when given, goes before it (e.g. "mpirun -np 2").
+inline CliResult run_cli(const std::string& args, const std::string& launcher = "") {
+  std::string cmd = (launcher.empty() ? "" : launcher + " ") + std::string(TOPOPT_CLI) + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   std::string out;
   std::array<char, 4096> buf;

@@ -1,0 +1,238 @@
+// Distributed elasticity on PETSc (see dist_elasticity.h).
+#include "dist/dist_elasticity.h"
+
+#include <petscksp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/error.h"
+#include "fem/tet_element.h"
+
+namespace topopt::dist {
+
+struct DistElasticity::Impl {
+  const MpiSession& session;
+  const DistMesh& mesh;
+  DistSolverParams params;
+  double lambda = 0, mu = 0, hold = 1;  // hold: the diagonal of a held dof, about K's own
+  std::vector<double> grad, vol;        // per local tet: 12 gradients, volume
+  VecXd scale;
+  std::vector<PetscInt> dof;  // 3 × #local nodes: global dof, or -1 where held
+  Mat K = nullptr;
+  KSP ksp = nullptr;
+  Vec b = nullptr;
+  std::vector<Vec> x;  // one ghosted solution per load case (warm starts)
+  bool dirty = true;
+  int iterations = 0;
+
+  Impl(const MpiSession& s, const DistMesh& m, const DistSolverParams& p) : session(s), mesh(m), params(p) {}
+  ~Impl() {
+    for (Vec& v : x) VecDestroy(&v);
+    VecDestroy(&b);
+    KSPDestroy(&ksp);
+    MatDestroy(&K);
+  }
+  void geometry(const fem::Material& material);
+  void insert(Mat A, bool values) const;
+  void create_matrix();
+  void create_solver();
+  Vec ghosted_vector() const;
+  void solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U);
+  template <class F>
+  VecXd per_element(const VecXd& u, const F& f) const;
+};
+
+void DistElasticity::Impl::geometry(const fem::Material& material) {
+  fem::lame(material, lambda, mu);
+  const long nt = mesh.local.T.rows();
+  grad.assign(12 * nt, 0.0);
+  vol.assign(nt, 0.0);
+  double sum = 0;
+  long bad = -1;  // the serial number of a tet without positive volume
+  for (long t = 0; t < nt; ++t) {
+    const double det = fem::tet_gradients(mesh.local, t, &grad[12 * t]);
+    if (!(det > 0)) bad = std::max(bad, mesh.tet_serial[t]);
+    vol[t] = det / 6.0;
+    sum += vol[t];
+  }
+  // every rank learns of a bad tet, so that all of them throw together
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG, MPI_MAX, session.comm());
+  if (bad >= 0)
+    throw Error(ErrorCode::InvalidParameter,
+                "tet " + std::to_string(bad) + " has no positive volume; the mesh must have positively oriented tets");
+  double total[2] = {sum, static_cast<double>(nt)};
+  MPI_Allreduce(MPI_IN_PLACE, total, 2, MPI_DOUBLE, MPI_SUM, session.comm());
+  hold = material.young * std::cbrt(total[0] / std::max(1.0, total[1]));
+  scale = VecXd::Ones(nt);
+  const long nl = mesh.local.V.rows();
+  dof.assign(3 * nl, -1);
+  for (long i = 0; i < nl; ++i)
+    for (int c = 0; c < 3; ++c)
+      if (!mesh.fixed[3 * i + c]) dof[3 * i + c] = static_cast<PetscInt>(3 * mesh.node_global[i] + c);
+}
+
+void DistElasticity::Impl::insert(Mat A, bool values) const {
+  double Ke[144] = {0};
+  PetscInt idx[12];
+  for (long t = 0; t < mesh.local.T.rows(); ++t) {
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) idx[3 * a + c] = dof[3 * mesh.local.T(t, a) + c];
+    if (values) fem::element_stiffness(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+    check_petsc(MatSetValues(A, 12, idx, 12, idx, Ke, ADD_VALUES), "MatSetValues");
+  }
+  for (long i = 0; i < 3L * mesh.owned_nodes; ++i)
+    if (dof[i] < 0) {
+      const PetscInt g = static_cast<PetscInt>(3 * mesh.node_global[i / 3] + i % 3);
+      check_petsc(MatSetValue(A, g, g, values ? hold : 0.0, ADD_VALUES), "MatSetValue");
+    }
+  check_petsc(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  check_petsc(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+}
+
+void DistElasticity::Impl::create_matrix() {
+  const PetscInt n = 3 * mesh.owned_nodes, N = static_cast<PetscInt>(3 * mesh.total_nodes);
+  Mat pre;
+  check_petsc(MatCreate(session.comm(), &pre), "MatCreate");
+  check_petsc(MatSetType(pre, MATPREALLOCATOR), "MatSetType");
+  check_petsc(MatSetSizes(pre, n, n, N, N), "MatSetSizes");
+  check_petsc(MatSetBlockSize(pre, 3), "MatSetBlockSize");
+  check_petsc(MatSetUp(pre), "MatSetUp");
+  insert(pre, false);
+  check_petsc(MatCreate(session.comm(), &K), "MatCreate");
+  check_petsc(MatSetType(K, MATAIJ), "MatSetType");
+  check_petsc(MatSetSizes(K, n, n, N, N), "MatSetSizes");
+  check_petsc(MatSetBlockSize(K, 3), "MatSetBlockSize");
+  check_petsc(MatPreallocatorPreallocate(pre, PETSC_TRUE, K), "MatPreallocatorPreallocate");
+  MatDestroy(&pre);
+  check_petsc(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  // the near-null space: the six rigid-body modes at the owned nodes
+  Vec coords;
+  check_petsc(VecCreateMPI(session.comm(), n, N, &coords), "VecCreateMPI");
+  check_petsc(VecSetBlockSize(coords, 3), "VecSetBlockSize");
+  PetscScalar* c = nullptr;
+  VecGetArray(coords, &c);
+  for (long i = 0; i < mesh.owned_nodes; ++i)
+    for (int k = 0; k < 3; ++k) c[3 * i + k] = mesh.local.V(i, k);
+  VecRestoreArray(coords, &c);
+  MatNullSpace modes;
+  check_petsc(MatNullSpaceCreateRigidBody(coords, &modes), "MatNullSpaceCreateRigidBody");
+  check_petsc(MatSetNearNullSpace(K, modes), "MatSetNearNullSpace");
+  MatNullSpaceDestroy(&modes);
+  VecDestroy(&coords);
+  check_petsc(MatCreateVecs(K, nullptr, &b), "MatCreateVecs");
+}
+
+void DistElasticity::Impl::create_solver() {
+  check_petsc(KSPCreate(session.comm(), &ksp), "KSPCreate");
+  check_petsc(KSPSetType(ksp, KSPCG), "KSPSetType");
+  PC pc;
+  KSPGetPC(ksp, &pc);
+  check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
+  check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
+  check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+  check_petsc(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE), "KSPSetInitialGuessNonzero");
+  check_petsc(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+}
+
+Vec DistElasticity::Impl::ghosted_vector() const {
+  std::vector<PetscInt> ghosts(mesh.node_global.begin() + mesh.owned_nodes, mesh.node_global.end());
+  Vec v;
+  check_petsc(VecCreateGhostBlock(session.comm(), 3, 3 * mesh.owned_nodes, static_cast<PetscInt>(3 * mesh.total_nodes),
+                                  static_cast<PetscInt>(ghosts.size()), ghosts.data(), &v),
+              "VecCreateGhostBlock");
+  VecSet(v, 0.0);
+  return v;
+}
+
+void DistElasticity::Impl::solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U) {
+  PetscScalar* f = nullptr;
+  VecGetArray(b, &f);
+  for (long i = 0; i < 3L * mesh.owned_nodes; ++i) f[i] = dof[i] >= 0 ? loads(i, k) : 0.0;
+  VecRestoreArray(b, &f);
+  while (static_cast<long>(x.size()) <= k) x.push_back(ghosted_vector());
+  check_petsc(KSPSolve(ksp, b, x[k]), "KSPSolve");
+  KSPConvergedReason reason;
+  KSPGetConvergedReason(ksp, &reason);
+  PetscInt its = 0;
+  KSPGetIterationNumber(ksp, &its);
+  iterations = std::max(iterations, static_cast<int>(its));
+  if (reason < 0)
+    throw Error(ErrorCode::NoSupport,
+                "the distributed solver (CG with algebraic multigrid) did not converge (PETSc reason " +
+                    std::to_string(static_cast<int>(reason)) + ", " + std::to_string(its) +
+                    " iterations): check that the supports hold every piece of the part");
+  VecGhostUpdateBegin(x[k], INSERT_VALUES, SCATTER_FORWARD);
+  VecGhostUpdateEnd(x[k], INSERT_VALUES, SCATTER_FORWARD);
+  Vec local;
+  VecGhostGetLocalForm(x[k], &local);
+  const PetscScalar* u = nullptr;
+  VecGetArrayRead(local, &u);
+  for (long i = 0; i < U.rows(); ++i) U(i, k) = dof[i] >= 0 ? u[i] : 0.0;
+  VecRestoreArrayRead(local, &u);
+  VecGhostRestoreLocalForm(x[k], &local);
+}
+
+DistElasticity::DistElasticity(const MpiSession& session, const DistMesh& mesh, const fem::Material& material,
+                               const DistSolverParams& params)
+    : impl_(std::make_unique<Impl>(session, mesh, params)) {
+  impl_->geometry(material);
+  impl_->create_matrix();
+  impl_->create_solver();
+}
+
+DistElasticity::~DistElasticity() = default;
+
+void DistElasticity::set_scale(const VecXd& scale) {
+  if (scale.size() != impl_->mesh.local.T.rows())
+    throw Error(ErrorCode::Internal, "DistElasticity::set_scale: one factor per local tet expected");
+  impl_->scale = scale;
+  impl_->dirty = true;
+}
+
+Eigen::MatrixXd DistElasticity::solve(const Eigen::MatrixXd& loads) {
+  Impl& m = *impl_;
+  if (m.dirty) {
+    check_petsc(MatZeroEntries(m.K), "MatZeroEntries");
+    m.insert(m.K, true);
+    check_petsc(KSPSetOperators(m.ksp, m.K, m.K), "KSPSetOperators");
+    m.dirty = false;
+  }
+  m.iterations = 0;
+  Eigen::MatrixXd U(3 * m.mesh.local.V.rows(), loads.cols());
+  for (long k = 0; k < loads.cols(); ++k) m.solve_case(loads, k, U);
+  return U;
+}
+
+/// f(t, ε_t) for each local tet t, ε_t its strain under the local displacements u.
+template <class F>
+VecXd DistElasticity::Impl::per_element(const VecXd& u, const F& f) const {
+  const long nt = mesh.local.T.rows();
+  VecXd out(nt);
+  double ue[12];
+  for (long t = 0; t < nt; ++t) {
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) ue[3 * a + c] = u[3 * mesh.local.T(t, a) + c];
+    out[t] = f(t, fem::element_strain(&grad[12 * t], ue));
+  }
+  return out;
+}
+
+VecXd DistElasticity::element_energy(const VecXd& u) const {
+  const Impl& m = *impl_;
+  return m.per_element(u, [&m](long t, const Eigen::Matrix3d& eps) {
+    return fem::element_energy_of_strain(eps, m.vol[t], m.lambda, m.mu);
+  });
+}
+
+VecXd DistElasticity::von_mises(const VecXd& u) const {
+  const Impl& m = *impl_;
+  return m.per_element(u, [&m](long t, const Eigen::Matrix3d& eps) {
+    return fem::von_mises_of_strain(eps, m.lambda, m.mu, m.scale[t]);
+  });
+}
+
+int DistElasticity::last_iterations() const { return impl_->iterations; }
+
+}  // namespace topopt::dist

@@ -1,0 +1,54 @@
+// Linear elasticity on the distributed mesh, on PETSc: a MatMPIAIJ (block size 3) whose
+// pattern is preallocated once from the ranks' tets (MatPreallocator) and whose values are
+// refilled for every new set of element factors, solved by CG with algebraic multigrid (GAMG,
+// the six rigid-body modes as near-null space; PETSC_OPTIONS may name another, e.g.
+// "-pc_type hypre"). Held dofs (supports, unused nodes) are left out of the element matrices
+// and get a diagonal entry alone, so the matrix stays symmetric positive definite.
+#pragma once
+#include <memory>
+
+#include "dist/dist_mesh.h"
+#include "fem/elasticity.h"
+
+namespace topopt::dist {
+
+struct DistSolverParams {
+  double tolerance = 1e-8;    ///< relative residual ‖b − K u‖ / ‖b‖
+  int max_iterations = 5000;  ///< CG iterations per solve
+};
+
+class DistElasticity {
+ public:
+  /// mesh: this rank's part (distribute_mesh); it must outlive the object. Collective.
+  DistElasticity(const MpiSession& session, const DistMesh& mesh, const fem::Material& material,
+                 const DistSolverParams& params = {});
+  ~DistElasticity();
+  DistElasticity(const DistElasticity&) = delete;
+  DistElasticity& operator=(const DistElasticity&) = delete;
+
+  /// Element stiffness factors of this rank's tets (#local tets, > 0); default all 1.
+  void set_scale(const VecXd& scale);
+
+  /// Solves K U = F for each column of `loads` (3 × owned nodes by #cases, as DistMesh::loads;
+  /// values on held dofs are ignored). Returns the displacements of every local node, owned and
+  /// ghost (3 × #local nodes by #cases), held dofs 0. Warm-starts from the previous solution.
+  /// Collective. Throws Error(NoSupport) when CG fails (the supports do not hold the part).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& loads);
+
+  /// #local tets: u_eᵀ K0_e u_e for the local displacements u (3 × #local nodes), the unscaled
+  /// element energy that SIMP's sensitivities use.
+  VecXd element_energy(const VecXd& u) const;
+
+  /// #local tets: the von Mises stress (MPa) of each tet under u, with its stiffness factor
+  /// applied (as fem::Elasticity::von_mises).
+  VecXd von_mises(const VecXd& u) const;
+
+  /// CG iterations of the last solve (the largest over the load cases).
+  int last_iterations() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace topopt::dist

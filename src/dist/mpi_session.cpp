@@ -1,0 +1,41 @@
+// The MPI/PETSc session (see mpi_session.h).
+#include "dist/mpi_session.h"
+
+#include <petscsys.h>
+#include <sys/resource.h>
+
+#include "common/error.h"
+
+namespace topopt::dist {
+
+MpiSession::MpiSession() {
+  check_petsc(PetscInitializeNoArguments(), "PetscInitialize");
+  comm_ = PETSC_COMM_WORLD;
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+MpiSession::~MpiSession() { PetscFinalize(); }
+
+void check_petsc(int code, const char* what) {
+  if (code == 0) return;
+  const char* text = nullptr;
+  PetscErrorMessage(static_cast<PetscErrorCode>(code), &text, nullptr);
+  throw Error(ErrorCode::Internal,
+              std::string("PETSc failed in ") + what + " (" + (text ? text : "unknown error") + ")");
+}
+
+double peak_memory_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return 1024.0 * static_cast<double>(usage.ru_maxrss);
+}
+
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+}  // namespace topopt::dist

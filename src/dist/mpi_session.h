@@ -1,0 +1,40 @@
+// The MPI/PETSc session of one `topopt` process started by mpirun (or srun): PETSc initialised
+// for the life of the object, the communicator, this process's rank and the number of ranks.
+// Passed to everything distributed; nothing in src/dist reads MPI's world on its own.
+#pragma once
+#include <mpi.h>
+
+#include <string>
+
+namespace topopt::dist {
+
+class MpiSession {
+ public:
+  /// Initialises PETSc (and MPI) without command-line arguments; PETSc's own options come
+  /// from the environment variable PETSC_OPTIONS (e.g. "-pc_type hypre"). Throws
+  /// Error(Internal) when PETSc cannot start.
+  MpiSession();
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+
+  MPI_Comm comm() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+ private:
+  MPI_Comm comm_ = MPI_COMM_WORLD;
+  int rank_ = 0, size_ = 1;
+};
+
+/// Throws Error(Internal) naming `what` when a PETSc call returned a non-zero code.
+void check_petsc(int code, const char* what);
+
+/// Peak resident memory of this process (bytes), from getrusage.
+double peak_memory_bytes();
+
+/// User + system CPU time of this process so far (s), from getrusage: on a shared machine the
+/// work a rank did, where wall time also counts the waits for the others.
+double cpu_seconds();
+
+}  // namespace topopt::dist

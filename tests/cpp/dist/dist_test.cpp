@@ -1,0 +1,175 @@
+// The distributed path against the serial one, on 2 ranks (ctest runs this binary under
+// mpirun -np 2): the partition is balanced, the ghost layer holds the owners' data, and the
+// distributed solve, Helmholtz filter and SIMP give the serial answers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "dist/dist_elasticity.h"
+#include "dist/dist_helmholtz.h"
+#include "dist/dist_mesh.h"
+#include "dist/dist_run.h"
+#include "dist/partition.h"
+#include "dist_test_session.h"
+#include "fem/boundary_conditions.h"
+#include "mesh/core/structured_box.h"
+#include "simp/density_filter.h"
+#include "simp/helmholtz_filter.h"
+
+namespace topopt::dist {
+namespace {
+
+const MpiSession& session() { return *testing::g_session; }
+bool root() { return session().rank() == 0; }
+
+/// A cantilever box 24 × 6 × 6 mm (12 × 3 × 3 cells, 648 tets) on rank 0, empty elsewhere,
+/// fixed at x = 0 and pulled down at x = 24, with a non-design pad at the loaded end.
+struct Beam {
+  TetMesh mesh;
+  fem::Material material{200000, 0.3};
+  fem::Supports supports;
+  Eigen::MatrixXd loads;
+};
+
+Beam make_beam() {
+  Beam b;
+  if (!root()) return b;
+  mesh::StructuredBoxParams p;
+  p.size = {24, 6, 6};
+  p.cells = {12, 3, 3};
+  p.nondesign = {{22, 0, 0, 24, 6, 6}};
+  b.mesh = mesh::structured_box_mesh(p);
+  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  b.loads =
+      fem::make_loads(b.mesh, b.material,
+                      {fem::LoadCase{"tip", {fem::LoadSpec{fem::LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}}}, 1}});
+  return b;
+}
+
+DistMesh distribute(const Beam& b) {
+  return distribute_mesh(session(), b.mesh, partition_tets(session(), b.mesh.T), b.supports, b.loads);
+}
+
+TEST(DistMesh, PartitionIsBalancedAndGhostsHoldTheOwnersData) {
+  ASSERT_EQ(session().size(), 2) << "run under mpirun -np 2";
+  const Beam b = make_beam();
+  const DistMesh d = distribute(b);
+  long tets[2] = {d.local.T.rows(), 0};
+  MPI_Allgather(&tets[0], 1, MPI_LONG, tets, 1, MPI_LONG, session().comm());
+  EXPECT_EQ(tets[0] + tets[1], d.total_tets);
+  // PT-Scotch balances the tets to a few per cent
+  EXPECT_LT(std::abs(tets[0] - tets[1]), 0.1 * d.total_tets) << tets[0] << " and " << tets[1];
+  // a node belongs to the lowest of its tets' ranks: the ranks above hold the shared ones as ghosts
+  long ghosts = d.local.V.rows() - d.owned_nodes;
+  MPI_Allreduce(MPI_IN_PLACE, &ghosts, 1, MPI_LONG, MPI_SUM, session().comm());
+  EXPECT_GT(ghosts, 0) << "two parts of one beam share nodes";
+  // every global node owned once; every ghost's coordinates are its owner's
+  MatX3d all(d.total_nodes, 3);
+  std::vector<int> counts(2), offsets(2, 0);
+  const int mine = 3 * d.owned_nodes;
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, session().comm());
+  offsets[1] = counts[0];
+  EXPECT_EQ(counts[0] + counts[1], 3 * d.total_nodes);
+  MPI_Allgatherv(d.local.V.data(), mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+                 session().comm());
+  for (long i = 0; i < d.local.V.rows(); ++i)
+    EXPECT_EQ((all.row(d.node_global[i]) - d.local.V.row(i)).norm(), 0.0) << "local node " << i;
+  // each local tet is its serial tet: the same corners (through the global numbering)
+  const VecXd serial_of = gather_tets(
+      session(), d, Eigen::Map<const Eigen::Matrix<long, -1, 1>>(d.tet_serial.data(), d.local.T.rows()).cast<double>());
+  if (root()) {
+    for (long t = 0; t < b.mesh.T.rows(); ++t) EXPECT_EQ(serial_of[t], t);
+    std::set<int> owned(d.serial_node.begin(), d.serial_node.end());
+    EXPECT_EQ(static_cast<long>(owned.size()), b.mesh.V.rows());
+    for (long t = 0; t < d.local.T.rows(); ++t)
+      for (int a = 0; a < 4; ++a)
+        EXPECT_EQ(d.serial_node[d.node_global[d.local.T(t, a)]], b.mesh.T(d.tet_serial[t], a));
+  }
+}
+
+TEST(DistElasticity, DisplacementsEqualTheSerialSolve) {
+  const Beam b = make_beam();
+  DistSolverParams params;
+  params.tolerance = 1e-10;
+  Eigen::MatrixXd U;
+  std::vector<VecXd> von_mises;
+  std::vector<RankStats> stats;
+  if (!root()) return serve_ranks(session());
+  solve_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, params, U, von_mises, &stats);
+  release_ranks(session());
+  fem::SolverParams direct;
+  direct.kind = fem::SolverKind::Direct;
+  fem::Elasticity fe(b.mesh, b.material, b.supports, direct);
+  const Eigen::MatrixXd reference = fe.solve(b.loads);
+  EXPECT_LT((U - reference).norm(), 1e-6 * reference.norm());
+  EXPECT_LT((von_mises[0] - fe.von_mises(reference.col(0))).norm(), 1e-6 * von_mises[0].norm());
+  ASSERT_EQ(stats.size(), 2u);
+  EXPECT_GT(stats[1].tets, 0);
+  EXPECT_GT(stats[1].peak_bytes, 0);
+}
+
+TEST(DistHelmholtz, FiltersAsTheSerialFilter) {
+  const Beam b = make_beam();
+  const DistMesh d = distribute(b);
+  std::vector<int> design;
+  VecXd x_local;
+  for (long t = 0; t < d.local.T.rows(); ++t)
+    if (d.local.domain[t] == 0) {
+      design.push_back(static_cast<int>(t));
+      const Eigen::RowVector3d c = d.local.V.row(d.local.T(t, 0));
+      x_local.conservativeResize(x_local.size() + 1);
+      x_local[x_local.size() - 1] = 0.5 + 0.4 * std::sin(c[0] / 3) * std::cos(c[2] / 2);
+    }
+  const double length = simp::helmholtz_length(4.0, false);
+  DistHelmholtz filter(session(), d, design, length);
+  // spread the local answers over the tets to gather them in the serial order
+  auto gathered = [&](const VecXd& per_design) {
+    VecXd per_tet = VecXd::Constant(d.local.T.rows(), -1.0);
+    for (size_t i = 0; i < design.size(); ++i) per_tet[design[i]] = per_design[static_cast<long>(i)];
+    return gather_tets(session(), d, per_tet);
+  };
+  const VecXd x = gathered(x_local), fx = gathered(filter.apply(x_local)),
+              ftx = gathered(filter.apply_transpose(x_local));
+  if (!root()) return;
+  std::vector<int> serial_design;
+  for (long t = 0; t < b.mesh.T.rows(); ++t)
+    if (b.mesh.domain[t] == 0) serial_design.push_back(static_cast<int>(t));
+  VecXd xs(static_cast<long>(serial_design.size()));
+  for (size_t i = 0; i < serial_design.size(); ++i) xs[static_cast<long>(i)] = x[serial_design[i]];
+  simp::HelmholtzFilter serial(b.mesh, serial_design, simp::tet_volumes(b.mesh),
+                               {simp::FilterKind::Helmholtz, 4.0, 1, false});
+  const VecXd f = serial.apply(xs), ft = serial.apply_transpose(xs);
+  ASSERT_GT((f - xs).norm(), 1e-2 * xs.norm()) << "the filter must change this field";
+  for (size_t i = 0; i < serial_design.size(); ++i) {
+    EXPECT_NEAR(fx[serial_design[i]], f[static_cast<long>(i)], 1e-9);
+    EXPECT_NEAR(ftx[serial_design[i]], ft[static_cast<long>(i)], 1e-9 * ft.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(DistSimp, OptimizeEqualsTheSerialRun) {
+  const Beam b = make_beam();
+  simp::SimpParams params;
+  params.volume_fraction = 0.4;
+  params.filter = {simp::FilterKind::Helmholtz, 3.0, 1, false};
+  params.max_iterations = 20;
+  params.solver.tolerance = 1e-9;
+  if (!root()) return serve_ranks(session());
+  const simp::SimpResult distributed =
+      optimize_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, {}, params, {}, {}, {});
+  release_ranks(session());
+  params.solver.kind = fem::SolverKind::Direct;
+  const simp::SimpResult serial = simp::optimize(b.mesh, b.material, b.supports, b.loads, {}, params);
+  ASSERT_FALSE(serial.history.empty());
+  const double c_serial = serial.history.back().compliance, c_dist = distributed.history.back().compliance;
+  EXPECT_NEAR(c_dist, c_serial, 1e-3 * c_serial);
+  EXPECT_LE(std::abs(static_cast<int>(serial.history.size()) - static_cast<int>(distributed.history.size())), 2);
+  EXPECT_LT(serial.history.back().compliance, 0.8 * serial.history.front().compliance)
+      << "the case must optimise something";
+  ASSERT_EQ(distributed.density.size(), serial.density.size());
+  EXPECT_EQ(distributed.design, serial.design);
+  EXPECT_LT((distributed.density - serial.density).cwiseAbs().maxCoeff(), 0.05);
+}
+
+}  // namespace
+}  // namespace topopt::dist
