@@ -18,18 +18,20 @@ namespace topopt::pipeline {
 
 /// The "optimization" section (docs/optimization.md).
 struct OptimizeSettings {
-  simp::SimpParams simp;  ///< the solver's tolerance 1e-5 unless given
+  simp::SimpParams simp;         ///< the solver's tolerance 1e-5 unless given
   bool filter_automatic = true;  ///< "filter": "auto" (the default): chosen_filter decides the kind
-  double threshold = -1;  ///< iso-value of the result shape; < 0: the one that meets the volume fraction
+  double threshold = -1;         ///< iso-value of the result shape; < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
   result::HygieneParams hygiene;  ///< loose pieces out, closed voids filled (fill_voids)
 };
 
 /// The "output" section.
 struct OutputSettings {
-  std::string directory;  ///< absolute; default "<job folder>/out"
-  bool vtu = true;        ///< solve: DIR/result.vtu
-  bool inp = false;       ///< solve: DIR/result.inp, the problem as a CalculiX deck
+  std::string directory;     ///< absolute; default "<job folder>/out"
+  bool vtu = true;           ///< solve: DIR/result.vtu
+  bool inp = false;          ///< solve: DIR/result.inp, the problem as a CalculiX deck
+  bool step = true;          ///< optimize: DIR/result.step, the result as one CAD solid
+  bool verification = true;  ///< optimize: DIR/verification.json and .vtu, the result solid analysed
 };
 
 /// A parsed, validated job. Paths are absolute (resolved against the job file's folder).
