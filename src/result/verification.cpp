@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <unordered_map>
 
 #include "common/error.h"
+#include "common/isolate.h"
 #include "fem/elasticity.h"
 #include "result/design_hygiene.h"
 
@@ -100,9 +102,33 @@ Progress with_deadline(const Progress& outer, std::chrono::steady_clock::time_po
   return p;
 }
 
+/// The bytes of a fill's nodes and tets (row counts, then the raw arrays), and back.
+std::string pack(const mesh::VolumeFillResult& r) {
+  const long nv = r.V.rows(), nt = r.T.rows();
+  std::string b(2 * sizeof(long) + nv * 3 * sizeof(double) + nt * 4 * sizeof(int), '\0');
+  char* p = b.data();
+  std::memcpy(p, &nv, sizeof nv), std::memcpy(p + sizeof nv, &nt, sizeof nt);
+  std::memcpy(p + 2 * sizeof(long), r.V.data(), nv * 3 * sizeof(double));
+  std::memcpy(p + 2 * sizeof(long) + nv * 3 * sizeof(double), r.T.data(), nt * 4 * sizeof(int));
+  return b;
+}
+
+mesh::VolumeFillResult unpack(const std::string& b) {
+  long nv = 0, nt = 0;
+  if (b.size() < 2 * sizeof(long)) throw Error(ErrorCode::Internal, "the result's volume mesh came back cut short");
+  std::memcpy(&nv, b.data(), sizeof nv), std::memcpy(&nt, b.data() + sizeof nv, sizeof nt);
+  if (nv < 0 || nt < 0 || b.size() != 2 * sizeof(long) + nv * 3 * sizeof(double) + nt * 4 * sizeof(int))
+    throw Error(ErrorCode::Internal, "the result's volume mesh came back cut short");
+  mesh::VolumeFillResult r;
+  r.V.resize(nv, 3), r.T.resize(nt, 4);
+  std::memcpy(r.V.data(), b.data() + 2 * sizeof(long), nv * 3 * sizeof(double));
+  std::memcpy(r.T.data(), b.data() + 2 * sizeof(long) + nv * 3 * sizeof(double), nt * 4 * sizeof(int));
+  return r;
+}
+
 }  // namespace
 
-TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill,
+TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
                           const Progress& progress) {
   std::vector<int> index(s.V.rows(), -1);
   int used = 0;
@@ -115,7 +141,15 @@ TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::Vo
   MatX3i F(s.F.rows(), 3);
   for (long q = 0; q < s.F.rows(); ++q)
     for (int k = 0; k < 3; ++k) F(q, k) = index[s.F(q, k)];
-  const mesh::VolumeFillResult filled = mesh::fill_volume(V, F, MatX4i(0, 4), fill, progress);
+  // in a child with a hard deadline: the front's inner loops do not all look at the clock
+  const mesh::VolumeFillResult filled = unpack(run_isolated(
+      "meshing the result solid", seconds,
+      [&]() {
+        Progress quiet;  // the child says nothing (the worker's stdout is its protocol)
+        quiet.cancelled = progress.cancelled;
+        return pack(mesh::fill_volume(V, F, MatX4i(0, 4), fill, quiet));
+      },
+      progress));
   TetMesh m;
   m.V = filled.V;
   m.T = filled.T;
@@ -171,9 +205,9 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   };
   Verification v;
   try {
-    v.mesh = verification_mesh(s, fe, params.fill, timed);
+    v.mesh = verification_mesh(s, fe, params.fill, params.seconds, timed);
   } catch (const Error& e) {
-    if (e.code() == ErrorCode::Cancelled) out_of_time("meshing the result solid");
+    if (e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Timeout) out_of_time("meshing the result solid");
     throw;
   }
   const double seconds_mesh = seconds_since(t0);

@@ -52,9 +52,10 @@ struct Verification {
 /// The tet mesh inside the closed surface `s` (its unused points dropped; F oriented
 /// outwards): tets from fill_volume, F = s.F, `face` the Ω face tags (0 where the triangle
 /// lies on the iso-surface or a non-design solid inside Ω), `nd_face` taken from the FE mesh
-/// `fe` boundary triangle each tagged triangle lies on. Throws what fill_volume throws;
-/// Error(Timeout) when progress says cancelled because the budget ran out is the caller's.
-TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill,
+/// `fe` boundary triangle each tagged triangle lies on. The fill runs in a child process
+/// (run_isolated) stopped after `seconds` (<= 0: no limit): throws what fill_volume throws,
+/// Error(Timeout) past the budget, Error(Crashed) if the child dies.
+TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
                           const Progress& progress = {});
 
 /// Solves `problem` on `mesh` with element stiffness factors `scale` (#T, empty: all 1) and

@@ -49,7 +49,7 @@ Fixture bar_fixture() {
 
 TEST(Verification, TheResultMeshCarriesTheLoadsOnTheRightFaces) {
   const Fixture f = bar_fixture();
-  const TetMesh m = verification_mesh(f.surface, f.mesh, {});
+  const TetMesh m = verification_mesh(f.surface, f.mesh, {}, 0);
   EXPECT_GT(m.T.rows(), 200);
   // the non-design face 8 (x = 40 on the block) is found on the result: its area is the block's 8 x 6
   double area = 0;
