@@ -74,9 +74,42 @@ def one(build, work, name, setting):
     vol = abs(crisp.tet_volumes(points, tets))
     keep = crisp.crisp_tets(points, tets, domain, density, h["threshold"])
     c, solved = crisp.ccx_compliance(deck, points, tets, keep, os.path.join(out, "ccx"), name)
-    return {"tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
+    cad = cad_columns(out)
+    return {**cad, "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
             "wall_s": wall, "cpu_s": cpu, "grey": crisp.grey_share(density, domain, vol),
             "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_tets": solved, "kept_tets": int(keep.sum())}
+
+
+def cad_columns(out):
+    """The result back in CAD and verified, from the run's verification.json: STEP size (MB),
+    faces (planar) and time, the as-built compliance (the result solid meshed by fill_volume,
+    solved by our FEM), ours on the crisp design's tets, and the verification's time; None for
+    a step that failed (its error is under "failed")."""
+    v = json.load(open(os.path.join(out, "verification.json")))
+    step, crisp_v = v.get("step", {}), v.get("crisp", {})
+    return {"step_mb": step.get("bytes", 0) / 1e6 if step else None, "step_s": step.get("seconds"),
+            "step_faces": step.get("faces"), "step_planar": step.get("planar_faces"),
+            "as_built": v.get("compliance_as_built"), "as_built_tets": v.get("tets"),
+            "crisp_ours": crisp_v.get("compliance"),
+            "verification_s": (v["as_built"]["seconds"] + crisp_v["seconds"]) if "as_built" in v else None,
+            "failed": sorted(v.get("failed", {}))}
+
+
+def cad_table(rows):
+    """Prints the table of the result back in CAD and its verification (issue 19, part C)."""
+    def f(x, fmt):
+        return fmt % x if x is not None else "failed"
+    print("\n## Result: back in CAD and verified (bench/result/run.py)\n")
+    print("| example | setting | STEP (MB) | STEP faces (planar) | STEP time (s) | as-built compliance (N·mm) | "
+          "as-built tets | crisp, our FEM (N·mm) | as built / crisp, CalculiX | verification time (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for (name, setting), r in rows.items():
+        ratio = r["as_built"] / r["crisp"] if r["as_built"] is not None and r["crisp"] else None
+        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |"
+              % (name, setting, f(r["step_mb"], "%.2f"),
+                 "%s (%s)" % (r["step_faces"], r["step_planar"]) if r["step_faces"] is not None else "failed",
+                 f(r["step_s"], "%.1f"), f(r["as_built"], "%.2f"), f(r["as_built_tets"], "%d"),
+                 f(r["crisp_ours"], "%.2f"), f(ratio, "%.3f"), f(r["verification_s"], "%.1f")))
 
 
 def main():
@@ -101,6 +134,7 @@ def main():
         print("| %s | %d | %s | %d | %s | %.1f %% | %.2f | %.2f | %.1f | %.1f | %.2f |"
               % (name, r["tets"], setting, r["iterations"], r["status"], 100 * r["grey"], r["compliance_simp"], r["crisp"],
                  r["simp_s"], r["cpu_s"], ratio))
+    cad_table(rows)
 
 
 if __name__ == "__main__":

@@ -46,8 +46,11 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
               "  Meshes the part (or reads the job's mesh file), runs SIMP with the job's supports,\n"
               "  loads and \"optimization\" settings (docs/optimization.md), extracts the shape at the\n"
               "  threshold that keeps the volume fraction and smooths it. Writes DIR/density.vtu,\n"
-              "  DIR/history.csv, DIR/history.json and DIR/result.stl. The whole job is checked, and\n"
-              "  DIR made and tested, before any work.\n"
+              "  DIR/history.csv, DIR/history.json and DIR/result.stl, then DIR/result.step (the result as\n"
+              "  one CAD solid) and DIR/verification.json and .vtu (the result solid meshed and analysed\n"
+              "  with the job's supports and loads, next to the crisp design; \"output\": {\"step\": false,\n"
+              "  \"verification\": false} skips them). A failed export or verification is a warning: the\n"
+              "  other files are written. The whole job is checked, and DIR made and tested, before any work.\n"
               "  --out-dir  output folder (default: the job's output.directory, or out/ beside it)\n"
               "  --quiet    no line per iteration\n"
               "  --verbose  also the solver's timings\n"
@@ -88,6 +91,14 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
             << "surface: threshold " << r.threshold << ", " << r.surface.F.rows() << " triangles, "
             << (check.closed_manifold() ? "closed" : "NOT closed") << ", volume " << check.volume << " mm^3 ("
             << r.seconds_surface << " s)\n";
+  if (run.files.step)
+    std::cout << "step: " << run.files.step->faces << " faces (" << run.files.step->planar_faces << " planar), "
+              << run.files.step->bytes / 1e6 << " MB (" << run.files.step->seconds << " s)\n";
+  if (const auto& v = run.files.verification)
+    std::cout << "verification: compliance as built " << v->as_built.compliance << " N*mm on " << v->as_built.tets
+              << " tets, crisp design " << v->crisp.compliance << " N*mm (ratio " << v->ratio()
+              << "), max displacement " << v->as_built.max_displacement << " mm, max von Mises "
+              << v->as_built.max_von_mises << " MPa (" << v->as_built.seconds << " s)\n";
   for (const auto& p : run.written) std::cout << "wrote " << p << "\n";
   if (stats_text.empty()) stats_text = serial_stats_json(run.mesh.T.rows(), r.seconds_simp);
   write_stats_file(stats, stats_text);

@@ -26,7 +26,10 @@ RunResult run_job(const Job& job, const JobShapes& shapes, const Progress& progr
   watched.check_cancel("meshing");
   r.optimization = optimize_job(job, r.mesh, watched, on_iteration, options.simp);
   r.optimization.ranks = options.ranks;
-  if (options.write_outputs) r.written = write_optimize_outputs(r.mesh, r.optimization, job.output.directory);
+  if (!options.write_outputs) return r;
+  r.written = write_optimize_outputs(r.mesh, r.optimization, job.output.directory);
+  r.files = write_result_files(job, r.mesh, r.optimization, job.output.directory, options.result_files, watched);
+  r.written.insert(r.written.end(), r.files.written.begin(), r.files.written.end());
   return r;
 }
 

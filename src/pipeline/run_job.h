@@ -12,17 +12,21 @@
 #include "pipeline/job.h"
 #include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
+#include "pipeline/result_files.h"
 
 namespace topopt::pipeline {
 
 struct RunOptions {
   /// Make and test job.output.directory before meshing, and write density.vtu,
-  /// history.csv, history.json and result.stl into it at the end.
+  /// history.csv, history.json and result.stl into it at the end, then (as job.output asks)
+  /// result.step, verification.vtu and verification.json (result_files.h: each may fail
+  /// alone, with a warning, after the others are written).
   bool write_outputs = false;
   /// The SIMP run (empty: serial simp::optimize; under mpirun dist's optimize_on_ranks) and
   /// the number of ranks it runs on (history.json's "ranks").
   SimpRunner simp;
   int ranks = 1;
+  ResultFilesParams result_files;  ///< budgets of the STEP export and the verification
 };
 
 struct RunResult {
@@ -32,6 +36,7 @@ struct RunResult {
   OptimizeResult optimization;        ///< SIMP, threshold, smoothed surface, their times
   std::vector<std::string> warnings;  ///< what the run warned about (e.g. the Gmsh fallback)
   std::vector<std::string> written;   ///< the result files written (RunOptions::write_outputs)
+  ResultFiles files;                  ///< the STEP export's and the verification's figures (write_outputs)
 };
 
 /// Runs `job`: checks that it has supports and loads (and, with options.write_outputs, that

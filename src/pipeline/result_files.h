@@ -1,0 +1,43 @@
+// The result handed back to CAD and checked by analysis, after the optimisation's own files:
+// DIR/result.step (the result as one solid, result/step_export.h), DIR/verification.vtu and
+// DIR/verification.json (the result solid meshed and solved with the job's supports and loads
+// next to the crisp design on the FE mesh, result/verification.h). Each step runs with a time
+// budget and may fail on its own: what failed is named in a warning and in
+// verification.json, and never costs the files already written.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/progress.h"
+#include "pipeline/job.h"
+#include "pipeline/optimize_job.h"
+#include "result/step_export.h"
+#include "result/verification.h"
+
+namespace topopt::pipeline {
+
+struct ResultFilesParams {
+  result::StepExportParams step;            ///< the STEP export's budget and merging
+  result::VerificationParams verification;  ///< the verification's budget, mesher and solver
+};
+
+struct ResultFiles {
+  std::vector<std::string> written;                  ///< paths written
+  std::vector<std::string> warnings;                 ///< one per step that failed, naming it and why
+  std::optional<result::StepExportReport> step;      ///< when result.step was written
+  std::optional<result::Verification> verification;  ///< when the verification ran
+};
+
+/// The job's problem (material, supports, load cases) as the verification solves it.
+result::VerificationProblem verification_problem(const Job& job);
+
+/// Writes, as job.output asks (step, verification), DIR/result.step, DIR/verification.vtu and
+/// DIR/verification.json for the optimisation `r` on the FE `mesh`; `dir` exists
+/// (prepare_output_folder). verification.json is written whenever either step was asked for,
+/// with what succeeded and the error of what failed. Warnings also go to progress.warn.
+/// Throws only Error(Cancelled) when progress says so.
+ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
+                               const ResultFilesParams& params = {}, const Progress& progress = {});
+
+}  // namespace topopt::pipeline

@@ -1,0 +1,204 @@
+// The result shape as an OCCT solid and a STEP file (see step_export.h).
+#include "result/step_export.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepGProp.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
+#include <Geom_Line.hxx>
+#include <Geom_Plane.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <Interface_Static.hxx>
+#include <STEPControl_Writer.hxx>
+#include <ShapeUpgrade_UnifySameDomain.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shell.hxx>
+#include <TopoDS_Solid.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <TopoDS_Wire.hxx>
+
+#include <chrono>
+#include <filesystem>
+#include <gp_Pln.hxx>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "brep/occt_guard.h"
+#include "common/error.h"
+#include "common/isolate.h"
+
+namespace topopt::result {
+namespace {
+
+gp_Pnt point(const TriSurface& s, int i) { return gp_Pnt(s.V(i, 0), s.V(i, 1), s.V(i, 2)); }
+
+/// The B-Rep vertices and edges of the surface, each made once and shared by every face
+/// that uses it (so the shell is closed by construction).
+class SharedTopology {
+ public:
+  explicit SharedTopology(const TriSurface& s) : s_(s), vertex_(s.V.rows()) {}
+
+  /// The edge from point a to point b, oriented a -> b (the stored edge runs low -> high).
+  TopoDS_Edge edge(int a, int b) {
+    const auto key = std::minmax(a, b);
+    auto it = edges_.find(key);
+    if (it == edges_.end()) it = edges_.emplace(key, straight_edge(key.first, key.second)).first;
+    return a < b ? it->second : TopoDS::Edge(it->second.Reversed());
+  }
+
+ private:
+  TopoDS_Vertex vertex(int i) {
+    if (vertex_[i].IsNull()) vertex_[i] = BRepBuilderAPI_MakeVertex(point(s_, i)).Vertex();
+    return vertex_[i];
+  }
+  TopoDS_Edge straight_edge(int a, int b) {
+    TopoDS_Edge e;
+    const gp_Pnt pa = point(s_, a), pb = point(s_, b);
+    const double length = pa.Distance(pb);
+    Handle(Geom_Line) line = new Geom_Line(pa, gp_Dir(gp_Vec(pa, pb)));
+    builder_.MakeEdge(e, line, Precision::Confusion());
+    builder_.Add(e, vertex(a).Oriented(TopAbs_FORWARD));
+    builder_.Add(e, vertex(b).Oriented(TopAbs_REVERSED));
+    builder_.Range(e, 0, length);
+    return e;
+  }
+
+  const TriSurface& s_;
+  BRep_Builder builder_;
+  std::vector<TopoDS_Vertex> vertex_;
+  std::map<std::pair<int, int>, TopoDS_Edge> edges_;
+};
+
+/// Triangle q's planar face, bounded by its three shared edges. Throws Error(InvalidShape)
+/// for a triangle without area (no plane to put it on) or with an edge of no length.
+TopoDS_Face triangle_face(const TriSurface& s, SharedTopology& topo, long q) {
+  const int a = s.F(q, 0), b = s.F(q, 1), c = s.F(q, 2);
+  const gp_Pnt pa = point(s, a), pb = point(s, b), pc = point(s, c);
+  const gp_Vec n = gp_Vec(pa, pb).Crossed(gp_Vec(pa, pc));
+  const double shortest = std::min({pa.Distance(pb), pb.Distance(pc), pc.Distance(pa)});
+  if (n.Magnitude() <= 1e-12 * std::max(1.0, pa.SquareDistance(pb)) || shortest <= Precision::Confusion())
+    throw Error(ErrorCode::InvalidShape, "the result surface has a triangle without area near (" +
+                                             std::to_string(pa.X()) + ", " + std::to_string(pa.Y()) + ", " +
+                                             std::to_string(pa.Z()) +
+                                             "): it cannot become a CAD face; try other smoothing settings "
+                                             "(\"optimization.smooth\") or a finer mesh");
+  TopoDS_Wire w;
+  BRep_Builder builder;
+  builder.MakeWire(w);
+  builder.Add(w, topo.edge(a, b));
+  builder.Add(w, topo.edge(b, c));
+  builder.Add(w, topo.edge(c, a));
+  w.Closed(true);
+  BRepBuilderAPI_MakeFace mf(gp_Pln(pa, gp_Dir(n)), w, true);
+  if (!mf.IsDone()) throw Error(ErrorCode::InvalidShape, "OCCT could not make a face of a result triangle");
+  return mf.Face();
+}
+
+std::string report_text(const StepExportReport& r) {
+  std::ostringstream o;
+  o.precision(17);
+  o << r.valid << " " << r.solids << " " << r.faces << " " << r.planar_faces << " " << r.volume;
+  return o.str();
+}
+
+StepExportReport report_of(const std::string& text) {
+  StepExportReport r;
+  std::istringstream in(text);
+  in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume;
+  if (!in) throw Error(ErrorCode::Internal, "the STEP export's child answered '" + text + "'");
+  return r;
+}
+
+void write_step_file(const TopoDS_Shape& shape, const std::string& path) {
+  STEPControl_Writer writer;
+  Interface_Static::SetCVal("write.step.schema", "AP214IS");
+  Interface_Static::SetCVal("write.step.unit", "MM");
+  if (writer.Transfer(shape, STEPControl_ManifoldSolidBrep) != IFSelect_RetDone)
+    throw Error(ErrorCode::InvalidShape, "OCCT could not translate the result solid to STEP");
+  if (writer.Write(path.c_str()) != IFSelect_RetDone)
+    throw Error(ErrorCode::Io, "cannot write '" + path + "' (folder missing, not writable, or disk full)");
+}
+
+}  // namespace
+
+TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params) {
+  const SurfaceCheck check = check_surface(s.V, s.F);
+  if (!check.closed_manifold() || check.volume <= 0)
+    throw Error(
+        ErrorCode::InvalidShape,
+        "the result surface is not closed and outward (" + std::to_string(check.unpaired_edges) +
+            " unpaired edges): it cannot become a solid; try other smoothing settings (\"optimization.smooth\")");
+  SharedTopology topo(s);
+  BRep_Builder builder;
+  TopoDS_Shell shell;
+  builder.MakeShell(shell);
+  for (long q = 0; q < s.F.rows(); ++q) builder.Add(shell, triangle_face(s, topo, q));
+  shell.Closed(true);
+  TopoDS_Solid solid;
+  builder.MakeSolid(solid);
+  builder.Add(solid, shell);
+  if (!params.unify) return solid;
+  ShapeUpgrade_UnifySameDomain unify(solid, true, true, false);
+  unify.SetAngularTolerance(params.angular_tolerance);
+  unify.Build();
+  return unify.Shape();
+}
+
+StepExportReport describe_solid(const TopoDS_Shape& shape) {
+  StepExportReport r;
+  for (TopExp_Explorer e(shape, TopAbs_SOLID); e.More(); e.Next()) ++r.solids;
+  for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) {
+    ++r.faces;
+    Handle(Geom_Surface) surface = BRep_Tool::Surface(TopoDS::Face(e.Current()));
+    if (!surface.IsNull() && surface->IsKind(STANDARD_TYPE(Geom_Plane))) ++r.planar_faces;
+  }
+  r.valid = BRepCheck_Analyzer(shape).IsValid();
+  GProp_GProps props;
+  BRepGProp::VolumeProperties(shape, props);
+  r.volume = props.Mass();
+  return r;
+}
+
+StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
+                                   const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t caller = getpid();
+  const std::string answer = run_isolated(
+      "writing the result as STEP", params.seconds,
+      [&]() {
+        // OCCT's STEP writer prints its statistics on stdout: silenced in the child only
+        // (stdout is the CLI's answer and the worker's protocol)
+        if (getpid() != caller) {
+          const int null = open("/dev/null", O_WRONLY);
+          if (null >= 0) dup2(null, 1), close(null);
+        }
+        return brep::guard_occt("building the result solid", [&]() {
+          const TopoDS_Shape solid = result_solid(s, params);
+          const StepExportReport r = describe_solid(solid);
+          if (!r.valid || r.solids != 1)
+            throw Error(ErrorCode::InvalidShape,
+                        "the result solid is not one valid solid (" + std::to_string(r.solids) +
+                            " solids, OCCT's check " + (r.valid ? "passed" : "failed") +
+                            "); the STL is written: try other smoothing settings (\"optimization.smooth\")");
+          write_step_file(solid, path);
+          return report_text(r);
+        });
+      },
+      progress);
+  StepExportReport r = report_of(answer);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::error_code ec;
+  r.bytes = static_cast<long>(std::filesystem::file_size(path, ec));
+  return r;
+}
+
+}  // namespace topopt::result

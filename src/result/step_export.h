@@ -1,0 +1,56 @@
+// The result shape back in CAD: the closed, tagged triangle surface (iso_surface.h) made into
+// one OCCT solid and written as STEP. Every triangle becomes a planar face and every mesh edge
+// one B-Rep edge shared by its two faces, so the shell is closed by construction (no sewing
+// by distance, which is slow and can glue the wrong edges where the design is thin); OCCT's
+// ShapeUpgrade_UnifySameDomain then merges coplanar neighbours into one planar face (Ω's
+// planar faces come back whole, bounded by the polygon of the kept region) and collinear
+// edges into one. The free-form region stays a shell of planar facets.
+#pragma once
+#include <string>
+
+#include "common/progress.h"
+#include "result/iso_surface.h"
+
+class TopoDS_Shape;
+
+namespace topopt::result {
+
+struct StepExportParams {
+  double seconds = 120;  ///< time budget of the child process that builds and writes the solid (<= 0: none)
+  bool unify = true;     ///< merge coplanar faces and collinear edges (ShapeUpgrade_UnifySameDomain)
+  /// Angle (radians) within which two facets count as coplanar when merging. Ω's planar faces
+  /// are exactly planar; a small value keeps the free-form region's facets apart.
+  double angular_tolerance = 1e-6;
+};
+
+/// What the solid written holds, as OCCT's checks found it after building.
+struct StepExportReport {
+  bool valid = false;    ///< BRepCheck_Analyzer found no fault
+  int solids = 0;        ///< solids in the shape (1 when all went well)
+  int faces = 0;         ///< B-Rep faces after merging
+  int planar_faces = 0;  ///< faces on a Geom_Plane
+  double volume = 0;     ///< mm³, by OCCT's GProp
+  double seconds = 0;    ///< building, checking and writing
+  long bytes = 0;        ///< size of the STEP file
+};
+
+/// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): a planar
+/// face per triangle sharing its edges with the neighbours, then, with params.unify, coplanar
+/// faces merged. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
+/// first triangle without area or an open surface (what to change: the smoothing settings).
+/// Runs OCCT in this process: callers with foreign or untrusted surfaces use write_result_step.
+TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {});
+
+/// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer) and
+/// measures its volume; seconds and bytes are left 0.
+StepExportReport describe_solid(const TopoDS_Shape& shape);
+
+/// Builds result_solid(s) and writes it to `path` as STEP (AP214, mm), in a child process
+/// with the time budget params.seconds, so that a fault or a hang inside OCCT costs the
+/// export, never the caller. Returns the report of the solid written. Throws Error(Timeout)
+/// past the budget, Error(Crashed) when OCCT ends the child, Error(InvalidShape) when the
+/// solid is not one valid solid, Error(Io) when the file cannot be written.
+StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params = {},
+                                   const Progress& progress = {});
+
+}  // namespace topopt::result

@@ -1,0 +1,237 @@
+// Verification of the result shape by analysis (see verification.h).
+#include "result/verification.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include "common/error.h"
+#include "common/isolate.h"
+#include "fem/elasticity.h"
+#include "result/design_hygiene.h"
+
+namespace topopt::result {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Eigen::Vector3d corner(const MatX3d& V, const MatX3i& F, long q, int k) { return V.row(F(q, k)).transpose(); }
+
+/// How far point p lies from triangle q of (V, F): its distance to the plane plus how far its
+/// projection falls outside the triangle (barycentric coordinates below 0, scaled by size).
+double off_triangle(const MatX3d& V, const MatX3i& F, long q, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d a = corner(V, F, q, 0), b = corner(V, F, q, 1), c = corner(V, F, q, 2);
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double area2 = n.squaredNorm();
+  if (area2 <= 0) return 1e300;
+  const double wa = (b - p).cross(c - p).dot(n) / area2, wb = (c - p).cross(a - p).dot(n) / area2;
+  const double wc = 1 - wa - wb;
+  const double outside = std::max({0.0, -wa, -wb, -wc}) * std::sqrt(std::sqrt(area2));
+  return std::abs((p - a).dot(n)) / std::sqrt(area2) + outside;
+}
+
+/// FE boundary triangles binned by centroid on a grid of cells as large as the longest edge.
+class BoundaryGrid {
+ public:
+  explicit BoundaryGrid(const TetMesh& fe) : fe_(fe) {
+    for (long q = 0; q < fe.F.rows(); ++q)
+      for (int k = 0; k < 3; ++k)
+        cell_ = std::max(cell_, (corner(fe.V, fe.F, q, k) - corner(fe.V, fe.F, q, (k + 1) % 3)).norm());
+    for (long q = 0; q < fe.F.rows(); ++q) bins_[key(centroid(fe.V, fe.F, q), 0, 0, 0)].push_back(q);
+  }
+
+  /// The boundary triangle of Ω's face `face` that p lies on (the nearest by off_triangle), -1 if none is near.
+  long nearest(const Eigen::Vector3d& p, int face) const {
+    long best = -1;
+    double best_off = 1e300;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          const auto it = bins_.find(key(p, i, j, k));
+          if (it == bins_.end()) continue;
+          for (long q : it->second) {
+            if (fe_.face.size() && fe_.face[q] != face) continue;
+            const double off = off_triangle(fe_.V, fe_.F, q, p);
+            if (off < best_off) best_off = off, best = q;
+          }
+        }
+    return best;
+  }
+
+  static Eigen::Vector3d centroid(const MatX3d& V, const MatX3i& F, long q) {
+    return (corner(V, F, q, 0) + corner(V, F, q, 1) + corner(V, F, q, 2)) / 3;
+  }
+
+ private:
+  long long key(const Eigen::Vector3d& p, int i, int j, int k) const {
+    const double h = cell_ > 0 ? cell_ : 1;
+    const long long x = static_cast<long long>(std::floor(p.x() / h)) + i,
+                    y = static_cast<long long>(std::floor(p.y() / h)) + j,
+                    z = static_cast<long long>(std::floor(p.z() / h)) + k;
+    return (x & 0x1FFFFF) | ((y & 0x1FFFFF) << 21) | ((z & 0x1FFFFF) << 42);
+  }
+  const TetMesh& fe_;
+  double cell_ = 0;
+  std::unordered_map<long long, std::vector<long>> bins_;
+};
+
+/// #F of the result surface: the non-design face of the FE boundary triangle each triangle on
+/// Ω's face lies on (0 elsewhere, and everywhere when the FE mesh has none).
+VecXi nd_faces_of(const MatX3d& V, const MatX3i& F, const VecXi& face, const TetMesh& fe) {
+  VecXi nd = VecXi::Zero(F.rows());
+  if (fe.nd_face.size() != fe.F.rows() || (fe.nd_face.array() == 0).all()) return nd;
+  const BoundaryGrid grid(fe);
+  for (long q = 0; q < F.rows(); ++q) {
+    if (face[q] <= 0) continue;
+    const long on = grid.nearest(BoundaryGrid::centroid(V, F, q), face[q]);
+    if (on >= 0) nd[q] = fe.nd_face[on];
+  }
+  return nd;
+}
+
+/// A Progress that answers "cancelled" once `deadline` has passed (or when `outer` says so).
+Progress with_deadline(const Progress& outer, std::chrono::steady_clock::time_point deadline, bool limited) {
+  Progress p = outer;
+  p.cancelled = [outer, deadline, limited]() {
+    return (limited && std::chrono::steady_clock::now() > deadline) || (outer.cancelled && outer.cancelled());
+  };
+  return p;
+}
+
+/// The bytes of a fill's nodes and tets (row counts, then the raw arrays), and back.
+std::string pack(const mesh::VolumeFillResult& r) {
+  const long nv = r.V.rows(), nt = r.T.rows();
+  std::string b(2 * sizeof(long) + nv * 3 * sizeof(double) + nt * 4 * sizeof(int), '\0');
+  char* p = b.data();
+  std::memcpy(p, &nv, sizeof nv), std::memcpy(p + sizeof nv, &nt, sizeof nt);
+  std::memcpy(p + 2 * sizeof(long), r.V.data(), nv * 3 * sizeof(double));
+  std::memcpy(p + 2 * sizeof(long) + nv * 3 * sizeof(double), r.T.data(), nt * 4 * sizeof(int));
+  return b;
+}
+
+mesh::VolumeFillResult unpack(const std::string& b) {
+  long nv = 0, nt = 0;
+  if (b.size() < 2 * sizeof(long)) throw Error(ErrorCode::Internal, "the result's volume mesh came back cut short");
+  std::memcpy(&nv, b.data(), sizeof nv), std::memcpy(&nt, b.data() + sizeof nv, sizeof nt);
+  if (nv < 0 || nt < 0 || b.size() != 2 * sizeof(long) + nv * 3 * sizeof(double) + nt * 4 * sizeof(int))
+    throw Error(ErrorCode::Internal, "the result's volume mesh came back cut short");
+  mesh::VolumeFillResult r;
+  r.V.resize(nv, 3), r.T.resize(nt, 4);
+  std::memcpy(r.V.data(), b.data() + 2 * sizeof(long), nv * 3 * sizeof(double));
+  std::memcpy(r.T.data(), b.data() + 2 * sizeof(long) + nv * 3 * sizeof(double), nt * 4 * sizeof(int));
+  return r;
+}
+
+}  // namespace
+
+TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
+                          const Progress& progress) {
+  std::vector<int> index(s.V.rows(), -1);
+  int used = 0;
+  for (long q = 0; q < s.F.rows(); ++q)
+    for (int k = 0; k < 3; ++k)
+      if (index[s.F(q, k)] < 0) index[s.F(q, k)] = used++;
+  MatX3d V(used, 3);
+  for (long i = 0; i < s.V.rows(); ++i)
+    if (index[i] >= 0) V.row(index[i]) = s.V.row(i);
+  MatX3i F(s.F.rows(), 3);
+  for (long q = 0; q < s.F.rows(); ++q)
+    for (int k = 0; k < 3; ++k) F(q, k) = index[s.F(q, k)];
+  // in a child with a hard deadline: the front's inner loops do not all look at the clock
+  const mesh::VolumeFillResult filled = unpack(run_isolated(
+      "meshing the result solid", seconds,
+      [&]() {
+        Progress quiet;  // the child says nothing (the worker's stdout is its protocol)
+        quiet.cancelled = progress.cancelled;
+        return pack(mesh::fill_volume(V, F, MatX4i(0, 4), fill, quiet));
+      },
+      progress));
+  TetMesh m;
+  m.V = filled.V;
+  m.T = filled.T;
+  m.domain = VecXi::Zero(m.T.rows());
+  m.F = F;
+  m.face = s.tag.cwiseMax(0);
+  m.nd_face = nd_faces_of(V, F, m.face, fe);
+  return m;
+}
+
+AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const VerificationProblem& problem,
+                        const VecXd& scale, const fem::SolverParams& solver, const Progress& progress,
+                        Eigen::MatrixXd* U, std::vector<VecXd>* von_mises) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const fem::Supports supports = fem::make_supports(mesh, problem.supports);
+  const Eigen::MatrixXd loads = fem::make_loads(loaded, problem.material, problem.load_cases);
+  fem::Elasticity fe(mesh, problem.material, supports, solver);
+  if (scale.size()) fe.set_scale(scale);
+  const Eigen::MatrixXd u = fe.solve(loads, progress);
+  AnalysisFigures a;
+  std::vector<char> node_used(mesh.V.rows(), 0);
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (!scale.size() || scale[t] >= 1)
+      for (int k = 0; k < 4; ++k) node_used[mesh.T(t, k)] = 1;
+  for (long c = 0; c < loads.cols(); ++c) {
+    a.compliance += problem.load_cases[c].weight * loads.col(c).dot(u.col(c));
+    for (long i = 0; i < mesh.V.rows(); ++i)
+      if (node_used[i]) a.max_displacement = std::max(a.max_displacement, u.col(c).segment<3>(3 * i).norm());
+    const VecXd vm = fe.von_mises(u.col(c));
+    for (long t = 0; t < mesh.T.rows(); ++t)
+      if (!scale.size() || scale[t] >= 1) a.max_von_mises = std::max(a.max_von_mises, vm[t]);
+    if (von_mises) von_mises->push_back(vm);
+  }
+  a.nodes = std::count(node_used.begin(), node_used.end(), 1);
+  a.tets = scale.size() ? (scale.array() >= 1).count() : mesh.T.rows();
+  a.seconds = seconds_since(t0);
+  if (U) *U = u;
+  return a;
+}
+
+Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& design, double threshold,
+                           const VerificationProblem& problem, const VerificationParams& params,
+                           const Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(std::max(0.0, params.seconds)));
+  const Progress timed = with_deadline(progress, deadline, params.seconds > 0);
+  const auto out_of_time = [&](const std::string& step) {
+    if (progress.cancelled && progress.cancelled()) throw Error(ErrorCode::Cancelled, "cancelled during " + step);
+    throw Error(ErrorCode::Timeout, step + " ran past the verification's time budget of " +
+                                        std::to_string(static_cast<int>(params.seconds)) +
+                                        " s; the result files are written, only the verification is missing");
+  };
+  Verification v;
+  try {
+    v.mesh = verification_mesh(s, fe, params.fill, params.seconds, timed);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Timeout) out_of_time("meshing the result solid");
+    throw;
+  }
+  const double seconds_mesh = seconds_since(t0);
+  // the crisp design on the FE mesh: removed tets keep void_stiffness, only kept tets weigh
+  const std::vector<char> kept = crisp_tets(fe, node_densities(fe, design), threshold);
+  VecXd scale(fe.T.rows());
+  TetMesh loaded = fe;
+  if (loaded.domain.size() != fe.T.rows()) loaded.domain = VecXi::Zero(fe.T.rows());
+  long n = 0;
+  for (long t = 0; t < fe.T.rows(); ++t) {
+    scale[t] = kept[t] ? 1.0 : params.void_stiffness;
+    if (kept[t]) loaded.T.row(n) = fe.T.row(t), loaded.domain[n] = loaded.domain[t], ++n;
+  }
+  loaded.T.conservativeResize(n, 4);
+  loaded.domain.conservativeResize(n);
+  try {
+    v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
+    v.as_built.seconds += seconds_mesh;
+    v.crisp = analyse(fe, loaded, problem, scale, params.solver, timed);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::Cancelled) out_of_time("solving the verification");
+    throw;
+  }
+  return v;
+}
+
+}  // namespace topopt::result

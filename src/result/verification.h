@@ -1,0 +1,77 @@
+// Verification of the result shape by analysis: the closed result surface filled with tets by
+// the code's own volume mesher (mesh/volume/volume_front.h) and solved with the study's
+// supports and loads, next to the crisp design on the FE mesh solved the same way. Supports and
+// loads act on Ω's faces and the non-design solids' faces; both survive on the result (the
+// surface's triangle tags say which Ω face a triangle lies on, and the FE mesh's boundary says
+// which non-design face), so the same job applies to both meshes.
+#pragma once
+#include <vector>
+
+#include "common/progress.h"
+#include "common/types.h"
+#include "fem/boundary_conditions.h"
+#include "mesh/volume/volume_front.h"
+#include "result/iso_surface.h"
+
+namespace topopt::result {
+
+struct VerificationParams {
+  double seconds = 300;          ///< wall-time budget of meshing the result and solving (<= 0: none)
+  mesh::VolumeFillParams fill;   ///< the volume mesher's settings (default: size graded from the surface)
+  fem::SolverParams solver;      ///< the linear solver (default: chosen by size)
+  double void_stiffness = 1e-9;  ///< the crisp design's removed tets keep this share of E (as SIMP's void)
+};
+
+/// The study's problem: what verify_result solves on each mesh.
+struct VerificationProblem {
+  fem::Material material;
+  std::vector<fem::SupportSpec> supports;
+  std::vector<fem::LoadCase> load_cases;
+};
+
+/// One analysis: compliance summed over the load cases with their weights (N·mm), the largest
+/// displacement length (mm) and von Mises stress (MPa) over the cases, and the mesh's size.
+struct AnalysisFigures {
+  double compliance = 0;
+  double max_displacement = 0;
+  double max_von_mises = 0;
+  long tets = 0;
+  long nodes = 0;
+  double seconds = 0;  ///< meshing (as built only) and solving
+};
+
+struct Verification {
+  AnalysisFigures as_built;  ///< the result solid, meshed by fill_volume
+  AnalysisFigures crisp;     ///< the crisp design's tets on the FE mesh (void at void_stiffness)
+  TetMesh mesh;              ///< the verification mesh: tets of the result, F the result surface with Ω's face tags
+  Eigen::MatrixXd U;         ///< (3 #V) by #cases displacements on `mesh`
+  std::vector<VecXd> von_mises;  ///< per case, #T of `mesh` (MPa)
+  double ratio() const { return crisp.compliance > 0 ? as_built.compliance / crisp.compliance : 0; }
+};
+
+/// The tet mesh inside the closed surface `s` (its unused points dropped; F oriented
+/// outwards): tets from fill_volume, F = s.F, `face` the Ω face tags (0 where the triangle
+/// lies on the iso-surface or a non-design solid inside Ω), `nd_face` taken from the FE mesh
+/// `fe` boundary triangle each tagged triangle lies on. The fill runs in a child process
+/// (run_isolated) stopped after `seconds` (<= 0: no limit): throws what fill_volume throws,
+/// Error(Timeout) past the budget, Error(Crashed) if the child dies.
+TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
+                          const Progress& progress = {});
+
+/// Solves `problem` on `mesh` with element stiffness factors `scale` (#T, empty: all 1) and
+/// loads built on `loaded` (the same nodes as mesh; its tets carry the weight). Returns the
+/// figures over the tets whose scale is 1 and their nodes; U and von Mises when asked for.
+AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const VerificationProblem& problem,
+                        const VecXd& scale, const fem::SolverParams& solver, const Progress& progress = {},
+                        Eigen::MatrixXd* U = nullptr, std::vector<VecXd>* von_mises = nullptr);
+
+/// The verification: `s` meshed and solved (as built) and the crisp design of `design` (#T
+/// element densities after hygiene, cut at `threshold` as the surface was) solved on `fe`.
+/// The whole runs within params.seconds: past it, Error(Timeout) naming the step. Throws
+/// what fill_volume and fem throw (MeshingFailed, FaceNotFound when a support's face is gone,
+/// NoSupport).
+Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& design, double threshold,
+                           const VerificationProblem& problem, const VerificationParams& params = {},
+                           const Progress& progress = {});
+
+}  // namespace topopt::result

@@ -1,0 +1,127 @@
+// The result as a CAD solid: one valid solid whose volume is the surface's, Ω's planar faces
+// back as single planar B-Rep faces, and a STEP file OCCT reads back as the same solid.
+#include "result/step_export.h"
+
+#include <gtest/gtest.h>
+
+#include <BRepGProp.hxx>
+#include <BRep_Tool.hxx>
+#include <GProp_GProps.hxx>
+#include <Geom_Plane.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <cmath>
+#include <filesystem>
+#include <gp_Pln.hxx>
+
+#include "common/error.h"
+#include "mesh/core/structured_box.h"
+#include "simp/density_filter.h"
+
+namespace topopt::result {
+namespace {
+
+/// A 40x20x10 box, a non-design block at each end (x in [0, 6] and [36, 40]) and between them
+/// a round bar of varying radius: the unsmoothed iso-surface of that density field.
+TriSurface bar_surface() {
+  mesh::StructuredBoxParams p;
+  p.size = {40, 20, 10};
+  p.cells = {20, 10, 5};
+  p.nondesign = {{0, 6, 2, 6, 14, 8}, {36, 6, 2, 40, 14, 8}};
+  const TetMesh mesh = mesh::structured_box_mesh(p);
+  const MatX3d c = simp::tet_centroids(mesh);
+  VecXd density(mesh.T.rows());
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    const double r = std::hypot(c(t, 1) - 10, c(t, 2) - 5), radius = 3.5 + 1.5 * std::sin(c(t, 0) / 6);
+    density[t] = mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (r - radius)));
+  }
+  return extract_iso_surface(mesh, node_densities(mesh, density), 0.5);
+}
+
+/// The faces of `shape` on the plane x = x0 (normal along x).
+int faces_on_plane_x(const TopoDS_Shape& shape, double x0) {
+  int n = 0;
+  for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) {
+    Handle(Geom_Plane) plane = Handle(Geom_Plane)::DownCast(BRep_Tool::Surface(TopoDS::Face(e.Current())));
+    if (plane.IsNull()) continue;
+    const gp_Pln pl = plane->Pln();
+    if (std::abs(std::abs(pl.Axis().Direction().X()) - 1) < 1e-9 && std::abs(pl.Location().X() - x0) < 1e-9) ++n;
+  }
+  return n;
+}
+
+TEST(StepExport, OneValidSolidWithTheSurfacesVolumeAndMergedPlanarFaces) {
+  const TriSurface s = bar_surface();
+  const double volume = check_surface(s.V, s.F).volume;
+  const TopoDS_Shape solid = result_solid(s);
+  const StepExportReport r = describe_solid(solid);
+  EXPECT_TRUE(r.valid);
+  EXPECT_EQ(r.solids, 1);
+  EXPECT_NEAR(r.volume, volume, 1e-6 * volume);
+  // Ω's faces x = 0 and x = 40 keep one connected region each (the block's end and the bar's
+  // section meet there): each is one planar B-Rep face
+  EXPECT_EQ(faces_on_plane_x(solid, 0), 1);
+  EXPECT_EQ(faces_on_plane_x(solid, 40), 1);
+  // the blocks' five other faces are planar too; the bar's facets stay apart
+  EXPECT_GE(r.planar_faces, 2 + 2 * 4);
+  long free_form = 0;
+  for (long q = 0; q < s.tag.size(); ++q) free_form += s.tag[q] == 0;
+  EXPECT_LE(r.faces, free_form + r.planar_faces);
+  // without merging every triangle is a face
+  EXPECT_EQ(describe_solid(result_solid(s, {.unify = false})).faces, s.F.rows());
+}
+
+TEST(StepExport, TheStepFileReadsBackAsOneValidSolidOfTheSameVolume) {
+  const TriSurface s = bar_surface();
+  const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_test.step").string();
+  const StepExportReport written = write_result_step(path, s);
+  EXPECT_GT(written.bytes, 0);
+  STEPControl_Reader reader;
+  ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
+  reader.TransferRoots();
+  const StepExportReport back = describe_solid(reader.OneShape());
+  EXPECT_TRUE(back.valid);
+  EXPECT_EQ(back.solids, 1);
+  EXPECT_EQ(back.faces, written.faces);
+  const double stl_volume = check_surface(s.V, s.F).volume;
+  EXPECT_NEAR(back.volume, stl_volume, 0.005 * stl_volume);
+  EXPECT_EQ(faces_on_plane_x(reader.OneShape(), 0), 1);
+  std::filesystem::remove(path);
+}
+
+TEST(StepExport, AnOpenOrDegenerateSurfaceIsANamedError) {
+  TriSurface s = bar_surface();
+  TriSurface open = s;
+  open.F.conservativeResize(s.F.rows() - 1, 3);
+  try {
+    result_solid(open);
+    FAIL() << "an open surface became a solid";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidShape);
+    EXPECT_NE(std::string(e.what()).find("not closed"), std::string::npos) << e.what();
+  }
+  // a triangle squashed flat: its corner moved onto the opposite edge's midpoint
+  TriSurface flat = s;
+  flat.V.row(flat.F(0, 2)) = (flat.V.row(flat.F(0, 0)) + flat.V.row(flat.F(0, 1))) / 2;
+  try {
+    result_solid(flat);
+    FAIL() << "a triangle without area became a face";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidShape);
+    EXPECT_NE(std::string(e.what()).find("without area"), std::string::npos) << e.what();
+  }
+  // in the child the same error comes back with its code, and no file is left
+  const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_bad.step").string();
+  std::filesystem::remove(path);
+  try {
+    write_result_step(path, open);
+    FAIL() << "an open surface was written";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidShape);
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+}  // namespace
+}  // namespace topopt::result
