@@ -7,6 +7,7 @@
 
 #include "common/blas_threads.h"
 #include "common/error.h"
+#include "simp/controls/design_map.h"
 #include "simp/density_filter.h"
 #include "simp/update.h"
 
@@ -33,6 +34,10 @@ void check_params(const SimpParams& params) {
     throw Error(ErrorCode::InvalidParameter,
                 "the projection needs 1 <= beta_start <= beta_max, a factor above 1, at least one iteration per "
                 "beta and a threshold eta in (0, 1)");
+  if (params.sensitivity_filter && params.controls.any())
+    throw Error(ErrorCode::InvalidParameter,
+                "the geometry controls (symmetry, cyclic, pattern, extrusion) work with the density filter: "
+                "turn the sensitivity filter off");
 }
 
 void check_volume_fraction(double volume_fraction, const std::string& name) {
@@ -65,6 +70,9 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fp.radius = filter_radius(mesh, fp);
   filter_ = make_filter(mesh, design_, volume, fp, progress);
   progress.info("filter: " + filter_->describe());
+  const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
+  controls_ = std::make_unique<DesignMap>(mesh, design_, params.controls, tolerance);
+  if (params.controls.any()) progress.info("controls: " + controls_->describe());
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())
@@ -76,17 +84,23 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
   if (!params.projection.enabled)
-    volume_weights_ = (params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
+    volume_weights_ =
+        controls_->apply_transpose(params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
 }
 
 ComplianceProblem::~ComplianceProblem() = default;
 
 void ComplianceProblem::forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
-  rho_tilde = params_.sensitivity_filter ? x : filter_->apply(x);
+  const VecXd z = controls_->apply(x);
+  rho_tilde = params_.sensitivity_filter ? z : filter_->apply(z);
   rho_bar = rho_tilde;
   if (params_.projection.enabled)
     for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
 }
+
+int ComplianceProblem::num_variables() const { return controls_->num_variables(); }
+
+VecXd ComplianceProblem::design_field(const VecXd& x) const { return controls_->apply(x); }
 
 VecXd ComplianceProblem::physical(const VecXd& x) const {
   VecXd rt, rb;
@@ -130,7 +144,7 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
     // ---- chain rule back through projection and filter
     if (params_.projection.enabled)
       for (int i = 0; i < num_design; ++i) dc_bar[i] *= proj_.derivative(rho_tilde[i]);
-    *dc = params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar);
+    *dc = controls_->apply_transpose(params_.sensitivity_filter ? dc_bar : filter_->apply_transpose(dc_bar));
   }
   return c;
 }
@@ -146,7 +160,7 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
     VecXd g = vd_ / design_volume_;
     if (params_.projection.enabled)
       for (long i = 0; i < g.size(); ++i) g[i] *= proj_.derivative(rho_tilde[i]);
-    *dv = params_.sensitivity_filter ? g : filter_->apply_transpose(g);
+    *dv = controls_->apply_transpose(params_.sensitivity_filter ? g : filter_->apply_transpose(g));
   }
   return vd_.dot(rho_bar) / design_volume_;
 }
@@ -236,9 +250,10 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   SimpResult res;
   res.design = problem.design();
   const int num_design = static_cast<int>(res.design.size());
-  DesignUpdate update(params, num_design);
+  const int num_variables = problem.num_variables();
+  DesignUpdate update(params, num_variables);
   Continuation schedule(params.projection, params.tol_change, params.tol_objective);
-  VecXd x = VecXd::Constant(num_design, params.volume_fraction);
+  VecXd x = VecXd::Constant(num_variables, params.volume_fraction);
   for (int it = 1; it <= params.max_iterations; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
     progress.check_cancel("the optimisation (iteration " + std::to_string(it) + ")");
@@ -265,7 +280,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     if (next == NextStep::RaiseBeta) update.restart();
   }
   if (!res.converged) res.status = "iteration cap (" + std::to_string(params.max_iterations) + ") reached";
-  res.variables = x;
+  res.variables = problem.design_field(x);
   problem.set_beta(schedule.beta());
   const VecXd rho = problem.physical(x);
   res.density = VecXd::Ones(mesh.T.rows());
