@@ -1,6 +1,7 @@
 // The "optimization" section of a job (docs/optimization.md): every SIMP setting typed and
 // range-checked here, once.
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "common/error.h"
@@ -137,6 +138,56 @@ void parse_responses(const Fields& f, OptimizeSettings& s) {
   if (beyond) s.simp.update = simp::UpdateKind::MMA;
 }
 
+/// The direction [x, y, z] at `key` (required): finite and not all zero.
+Eigen::Vector3d vector3(const Fields& f, const std::string& key) {
+  const std::array<double, 3> v = f.vec3(key);
+  if (v[0] == 0 && v[1] == 0 && v[2] == 0) f.bad(key, "must not be [0, 0, 0]: give the direction in model axes");
+  return {v[0], v[1], v[2]};
+}
+
+/// A list of objects at `key`, each read by `one` (its Fields).
+void each_item(const Fields& f, const std::string& key, const std::function<void(const Fields&)>& one,
+               const std::vector<std::string>& keys, const std::string& example) {
+  if (!f.has(key)) return;
+  if (!f.at(key).is_array()) f.bad(key, "must be a list such as [" + example + "]");
+  for (size_t i = 0; i < f.at(key).size(); ++i)
+    one(Fields(f.at(key)[i], f.name(key) + "[" + std::to_string(i) + "]", keys, example));
+}
+
+/// "controls": {"symmetry_planes": [{"point", "normal"}], "cyclic": [{"point", "axis",
+/// "sectors"}], "patterns": [{"direction", "pitch", "count"}], "extrusion": [x, y, z],
+/// "tolerance"} (docs/optimization.md).
+void parse_controls(const Fields& opt, simp::ControlsParams& c) {
+  if (!opt.has("controls")) return;
+  const Fields f(opt.at("controls"), opt.name("controls"),
+                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "tolerance"},
+                 "{\"symmetry_planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0]}]}");
+  each_item(
+      f, "symmetry_planes",
+      [&](const Fields& g) {
+        c.mirrors.push_back({Eigen::Vector3d(g.vec3("point").data()), vector3(g, "normal")});
+      },
+      {"point", "normal"}, "{\"point\": [0, 0, 0], \"normal\": [0, 1, 0]}");
+  each_item(
+      f, "cyclic",
+      [&](const Fields& g) {
+        c.cyclic.push_back(
+            {Eigen::Vector3d(g.vec3("point").data()), vector3(g, "axis"), g.integer("sectors", 0, 2, 360)});
+      },
+      {"point", "axis", "sectors"}, "{\"point\": [0, 0, 0], \"axis\": [0, 0, 1], \"sectors\": 6}");
+  each_item(
+      f, "patterns",
+      [&](const Fields& g) {
+        const double pitch = g.number("pitch", 0);
+        if (!(pitch > 0)) g.bad("pitch", "must be above 0 (mm between copies)");
+        c.patterns.push_back({vector3(g, "direction"), pitch, g.integer("count", 0, 2, 10000)});
+      },
+      {"direction", "pitch", "count"}, "{\"direction\": [1, 0, 0], \"pitch\": 20, \"count\": 3}");
+  if (f.has("extrusion")) c.extrude = true, c.extrusion = vector3(f, "extrusion");
+  c.tolerance = f.number("tolerance", 0);
+  if (c.tolerance < 0) f.bad("tolerance", "must be positive (mm), or 0 for the mean edge length");
+}
+
 }  // namespace
 
 OptimizeSettings parse_optimization(const json& section) {
@@ -146,7 +197,9 @@ OptimizeSettings parse_optimization(const json& section) {
        "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
        "solver_tolerance", "smoothing_iterations", "fill_voids",
        // objectives and constraints (parse_responses)
-       "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation"},
+       "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation",
+       // geometry controls (parse_controls)
+       "controls"},
       "{\"volume_fraction\": 0.3}");
   OptimizeSettings s;
   simp::SimpParams& p = s.simp;
@@ -170,6 +223,9 @@ OptimizeSettings parse_optimization(const json& section) {
                                                   : simp::HelmholtzSolver::Auto;
   p.sensitivity_filter = f.boolean("sensitivity_filter", false);
   parse_heaviside(f, p.projection);
+  parse_controls(f, p.controls);
+  if (p.sensitivity_filter && p.controls.any())
+    f.bad("sensitivity_filter", "must be false with geometry controls (they act through the density filter)");
   p.update = f.choice("update", "oc", {"oc", "mma"}, "optimality criteria or the method of moving asymptotes") == "mma"
                  ? simp::UpdateKind::MMA
                  : simp::UpdateKind::OC;

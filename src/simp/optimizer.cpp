@@ -7,6 +7,7 @@
 
 #include "common/blas_threads.h"
 #include "common/error.h"
+#include "simp/controls/design_map.h"
 #include "simp/density_filter.h"
 #include "simp/responses/responses.h"
 #include "simp/update.h"
@@ -34,6 +35,10 @@ void check_params(const SimpParams& params) {
     throw Error(ErrorCode::InvalidParameter,
                 "the projection needs 1 <= beta_start <= beta_max, a factor above 1, at least one iteration per "
                 "beta and a threshold eta in (0, 1)");
+  if (params.sensitivity_filter && params.controls.any())
+    throw Error(ErrorCode::InvalidParameter,
+                "the geometry controls (symmetry, cyclic, pattern, extrusion) work with the density filter: "
+                "turn the sensitivity filter off");
 }
 
 void check_volume_fraction(double volume_fraction, const std::string& name) {
@@ -66,6 +71,9 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fp.radius = filter_radius(mesh, fp);
   filter_ = make_filter(mesh, design_, volume, fp, progress);
   progress.info("filter: " + filter_->describe());
+  const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
+  controls_ = std::make_unique<DesignMap>(mesh, design_, params.controls, tolerance);
+  if (params.controls.any()) progress.info("controls: " + controls_->describe());
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())
@@ -77,17 +85,23 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
   if (!params.projection.enabled)
-    volume_weights_ = (params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
+    volume_weights_ =
+        controls_->apply_transpose(params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
 }
 
 ComplianceProblem::~ComplianceProblem() = default;
 
 void ComplianceProblem::forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
-  rho_tilde = params_.sensitivity_filter ? x : filter_->apply(x);
+  const VecXd z = controls_->apply(x);
+  rho_tilde = params_.sensitivity_filter ? z : filter_->apply(z);
   rho_bar = rho_tilde;
   if (params_.projection.enabled)
     for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
 }
+
+int ComplianceProblem::num_variables() const { return controls_->num_variables(); }
+
+VecXd ComplianceProblem::design_field(const VecXd& x) const { return controls_->apply(x); }
 
 VecXd ComplianceProblem::physical(const VecXd& x) const {
   VecXd rt, rb;
@@ -124,7 +138,7 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
 VecXd ComplianceProblem::chain(const VecXd& rho_tilde, VecXd d_bar) const {
   if (params_.projection.enabled)
     for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= proj_.derivative(rho_tilde[i]);
-  return params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar);
+  return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
 }
 
 VecXd ComplianceProblem::stiffness_derivative(const VecXd& a, const VecXd& b) const {
@@ -247,9 +261,10 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   const int num_design = static_cast<int>(res.design.size());
   check_responses(params, 3 * mesh.V.rows());
   Responses responses(params, material.density);
-  DesignUpdate update(params, num_design, responses.constraints(static_cast<int>(loads.cols())));
+  const int num_variables = problem.num_variables();
+  DesignUpdate update(params, num_variables, responses.constraints(static_cast<int>(loads.cols())));
   Continuation schedule(params.projection, params.tol_change, params.tol_objective);
-  VecXd x = VecXd::Constant(num_design, params.volume_fraction);
+  VecXd x = VecXd::Constant(num_variables, params.volume_fraction);
   for (int it = 1; it <= params.max_iterations; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
     progress.check_cancel("the optimisation (iteration " + std::to_string(it) + ")");
@@ -287,7 +302,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     if (next == NextStep::RaiseBeta) update.restart();
   }
   if (!res.converged) res.status = "iteration cap (" + std::to_string(params.max_iterations) + ") reached";
-  res.variables = x;
+  res.variables = problem.design_field(x);
   problem.set_beta(schedule.beta());
   const VecXd rho = problem.physical(x);
   res.density = VecXd::Ones(mesh.T.rows());

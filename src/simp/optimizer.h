@@ -11,6 +11,7 @@
 #include "common/types.h"
 #include "fem/elasticity.h"
 #include "simp/continuation.h"
+#include "simp/controls/controls_params.h"
 #include "simp/filter.h"
 #include "simp/responses/response_params.h"
 #include "simp/simp_law.h"
@@ -32,6 +33,7 @@ struct SimpParams {
   double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
   ResponseParams responses;  ///< objective and limits beyond the volume fraction (responses/)
+  ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion); none
 };
 
 /// One iteration, as reported to the caller and kept in the history.
@@ -55,7 +57,7 @@ struct IterationRecord {
 
 struct SimpResult {
   VecXd density;            ///< #T physical densities ρ̄ (non-design tets 1)
-  VecXd variables;          ///< #D design variables x
+  VecXd variables;          ///< #D design field z: the variables x through the geometry controls
   std::vector<int> design;  ///< #D tet index of each variable
   std::vector<IterationRecord> history;
   bool converged = false;
@@ -64,6 +66,8 @@ struct SimpResult {
 
 /// The objective and constraint of SIMP as functions of the design variables x (#D): the
 /// filter, projection and FE model are built once; evaluate() runs one FE analysis.
+class DesignMap;
+
 class ComplianceProblem {
  public:
   /// gravity: 3 by #cases accelerations (mm/s², fem::gravity_of) whose full weight `loads`
@@ -74,11 +78,16 @@ class ComplianceProblem {
                     const Eigen::MatrixXd& loads, const std::vector<double>& weights, const SimpParams& params,
                     const Progress& progress = {}, const Eigen::Matrix3Xd& gravity = {});
   ~ComplianceProblem();
-  /// Weighted compliance c(x) and, if dc is given, dc/dx (#D) through projection and filter.
+  /// Number of design variables #N: the design elements #D, fewer when controls tie them.
+  int num_variables() const;
+  /// The design field z (#D) of the variables x (#N): x through the geometry controls.
+  VecXd design_field(const VecXd& x) const;
+  /// Weighted compliance c(x) (x: #N) and, if dc is given, dc/dx (#N) through projection,
+  /// filter and controls.
   double compliance(const VecXd& x, VecXd* dc = nullptr);
-  /// Volume fraction of the design domain with the physical densities, and d/dx if asked.
+  /// Volume fraction of the design domain with the physical densities, and d/dx (#N) if asked.
   double volume_fraction(const VecXd& x, VecXd* dv = nullptr) const;
-  /// Physical densities ρ̄ (#D) of x.
+  /// Physical densities ρ̄ (#D) of x (#N).
   VecXd physical(const VecXd& x) const;
   /// Share of the design volume whose physical density ρ̄(x) lies strictly between 0.1 and 0.9.
   double grey_share(const VecXd& x) const;
@@ -108,6 +117,7 @@ class ComplianceProblem {
   VecXd vd_;
   VecXd volume_weights_;  // without projection the volume is linear in x: w·x
   double design_volume_ = 0;
+  std::unique_ptr<DesignMap> controls_;  // x → z, before the filter
   std::unique_ptr<Filter> filter_;
   std::unique_ptr<fem::Elasticity> fe_;
   Eigen::MatrixXd loads_;     // as given: with every tet's full weight

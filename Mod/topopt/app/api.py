@@ -5,6 +5,7 @@ only OCCT, the same OCCT FreeCAD loads. Every call that meshes, runs or checks s
 the worker process (topopt.app.worker): a failure of the core ends that process, never
 FreeCAD, and comes back as a TopOptError. Arguments are checked here before anything starts.
 """
+import json
 import os
 
 import Part
@@ -206,6 +207,54 @@ def add_pressure(study, faces, value, obj=None):
         units.set_prop(c, "Pressure", abs(value), "MPa")
         c.Reversed = value < 0
     return _add_constraint(study, _fem("makeConstraintPressure", "Pressure"), configure)
+
+
+def _vector(value, name):
+    """[x, y, z] of finite numbers, not all zero."""
+    try:
+        v = [checks.number(c, name) for c in value]
+    except TypeError:
+        v = []
+    if len(v) != 3:
+        raise TopOptError("%s must be three numbers [x, y, z] (mm, model axes)" % name, "InvalidParameter")
+    if name.endswith(("normal", "axis", "direction", "extrusion")) and not any(v):
+        raise TopOptError("%s must not be [0, 0, 0]: give a direction" % name, "InvalidParameter")
+    return v
+
+
+def _whole(value, name, low, high):
+    x = checks.in_range(value, name, low, high)
+    if x != int(x):
+        raise TopOptError("%s is %g: give a whole number" % (name, x), "InvalidParameter")
+    return int(x)
+
+
+def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=None, tolerance=0.0):
+    """Sets the study's geometry controls (docs/optimization.md, "controls"); called without
+    arguments it clears them. symmetry_planes: [(point, normal), ...]; cyclic: [(point, axis,
+    sectors), ...]; patterns: [(direction, pitch mm, count), ...]; extrusion: a direction or
+    None; tolerance: mm, 0 = the mesh's mean edge length. Vectors are [x, y, z] in model axes.
+    Returns the controls as the job's dict. Raises TopOptError naming the argument."""
+    c = {}
+    if symmetry_planes:
+        c["symmetry_planes"] = [{"point": _vector(p, "symmetry plane %d point" % (i + 1)),
+                                 "normal": _vector(n, "symmetry plane %d normal" % (i + 1))}
+                                for i, (p, n) in enumerate(symmetry_planes)]
+    if cyclic:
+        c["cyclic"] = [{"point": _vector(p, "cyclic %d point" % (i + 1)), "axis": _vector(a, "cyclic %d axis" % (i + 1)),
+                        "sectors": _whole(n, "cyclic %d sectors" % (i + 1), 2, 360)}
+                       for i, (p, a, n) in enumerate(cyclic)]
+    if patterns:
+        c["patterns"] = [{"direction": _vector(d, "pattern %d direction" % (i + 1)),
+                          "pitch": checks.in_range(p, "pattern %d pitch" % (i + 1), 0, None, open_low=True),
+                          "count": _whole(n, "pattern %d count" % (i + 1), 2, 10000)}
+                         for i, (d, p, n) in enumerate(patterns)]
+    if extrusion is not None:
+        c["extrusion"] = _vector(extrusion, "extrusion")
+    if checks.in_range(tolerance, "tolerance", 0, None) > 0:
+        c["tolerance"] = float(tolerance)
+    study.GeometryControls = json.dumps(c) if c else ""
+    return c
 
 
 def job_of(study):

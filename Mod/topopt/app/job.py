@@ -5,6 +5,7 @@ Face names: "FaceN" is face N of the part, as FreeCAD numbers it; "NonDesign:Fac
 of the compound of the non-design solids (their faces numbered one solid after another), for
 loads on load pads whose faces lie on the part's boundary.
 """
+import json
 import Part
 
 from . import checks
@@ -134,9 +135,29 @@ def study_to_job(study):
     }
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]
+    controls = study_controls(study)
+    if controls:
+        job["optimization"]["controls"] = controls
     # no threshold: a run always extracts the shape that keeps the volume fraction; the study's
     # Threshold is the shown result's (the slider's), never an input of the next run
     return job
+
+
+def study_controls(study):
+    """The study's geometry controls (its GeometryControls property, JSON text) as a dict, {}
+    for none. Raises TopOptError naming the property when the text is not a JSON object."""
+    text = str(getattr(study, "GeometryControls", "") or "").strip()
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except ValueError as e:
+        raise errors.TopOptError("the study's GeometryControls is not valid JSON (%s): set it with "
+                                 "api.set_controls or clear it" % e, "InvalidParameter")
+    if not isinstance(value, dict):
+        raise errors.TopOptError("the study's GeometryControls must be a JSON object such as "
+                                 "{\"extrusion\": [0, 0, 1]}", "InvalidParameter")
+    return value
 
 
 #: the study's numeric properties: (name, unit or None, low, high, open low, open high); None = no bound

@@ -137,6 +137,9 @@ class Study:
                             "Update scheme: optimality criteria or MMA")
             obj.Update = ["oc", "mma"]
         _add(obj, "App::PropertyInteger", "MaxIterations", "Optimization", "Iteration cap", 80)
+        _add(obj, "App::PropertyString", "GeometryControls", "Optimization",
+             "Geometry controls as the job's \"controls\" object in JSON (symmetry planes, cyclic, "
+             "patterns, extrusion; docs/optimization.md); empty = none. Set with api.set_controls", "")
 
     def _results(self, obj):
         doc_t = ("Density threshold of the shown result shape: the run's (the one that keeps the volume "

@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""Geometry controls benchmark (issue 22): the cantilever and the bracket (suggested load cases
+of ../shared/data/README.md, steel, volume fraction 0.3) through `topopt optimize`, once free
+and once with each geometry control (docs/optimization.md, "controls"). For each run: tets,
+iterations, final compliance (SIMP's, on the tet mesh), SIMP wall time, whole-command wall
+time, all with OMP_NUM_THREADS=1 and one run after another in this one script; and a picture of
+the result surface (result.stl, rendered with matplotlib) in the work folder.
+
+usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
+Prints Markdown for BENCHMARKS.md.
+"""
+import argparse, json, os, re, struct, subprocess, sys, time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
+if not os.path.isdir(DATA):
+    DATA = "/work/shared/data/examples"
+
+EXAMPLES = {
+    # 60 x 20 x 10 mm, x = 0 fixed, 1000 N in -z on the load pad (y in [7, 13])
+    "cantilever": (2.0, {"supports": [{"type": "fixed", "faces": ["Face1"]}],
+                         "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["NonDesign:Face12"],
+                                                                   "vector": [0, 0, -1000]}]}]}),
+    # bolt bores Face10-13 fixed; pin bore Face7: 5000 N along +x, and separately along -z
+    "bracket": (3.0, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
+                      "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
+                                     {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
+}
+
+
+def controls_for(name, box):
+    """The controls to try on an example whose bounding box is box = (min xyz, max xyz)."""
+    lo, hi = np.array(box[0]), np.array(box[1])
+    mid = ((lo + hi) / 2).tolist()
+    out = {"free": None,
+           "symmetry (xz mid-plane)": {"symmetry_planes": [{"point": mid, "normal": [0, 1, 0]}]},
+           "extrusion along y": {"extrusion": [0, 1, 0]}}
+    if name == "cantilever":
+        out["pattern x (3 x 18 mm)"] = {"patterns": [{"direction": [1, 0, 0], "pitch": 18, "count": 3}]}
+    return out
+
+
+def step_box(path):
+    """Bounding box of a STEP file's CARTESIAN_POINTs (vertices, circle centres, placements):
+    the part's box for the prismatic examples here."""
+    pts = re.findall(r"CARTESIAN_POINT\s*\(\s*'[^']*'\s*,\s*\(([^)]*)\)", open(path).read())
+    xyz = np.array([[float(v) for v in p.split(",")] for p in pts if p.count(",") == 2])
+    return xyz.min(0).tolist(), xyz.max(0).tolist()
+
+
+def run(cmd):
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    return time.perf_counter() - t0, p
+
+
+def read_stl(path):
+    data = open(path, "rb").read()
+    if data[:5] == b"solid" and b"facet" in data[:300]:
+        v = [list(map(float, l.split()[1:4])) for l in data.decode().splitlines() if l.strip().startswith("vertex")]
+        return np.array(v).reshape(-1, 3, 3)
+    n = struct.unpack("<I", data[80:84])[0]
+    a = np.frombuffer(data[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    return a["v"].astype(float)
+
+
+def picture(stl, png, title):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    tri = read_stl(stl)
+    fig = plt.figure(figsize=(7, 5))
+    ax = fig.add_subplot(111, projection="3d")
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.maximum(1e-12, np.linalg.norm(n, axis=1))[:, None]
+    shade = 0.35 + 0.65 * np.clip(n @ np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8]), 0, 1)
+    ax.add_collection3d(Poly3DCollection(tri, facecolors=np.c_[shade * 0.5, shade * 0.7, shade, np.ones_like(shade)],
+                                         edgecolor="none"))
+    lo, hi = tri.reshape(-1, 3).min(0), tri.reshape(-1, 3).max(0)
+    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(hi - lo)
+    ax.view_init(elev=25, azim=-60)
+    ax.set_title(title, fontsize=9)
+    ax.set_axis_off()
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--work", default="/tmp/controls_bench")
+    ap.add_argument("--only", default="")
+    ap.add_argument("--iterations", type=int, default=60)
+    ap.add_argument("--pictures-only", action="store_true", help="render the result.stl files of an earlier run")
+    a = ap.parse_args()
+    if a.pictures_only:
+        for d in sorted(os.listdir(a.work)):
+            stl = os.path.join(a.work, d, "result.stl")
+            if os.path.exists(stl):
+                h = json.load(open(os.path.join(a.work, d, "history.json")))
+                picture(stl, os.path.join(a.work, d + ".png"), "%s: compliance %.4g" % (d, h["history"][-1]["compliance"]))
+        return
+    os.makedirs(a.work, exist_ok=True)
+    topopt = os.path.join(a.build, "topopt")
+    print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP (s) | command (s) | picture |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, (size, case) in EXAMPLES.items():
+        if a.only and name != a.only:
+            continue
+        part = os.path.join(DATA, name + ".step")
+        box = step_box(part)
+        free_c = None
+        for label, controls in controls_for(name, box).items():
+            slug = re.sub(r"[^a-z0-9]+", "_", label.lower()).strip("_")
+            out = os.path.join(a.work, name + "_" + slug)
+            opt = {"volume_fraction": 0.3, "max_iterations": a.iterations}
+            if controls:
+                opt["controls"] = controls
+            job = {"part": part, "nondesign": os.path.join(DATA, name + "_nondesign.step"), "mesh": {"size": size},
+                   "material": {"E": 210000.0, "nu": 0.3}, "optimization": opt, "output": {"directory": out}}
+            job.update(case)
+            path = out + ".json"
+            json.dump(job, open(path, "w"), indent=1)
+            wall, p = run([topopt, "optimize", path, "--verbose"])
+            if p.returncode:
+                print("| %s | %s | failed: %s |" % (name, label, (p.stderr or p.stdout).strip().splitlines()[-1]))
+                continue
+            h = json.load(open(os.path.join(out, "history.json")))
+            c = h["history"][-1]["compliance"]
+            free_c = c if controls is None else free_c
+            simp_s = sum(r["seconds"] for r in h["history"])
+            tets = re.search(r"(\d+) tets", p.stdout + p.stderr)
+            nvar = re.search(r"(\d+) variables for", p.stdout + p.stderr)
+            png = out + ".png"
+            picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
+            print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f | %s |" % (
+                name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
+                "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, os.path.basename(png)))
+            sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()

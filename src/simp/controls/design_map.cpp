@@ -1,0 +1,51 @@
+// The controls' map from variables to the design field (see design_map.h).
+#include "simp/controls/design_map.h"
+
+#include <numeric>
+
+#include "simp/controls/tying.h"
+
+namespace topopt::simp {
+
+namespace {
+
+Eigen::MatrixX3d design_centroids(const TetMesh& mesh, const std::vector<int>& design) {
+  Eigen::MatrixX3d c(design.size(), 3);
+  for (size_t i = 0; i < design.size(); ++i) {
+    c.row(i).setZero();
+    for (int a = 0; a < 4; ++a) c.row(i) += mesh.V.row(mesh.T(design[i], a)) / 4;
+  }
+  return c;
+}
+
+}  // namespace
+
+DesignMap::DesignMap(const TetMesh& mesh, const std::vector<int>& design, const ControlsParams& params,
+                     double tolerance) {
+  if (params.any()) {
+    Tying t = tie_design(design_centroids(mesh, design), params, tolerance);
+    variable_of_ = std::move(t.variable_of);
+    num_variables_ = t.num_variables;
+    summary_ = t.summary;
+    return;
+  }
+  variable_of_.resize(design.size());
+  std::iota(variable_of_.begin(), variable_of_.end(), 0);
+  num_variables_ = static_cast<int>(design.size());
+}
+
+DesignMap::~DesignMap() = default;
+
+VecXd DesignMap::apply(const VecXd& x) const {
+  VecXd z(variable_of_.size());
+  for (size_t i = 0; i < variable_of_.size(); ++i) z[i] = x[variable_of_[i]];
+  return z;
+}
+
+VecXd DesignMap::apply_transpose(const VecXd& g) const {
+  VecXd out = VecXd::Zero(num_variables_);
+  for (size_t i = 0; i < variable_of_.size(); ++i) out[variable_of_[i]] += g[i];
+  return out;
+}
+
+}  // namespace topopt::simp

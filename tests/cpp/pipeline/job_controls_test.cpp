@@ -1,0 +1,74 @@
+// The "controls" object of a job's optimization section (docs/optimization.md): parsed into
+// simp::ControlsParams, and every mistake named by its key with what to give.
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "pipeline/job.h"
+
+namespace topopt::pipeline {
+namespace {
+
+std::string with_controls(const std::string& controls) { return R"({"optimization": {"controls": )" + controls + "}}"; }
+
+/// parse_job must throw InvalidParameter with every fragment in its message.
+void expect_refused(const std::string& controls, const std::vector<std::string>& fragments) {
+  try {
+    parse_job(with_controls(controls), "/tmp");
+    ADD_FAILURE() << "no error for " << controls;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidParameter) << e.what();
+    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+  }
+}
+
+TEST(JobControls, EveryControlIsParsed) {
+  const Job job = parse_job(with_controls(R"({
+    "symmetry_planes": [{"point": [1, 2, 3], "normal": [0, 1, -1]}, {"point": [0, 0, 0], "normal": [1, 0, 0]}],
+    "cyclic": [{"point": [0, 0, 0], "axis": [0, 0, 2], "sectors": 6}],
+    "patterns": [{"direction": [1, 0, 0], "pitch": 12.5, "count": 4}],
+    "extrusion": [0, 0, 1],
+    "tolerance": 1.5})"),
+                            "/tmp");
+  const simp::ControlsParams& c = job.optimization.simp.controls;
+  ASSERT_EQ(c.mirrors.size(), 2u);
+  EXPECT_EQ(c.mirrors[0].point, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(c.mirrors[0].normal, Eigen::Vector3d(0, 1, -1));
+  ASSERT_EQ(c.cyclic.size(), 1u);
+  EXPECT_EQ(c.cyclic[0].sectors, 6);
+  EXPECT_EQ(c.cyclic[0].axis, Eigen::Vector3d(0, 0, 2));
+  ASSERT_EQ(c.patterns.size(), 1u);
+  EXPECT_EQ(c.patterns[0].pitch, 12.5);
+  EXPECT_EQ(c.patterns[0].count, 4);
+  EXPECT_TRUE(c.extrude);
+  EXPECT_EQ(c.extrusion, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(c.tolerance, 1.5);
+  EXPECT_TRUE(c.any());
+  EXPECT_FALSE(parse_job("{}", "/tmp").optimization.simp.controls.any());
+}
+
+TEST(JobControls, MistakesNameTheKeyAndWhatToGive) {
+  expect_refused(R"({"symetry_planes": []})",
+                 {"'optimization.controls.symetry_planes'", "did you mean 'symmetry_planes'?"});
+  expect_refused(R"({"symmetry_planes": {"point": [0, 0, 0]}})", {"'optimization.controls.symmetry_planes'", "list"});
+  expect_refused(R"({"symmetry_planes": [{"point": [0, 0, 0], "normal": [0, 0, 0]}]})",
+                 {"'optimization.controls.symmetry_planes[0].normal'", "[0, 0, 0]"});
+  expect_refused(R"({"symmetry_planes": [{"normal": [0, 0, 1]}]})",
+                 {"'optimization.controls.symmetry_planes[0].point'"});
+  expect_refused(R"({"cyclic": [{"point": [0, 0, 0], "axis": [0, 0, 1], "sectors": 1}]})",
+                 {"'optimization.controls.cyclic[0].sectors'"});
+  expect_refused(R"({"patterns": [{"direction": [1, 0, 0], "pitch": 0, "count": 3}]})",
+                 {"'optimization.controls.patterns[0].pitch'", "above 0"});
+  expect_refused(R"({"patterns": [{"direction": [1, 0, 0], "pitch": 5, "count": 2.5}]})",
+                 {"'optimization.controls.patterns[0].count'"});
+  expect_refused(R"({"draw": {"direction": [0, 0, 1]}})", {"'optimization.controls.draw'"});
+  expect_refused(R"({"tolerance": -1})", {"'optimization.controls.tolerance'"});
+  try {
+    parse_job(R"({"optimization": {"sensitivity_filter": true, "controls": {"extrusion": [0, 0, 1]}}})", "/tmp");
+    ADD_FAILURE() << "sensitivity filter with controls accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'optimization.sensitivity_filter'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace topopt::pipeline

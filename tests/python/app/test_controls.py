@@ -1,0 +1,59 @@
+"""Geometry controls through the Python API: api.set_controls writes the study's
+GeometryControls, the job carries them as the "controls" object the core reads, bad arguments
+are refused naming the argument, and a run with a control (in the worker) uses it: a mirror
+plane that is no symmetry of the part is refused by the core naming the plane."""
+import unittest
+
+import FreeCAD
+
+from topopt.app import api
+from helpers import box_study
+
+
+class Controls(unittest.TestCase):
+    def setUp(self):
+        self.doc, self.study = box_study("Controls", iterations=6, mesh_size=4.0)
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_controls_reach_the_job(self):
+        self.assertNotIn("controls", api.job_of(self.study)["optimization"])
+        api.set_controls(self.study, symmetry_planes=[((0, 5, 5), (0, 1, 1))],
+                         cyclic=[((0, 5, 5), (1, 0, 0), 4)], patterns=[((1, 0, 0), 20, 3)],
+                         extrusion=(0, 0, 1), tolerance=2)
+        c = api.job_of(self.study)["optimization"]["controls"]
+        self.assertEqual(c["symmetry_planes"], [{"point": [0, 5, 5], "normal": [0, 1, 1]}])
+        self.assertEqual(c["cyclic"], [{"point": [0, 5, 5], "axis": [1, 0, 0], "sectors": 4}])
+        self.assertEqual(c["patterns"], [{"direction": [1, 0, 0], "pitch": 20, "count": 3}])
+        self.assertEqual(c["extrusion"], [0, 0, 1])
+        self.assertEqual(c["tolerance"], 2)
+        api.set_controls(self.study)  # cleared
+        self.assertEqual(self.study.GeometryControls, "")
+        self.assertNotIn("controls", api.job_of(self.study)["optimization"])
+
+    def test_bad_arguments_name_what_to_fix(self):
+        for kwargs, words in [(dict(symmetry_planes=[((0, 5, 5), (0, 0, 0))]), "symmetry plane 1 normal"),
+                              (dict(cyclic=[((0, 0, 0), (1, 0, 0), 2.5)]), "cyclic 1 sectors"),
+                              (dict(patterns=[((1, 0, 0), -3, 2)]), "pattern 1 pitch"),
+                              (dict(extrusion=(1, 2)), "extrusion")]:
+            with self.assertRaises(api.TopOptError) as ctx:
+                api.set_controls(self.study, **kwargs)
+            self.assertIn(words, str(ctx.exception))
+        self.study.GeometryControls = "[1, 2]"
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.job_of(self.study)
+        self.assertIn("GeometryControls", str(ctx.exception))
+
+    def test_the_core_uses_the_controls(self):
+        api.set_controls(self.study, symmetry_planes=[((0, 40, 5), (0, 1, 0))])  # y = 40: off the part
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.run(self.study, verbose=False)
+        self.assertIn("symmetry plane 1", str(ctx.exception))
+        api.set_controls(self.study, symmetry_planes=[((0, 5, 5), (0, 1, 0))], extrusion=(0, 0, 1))
+        result = api.run(self.study, verbose=False)
+        self.assertGreater(result.Mesh.CountFacets, 0)
+
+
+if __name__ == "__main__":
+    unittest.main()
