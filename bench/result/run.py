@@ -23,7 +23,7 @@ run; triangles, smallest angle (free-form and Ω's faces), crossing triangle pai
 the smoothing and in the returned surface (exact check), volume, surface stage time.
 
 usage: bench/result/run.py [--build build] [--work /tmp/topopt-bench-result] [--only cantilever,...]
-                           [--surface [--size MM]]
+                           [--surface [--size MM] [--max-iterations N]]
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, resource, subprocess, sys, time
@@ -108,13 +108,14 @@ def one(build, work, name, setting):
             **surface_row(h)}
 
 
-def surface_table(build, work, names, size):
+def surface_table(build, work, names, size, max_iterations=None):
     """The surface before and after issue 19 B, per example, both in this run (OMP_NUM_THREADS=2
     for SIMP; the surface stage runs on one thread)."""
     rows = {}
     for name in names:
         for setting, options in SURFACE_SETTINGS.items():
-            h = optimize(build, work, name, setting, options, size)[4]
+            extra = {"max_iterations": max_iterations} if max_iterations else {}
+            h = optimize(build, work, name, setting, dict(options, **extra), size)[4]
             rows[name, setting] = r = surface_row(h)
             print("%s %s: %s" % (name, setting, json.dumps(r)), file=sys.stderr, flush=True)
     print("## Result: the design surface (bench/result/run.py --surface)\n")
@@ -135,10 +136,11 @@ def main():
     ap.add_argument("--only", default=",".join(EXAMPLES))
     ap.add_argument("--surface", action="store_true", help="only the surface table (before/after issue 19 B)")
     ap.add_argument("--size", type=float, default=None, help="mesh size for --surface (default: each example's)")
+    ap.add_argument("--max-iterations", type=int, default=None, help="SIMP's cap for --surface (default: the job default)")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     if a.surface:
-        rows = surface_table(a.build, a.work, a.only.split(","), a.size)
+        rows = surface_table(a.build, a.work, a.only.split(","), a.size, a.max_iterations)
         json.dump({"%s/%s" % k: v for k, v in rows.items()}, open(os.path.join(a.work, "surface_rows.json"), "w"), indent=1)
         return
     rows = {}
