@@ -75,7 +75,7 @@ TEST(ResultCheck, FoldedNeighboursSharingAnEdgeAreACrossing) {
 
 /// The bar of iso_surface_test: a 40x20x10 box, non-design blocks at both ends, a round bar of
 /// varying radius between them; its marching-tetrahedra surface at 15 % of the design volume.
-TriSurface bar_surface(double* kept_volume = nullptr) {
+TriSurface bar_surface(double* kept_volume = nullptr, double margin = 0) {
   mesh::StructuredBoxParams p;
   p.size = {40, 20, 10};
   p.cells = {20, 10, 5};
@@ -90,7 +90,7 @@ TriSurface bar_surface(double* kept_volume = nullptr) {
   const VecXd nd = node_densities(mesh, density);
   const double t = threshold_for_volume(mesh, nd, 0.15);
   if (kept_volume) *kept_volume = kept_design_volume(mesh, nd, t) + 2 * 4 * 8 * 6;
-  return extract_iso_surface(mesh, nd, t);
+  return extract_iso_surface(mesh, nd, t, margin);
 }
 
 TEST(ResultCheck, UntangleUndoesTheMovesThatMadeACrossing) {
@@ -110,7 +110,7 @@ TEST(ResultCheck, UntangleUndoesTheMovesThatMadeACrossing) {
   EXPECT_TRUE(untangle(s, before).empty());
   EXPECT_TRUE(check_result(s).valid());
   // the pushed point went (at least partly) back; points far from it kept their small move
-  EXPECT_GT(s.V(moved, 2), before(moved, 2) - 3);
+  EXPECT_GE(s.V(moved, 2), before(moved, 2) - 3 - 1e-9);
   long far = 0, far_kept = 0;
   for (long i = 0; i < s.V.rows(); ++i)
     if (s.lock[i] == 0 && (before.row(i) - before.row(moved)).norm() > 8) {
@@ -133,15 +133,16 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
   EXPECT_TRUE(c1.valid()) << c1.crossings.size() << " crossings";
   EXPECT_GT(c1.min_angle_free, c0.min_angle_free);
   EXPECT_NEAR(c1.closed.volume, kept, 0.01 * kept);
-  // points that stay keep their places; locked points all stay
-  for (size_t i = 0; i < r.kept_points.size(); ++i) EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
+  // locked points keep their places (free points may move within their triangles' plane)
+  for (size_t i = 0; i < r.kept_points.size(); ++i)
+    if (s.lock[i] != 0) EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
   long locked_before = (lock0.array() == 2).count(), locked_after = (s.lock.array() == 2).count();
   EXPECT_EQ(locked_after, locked_before);
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
   double kept = 0;
-  TriSurface s = bar_surface(&kept);
+  TriSurface s = bar_surface(&kept, SmoothParams{}.crossing_margin);  // cut as pipeline::result_surface cuts
   const DesignSurfaceReport r = finish_design_surface(s, SmoothParams{});
   EXPECT_TRUE(r.check.valid());
   EXPECT_GE(r.check.min_angle_free, 10.0);
