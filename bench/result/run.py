@@ -17,7 +17,13 @@ Settings: "before" is today's old default (no projection: `"heaviside": false`, 
 old code path exactly: fixed OC move limit, same convergence test), "after" is the new
 default (projection with beta continuation, adaptive OC move limits).
 
+With --surface, only the result surface: per example, `topopt optimize` with the surface as it
+was (`"surface_remesh": false, "surface_repair": false`) and as it is (defaults), both in one
+run; triangles, smallest angle (free-form and Ω's faces), crossing triangle pairs right after
+the smoothing and in the returned surface (exact check), volume, surface stage time.
+
 usage: bench/result/run.py [--build build] [--work /tmp/topopt-bench-result] [--only cantilever,...]
+                           [--surface [--size MM] [--max-iterations N]]
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, resource, subprocess, sys, time
@@ -39,8 +45,15 @@ EXAMPLES = {
     "bracket": (2.5, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
                       "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
                                      {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
+    # bolt bores Face28-31 fixed; the lug's bore Face8: 10 000 N in -z, and separately 5 000 N in +y
+    "mount": (2.5, {"supports": [{"type": "fixed", "faces": ["Face28", "Face29", "Face30", "Face31"]}],
+                    "load_cases": [{"name": "down", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 0, -10000]}]},
+                                   {"name": "side", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 5000, 0]}]}]}),
 }
 SETTINGS = {"before": {"heaviside": False}, "after": {}}
+# --surface: the result surface as it was (Taubin smoothing only) and as it is now (remeshed
+# before and after the smoothing, crossings repaired), on the same job with the new SIMP defaults
+SURFACE_SETTINGS = {"surface before": {"surface_remesh": False, "surface_repair": False}, "surface after": {}}
 
 
 def run(cmd):
@@ -56,17 +69,32 @@ def run(cmd):
     return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), p.stdout
 
 
-def one(build, work, name, setting):
-    size, problem = EXAMPLES[name]
-    out = os.path.join(work, name + "_" + setting)
+def optimize(build, work, name, setting, options, size=None):
+    """topopt optimize on the example with the "optimization" options; returns (job path,
+    output folder, wall s, CPU s, history.json)."""
+    size = size or EXAMPLES[name][0]
+    out = os.path.join(work, (name + "_" + setting).replace(" ", "_"))
     job = {"part": os.path.join(DATA, name + ".step"), "nondesign": os.path.join(DATA, name + "_nondesign.step"),
            "mesh": {"size": size}, "material": {"E": 210000.0, "nu": 0.3},
-           "optimization": dict({"volume_fraction": 0.3}, **SETTINGS[setting]), "output": {"directory": out}}
-    job.update(problem)
+           "optimization": dict({"volume_fraction": 0.3}, **options), "output": {"directory": out}}
+    job.update(EXAMPLES[name][1])
     path = out + ".json"
     json.dump(job, open(path, "w"), indent=1)
     wall, cpu, _ = run([os.path.join(build, "topopt"), "optimize", path, "--quiet"])
-    h = json.load(open(os.path.join(out, "history.json")))
+    return path, out, wall, cpu, json.load(open(os.path.join(out, "history.json")))
+
+
+def surface_row(h):
+    """The result surface's figures from history.json."""
+    s = h.get("surface", {})
+    return {"triangles": s.get("triangles"), "min_angle_free": s.get("min_angle_free"),
+            "min_angle_faces": s.get("min_angle_faces"), "self_intersections": s.get("self_intersections"),
+            "crossings_smoothed": s.get("self_intersections_after_smoothing"), "surface_s": h["seconds"]["surface"],
+            "volume": s.get("volume")}
+
+
+def one(build, work, name, setting):
+    path, out, wall, cpu, h = optimize(build, work, name, setting, SETTINGS[setting])
     deck = os.path.join(out, "problem.inp")
     run([os.path.join(build, "topopt"), "solve", path, "--out-dir", os.path.join(out, "solve"), "--inp", deck])
     points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
@@ -77,7 +105,29 @@ def one(build, work, name, setting):
     cad = cad_columns(out)
     return {**cad, "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
             "wall_s": wall, "cpu_s": cpu, "grey": crisp.grey_share(density, domain, vol),
-            "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_tets": solved, "kept_tets": int(keep.sum())}
+            "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_tets": solved, "kept_tets": int(keep.sum()),
+            **surface_row(h)}
+
+
+def surface_table(build, work, names, size, max_iterations=None):
+    """The surface before and after issue 19 B, per example, both in this run (OMP_NUM_THREADS=2
+    for SIMP; the surface stage runs on one thread)."""
+    rows = {}
+    for name in names:
+        for setting, options in SURFACE_SETTINGS.items():
+            extra = {"max_iterations": max_iterations} if max_iterations else {}
+            h = optimize(build, work, name, setting, dict(options, **extra), size)[4]
+            rows[name, setting] = r = surface_row(h)
+            print("%s %s: %s" % (name, setting, json.dumps(r)), file=sys.stderr, flush=True)
+    print("## Result: the design surface (bench/result/run.py --surface)\n")
+    print("| example | setting | triangles | smallest angle, free-form (°) | smallest angle, Ω's faces (°) | "
+          "self-intersections after smoothing | self-intersections returned | volume (mm³) | surface time (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for (name, setting), r in rows.items():
+        print("| %s | %s | %d | %.2f | %.2f | %d | %d | %.1f | %.2f |"
+              % (name, setting, r["triangles"], r["min_angle_free"], r["min_angle_faces"], r["crossings_smoothed"],
+                 r["self_intersections"], r["volume"], r["surface_s"]))
+    return rows
 
 
 def cad_columns(out):
@@ -117,8 +167,15 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--work", default="/tmp/topopt-bench-result")
     ap.add_argument("--only", default=",".join(EXAMPLES))
+    ap.add_argument("--surface", action="store_true", help="only the surface table (before/after issue 19 B)")
+    ap.add_argument("--size", type=float, default=None, help="mesh size for --surface (default: each example's)")
+    ap.add_argument("--max-iterations", type=int, default=None, help="SIMP's cap for --surface (default: the job default)")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
+    if a.surface:
+        rows = surface_table(a.build, a.work, a.only.split(","), a.size, a.max_iterations)
+        json.dump({"%s/%s" % k: v for k, v in rows.items()}, open(os.path.join(a.work, "surface_rows.json"), "w"), indent=1)
+        return
     rows = {}
     for name in a.only.split(","):
         for setting in SETTINGS:
@@ -131,9 +188,10 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for (name, setting), r in rows.items():
         ratio = r["cpu_s"] / rows[name, "before"]["cpu_s"] if (name, "before") in rows else float("nan")
-        print("| %s | %d | %s | %d | %s | %.1f %% | %.2f | %.2f | %.1f | %.1f | %.2f |"
+        print("| %s | %d | %s | %d | %s | %.1f %% | %.2f | %.2f | %.1f | %.1f | %.2f | %d | %.2f | %d | %.2f |"
               % (name, r["tets"], setting, r["iterations"], r["status"], 100 * r["grey"], r["compliance_simp"], r["crisp"],
-                 r["simp_s"], r["cpu_s"], ratio))
+                 r["simp_s"], r["cpu_s"], ratio, r["triangles"], r["min_angle_free"], r["self_intersections"],
+                 r["surface_s"]))
     cad_table(rows)
 
 

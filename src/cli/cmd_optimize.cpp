@@ -83,14 +83,15 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
   const pipeline::RunResult run = pipeline::run_job(job, {}, progress, {}, options);
   const pipeline::OptimizeResult& r = run.optimization;
   const auto& last = r.simp.history.back();
-  result::SurfaceCheck check = result::check_surface(r.surface.V, r.surface.F);
+  const result::ResultCheck& check = r.surface_report.check;
   std::cout << "mesh: " << run.mesh.V.rows() << " nodes, " << run.mesh.T.rows() << " tets (" << run.seconds_mesh
             << " s)\n"
             << std::setprecision(6) << "simp: " << r.simp.status << ", compliance " << last.compliance
             << " N*mm, volume fraction " << last.volume_fraction << " (" << r.seconds_simp << " s)\n"
             << "surface: threshold " << r.threshold << ", " << r.surface.F.rows() << " triangles, "
-            << (check.closed_manifold() ? "closed" : "NOT closed") << ", volume " << check.volume << " mm^3 ("
-            << r.seconds_surface << " s)\n";
+            << (check.closed.closed_manifold() ? "closed" : "NOT closed") << ", " << check.crossings.size()
+            << " self-intersections, smallest angle " << check.min_angle_free << " deg (free-form), volume "
+            << check.closed.volume << " mm^3 (" << r.seconds_surface << " s)\n";
   if (run.files.step)
     std::cout << "step: " << run.files.step->faces << " faces (" << run.files.step->planar_faces << " planar), "
               << run.files.step->bytes / 1e6 << " MB (" << run.files.step->seconds << " s)\n";

@@ -195,7 +195,7 @@ OptimizeSettings parse_optimization(const json& section) {
       section, "optimization",
       {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver", "sensitivity_filter",
        "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
-       "solver_tolerance", "smoothing_iterations", "fill_voids",
+       "solver_tolerance", "smoothing_iterations", "surface_remesh", "surface_repair", "fill_voids",
        // objectives and constraints (parse_responses)
        "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation",
        // geometry controls (parse_controls)
@@ -236,6 +236,8 @@ OptimizeSettings parse_optimization(const json& section) {
   if (f.has("threshold") && !(s.threshold > 0 && s.threshold < 1))
     f.bad("threshold", "must lie strictly between 0 and 1, or be null for the one that keeps the volume fraction");
   s.smooth.iterations = f.integer("smoothing_iterations", 20, 0, 1000);
+  s.smooth.remesh = f.boolean("surface_remesh", true);
+  s.smooth.repair = f.boolean("surface_repair", true);
   s.hygiene.fill_voids = f.boolean("fill_voids", true);
   return s;
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
@@ -37,6 +38,19 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   j["threshold"] = r.threshold;
   j["seconds"] = {{"simp", r.seconds_simp}, {"surface", r.seconds_surface}};
   j["grey"] = r.simp.history.empty() ? 0.0 : r.simp.history.back().grey;
+  const result::DesignSurfaceReport& sr = r.surface_report;
+  j["surface"] = {{"triangles", r.surface.F.rows()},
+                  {"closed", sr.check.closed.closed_manifold()},
+                  {"volume", sr.check.closed.volume},
+                  {"self_intersections", sr.check.crossings.size()},
+                  {"self_intersections_after_smoothing", sr.crossings_smoothed},
+                  {"min_angle_free", sr.check.min_angle_free},
+                  {"min_angle_faces", sr.check.min_angle_faces},
+                  {"min_angle_nondesign", sr.check.min_angle_nondesign},
+                  {"collapses", sr.collapses},
+                  {"flips", sr.flips},
+                  {"moves", sr.moves},
+                  {"remesh_undone", sr.remesh_undone}};
   const result::HygieneReport& h = r.hygiene;
   json apart = json::array();
   for (const auto& p : h.apart)
@@ -69,6 +83,23 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   if (!f) throw Error(ErrorCode::Io, "cannot write the iteration history (disk full?)");
 }
 
+/// Throws Error(MeshingFailed) for a result surface that is not a valid solid (open, or
+/// crossing itself after the repair), saying where and what to change; with the repair off
+/// (comparison runs) a crossing surface is only warned about.
+void refuse_invalid(const result::ResultCheck& c, double threshold, bool repair, const Progress& progress) {
+  if (c.valid()) return;
+  std::ostringstream m;
+  m << "the result shape at threshold " << threshold << " is not a valid solid: ";
+  if (!c.closed.closed_manifold() || c.closed.volume <= 0)
+    m << c.closed.unpaired_edges << " triangle edges are not shared by exactly two triangles";
+  else
+    m << c.crossings.size() << (c.crossings.size() >= 1000 ? " or more" : "")
+      << " pairs of its triangles cross each other even with the smoothing undone there";
+  m << "; try another \"threshold\", fewer \"smoothing_iterations\" or a smaller mesh \"size\"";
+  if (!repair && c.closed.closed_manifold()) return progress.warn(m.str() + " (\"surface_repair\" is off)");
+  throw Error(ErrorCode::MeshingFailed, m.str());
+}
+
 }  // namespace
 
 std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
@@ -88,7 +119,8 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used,
                                   const std::vector<char>& anchors, const result::HygieneParams& hygiene,
-                                  result::HygieneReport* report, VecXd* design, const Progress& progress) {
+                                  result::HygieneReport* report, VecXd* design, const Progress& progress,
+                                  result::DesignSurfaceReport* surface_report) {
   const double t = threshold > 0
                        ? threshold
                        : result::threshold_for_volume(mesh, result::node_densities(mesh, density), volume_fraction);
@@ -96,8 +128,11 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   result::HygieneReport found;
   const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
   for (const std::string& w : found.warnings) progress.warn(w);
-  result::TriSurface s = result::extract_iso_surface(mesh, result::node_densities(mesh, cleaned), t);
-  if (smooth.iterations > 0) result::smooth_surface(s, smooth);
+  result::TriSurface s = result::extract_iso_surface(mesh, result::node_densities(mesh, cleaned), t,
+                                                     smooth.remesh ? smooth.crossing_margin : 0.0);
+  const result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth);
+  refuse_invalid(finished.check, t, smooth.repair, progress);
+  if (surface_report) *surface_report = finished;
   if (report) *report = std::move(found);
   if (design) *design = cleaned;
   return s;
@@ -134,7 +169,7 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
                           ? r.simp.history.back().volume_fraction
                           : set.simp.volume_fraction;
   r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold,
-                             anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress);
+                             anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();

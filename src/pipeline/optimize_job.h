@@ -9,6 +9,7 @@
 #include "common/progress.h"
 #include "pipeline/job.h"
 #include "result/design_hygiene.h"
+#include "result/design_surface.h"
 #include "result/iso_surface.h"
 #include "result/smoothing.h"
 #include "simp/optimizer.h"
@@ -28,6 +29,7 @@ struct OptimizeResult {
   result::TriSurface surface;  ///< smoothed, closed, of the cleaned densities
   VecXd design;                ///< #T element densities after hygiene (what the surface is cut from)
   result::HygieneReport hygiene;
+  result::DesignSurfaceReport surface_report;  ///< remeshing, repair and the surface's final check
   double seconds_simp = 0, seconds_surface = 0;
   int ranks = 1;  ///< MPI ranks SIMP ran on (1: serial)
 };
@@ -50,13 +52,17 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 /// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain, found on the densities as given), cleaned by
 /// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the
-/// largest piece) and smoothed. `threshold_used`, `report` and `design` (#T, the cleaned
-/// densities) are optional outputs; the report's warnings are also given to progress.warn.
+/// largest piece), then finished: remeshed, smoothed, crossings repaired
+/// (result::finish_design_surface). `threshold_used`, `report`, `design` (#T, the cleaned
+/// densities) and `surface_report` are optional outputs; the report's warnings are also given
+/// to progress.warn. Throws Error(MeshingFailed) naming the threshold when the finished
+/// surface is open or still crosses itself (with smooth.repair off a crossing surface is
+/// returned with a warning instead).
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used = nullptr,
                                   const std::vector<char>& anchors = {}, const result::HygieneParams& hygiene = {},
                                   result::HygieneReport* report = nullptr, VecXd* design = nullptr,
-                                  const Progress& progress = {});
+                                  const Progress& progress = {}, result::DesignSurfaceReport* surface_report = nullptr);
 
 /// Writes DIR/density.vtu (fields "density", SIMP's, and "design", after hygiene),
 /// DIR/history.csv, DIR/history.json (with the hygiene report under "design") and

@@ -138,8 +138,12 @@ namespace {
 /// face (TriSurface's fields).
 class IsoSurfaceBuilder {
  public:
-  IsoSurfaceBuilder(const TetMesh& mesh, const VecXd& node_density, double threshold)
-      : mesh_(mesh), node_density_(node_density), threshold_(threshold), tagged_(mesh.domain.size() == mesh.T.rows()) {}
+  IsoSurfaceBuilder(const TetMesh& mesh, const VecXd& node_density, double threshold, double margin)
+      : mesh_(mesh), tagged_(mesh.domain.size() == mesh.T.rows()) {
+    values_.resize(mesh.V.rows());
+    for (long i = 0; i < mesh.V.rows(); ++i) values_[i] = level(node_density, static_cast<int>(i), threshold);
+    if (margin > 0) keep_crossings_off_nodes(margin);
+  }
 
   /// Iso-triangles inside every design tet the level crosses, oriented out of the kept side.
   void cut_design_tets() {
@@ -190,7 +194,26 @@ class IsoSurfaceBuilder {
   };
 
   bool is_design(long t) const { return !tagged_ || mesh_.domain[t] == 0; }
-  double f(int node) const { return level(node_density_, node, threshold_); }
+  double f(int node) const { return values_[node]; }
+
+  /// Raises |f| at nodes the level passes too close to: each node's value becomes at least
+  /// margin / (1 - margin) times the largest |f| across its crossed edges, so that the
+  /// crossings on those edges lie at least about `margin` of the edge away from it. Signs
+  /// stay, so the surface's topology does not change; only its points move along their edges.
+  void keep_crossings_off_nodes(double margin) {
+    const double k = margin / (1 - margin);
+    std::vector<double> need(values_.size(), 0);
+    for (long t = 0; t < mesh_.T.rows(); ++t)
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          const int a = mesh_.T(t, i), b = mesh_.T(t, j);
+          if ((values_[a] > 0) == (values_[b] > 0)) continue;
+          need[a] = std::max(need[a], k * std::abs(values_[b]));
+          need[b] = std::max(need[b], k * std::abs(values_[a]));
+        }
+    for (size_t i = 0; i < values_.size(); ++i)
+      if (std::abs(values_[i]) < need[i]) values_[i] = values_[i] > 0 ? need[i] : -need[i];
+  }
 
   int node_point(int n) {
     auto [it, fresh] = node_point_.emplace(n, static_cast<int>(pts_.size()));
@@ -323,9 +346,8 @@ class IsoSurfaceBuilder {
   }
 
   const TetMesh& mesh_;
-  const VecXd& node_density_;
-  const double threshold_;
   const bool tagged_;
+  std::vector<double> values_;  // the level at each node (node density - threshold, never 0)
   std::vector<Eigen::Vector3d> pts_;
   std::vector<int> lock_, pface_;
   std::vector<std::array<int, 3>> tris_;
@@ -336,8 +358,8 @@ class IsoSurfaceBuilder {
 
 }  // namespace
 
-TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold) {
-  IsoSurfaceBuilder b(mesh, node_density, threshold);
+TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold, double margin) {
+  IsoSurfaceBuilder b(mesh, node_density, threshold, margin);
   b.cut_design_tets();
   b.add_boundary_and_interfaces();
   return b.finish();

@@ -43,6 +43,11 @@ struct TriSurface {
 /// boundary of the kept region (common/closed_surface.h checks it): iso-triangles in design
 /// tets, Ω's boundary triangles (or their kept parts) with their face tags, non-design tets'
 /// boundary triangles on Ω, and the void side of faces between design and non-design tets.
-TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold);
+/// With margin in (0, 0.5) (0: the exact level set), the level's values at nodes it passes
+/// closer than about margin × the edge are raised in magnitude (signs kept, so the same
+/// topology) so that no crossing lies that close to a node: no needles or caps from
+/// crossings next to nodes, at the price of moving the surface by up to about margin × the
+/// edge length there.
+TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold, double margin = 0);
 
 }  // namespace topopt::result

@@ -12,6 +12,15 @@ struct SmoothParams {
   /// Vertices on Ω's boundary faces: slide within their face's plane when it is planar
   /// (true), or stay fixed (false). Non-design vertices never move.
   bool slide_on_planar_faces = true;
+  /// The finishing of the result surface around the smoothing (design_surface.h): edge flips
+  /// and collapses of badly shaped triangles before and after it (remesh, job key
+  /// "surface_remesh"), and the smoothing undone where triangles cross (repair,
+  /// "surface_repair"). Off only to compare with the surface as it was before issue 19.
+  bool remesh = true;
+  bool repair = true;
+  /// With remesh: crossings kept this share of an edge away from its nodes when the surface is
+  /// cut (extract_iso_surface's margin; slivers from crossings next to nodes never appear).
+  double crossing_margin = 0.2;
 };
 
 /// Smooths s.V in place. Vertices with lock 2 do not move; with lock 1 they move only

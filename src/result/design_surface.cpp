@@ -1,0 +1,40 @@
+// The design surface: remesh, smooth, remesh, repair, check (see design_surface.h).
+#include "result/design_surface.h"
+
+#include "mesh/surface/surface_check.h"
+
+namespace topopt::result {
+
+namespace {
+
+/// Remeshes s, and keeps the remeshed surface only when it crosses nothing (a flip across a
+/// bent edge, a collapse or a move can fold the surface onto a neighbour); counts into report.
+void remesh_unless_crossing(TriSurface& s, const RemeshParams& params, DesignSurfaceReport& report) {
+  TriSurface kept = s;
+  const RemeshReport r = remesh_surface(s, params);
+  if (!mesh::self_intersections(s.V, s.F, 1).empty()) {
+    s = std::move(kept);
+    ++report.remesh_undone;
+    return;
+  }
+  report.collapses += r.collapses, report.flips += r.flips, report.moves += r.moves;
+}
+
+}  // namespace
+
+DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smooth, const RemeshParams& remesh) {
+  DesignSurfaceReport report;
+  if (smooth.remesh) remesh_unless_crossing(s, remesh, report);
+  MatX3d before = s.V;
+  if (smooth.iterations > 0) {
+    smooth_surface(s, smooth);
+    report.crossings_smoothed = static_cast<long>(mesh::self_intersections(s.V, s.F, 1L << 40).size());
+    if (report.crossings_smoothed > 0 && smooth.repair) untangle(s, before);
+    // smoothing bent some triangles: flip, collapse and move again
+    if (smooth.remesh) remesh_unless_crossing(s, remesh, report);
+  }
+  report.check = check_result(s);
+  return report;
+}
+
+}  // namespace topopt::result

@@ -1,0 +1,36 @@
+// Well-shaped triangles on the result surface: marching tetrahedra leaves needles and caps
+// where the level passes close to a mesh node. Edge collapses and edge flips on the
+// free-form region (and on Ω's planar faces, within their plane) remove them; nothing on a
+// non-design solid and no point of Ω's faces leaves its place.
+#pragma once
+#include <vector>
+
+#include "result/iso_surface.h"
+
+namespace topopt::result {
+
+struct RemeshParams {
+  double target_angle = 15;     ///< triangles whose smallest angle is below this (degrees) are worked on
+  double flat_dihedral = 25;    ///< a flip on the free-form region only across edges bent less than this (degrees)
+  double max_normal_turn = 30;  ///< a collapse may turn no triangle's normal by more than this (degrees)
+  int passes = 20;              ///< sweeps over the surface at most (each stops the work when nothing changed)
+  bool planar_faces = true;     ///< also flip and collapse on Ω's planar faces (points stay in their plane)
+};
+
+/// What remesh_surface did.
+struct RemeshReport {
+  long collapses = 0, flips = 0, moves = 0;
+  std::vector<int> kept_points;  ///< for each point of the remeshed surface, its index before
+};
+
+/// Removes the badly shaped triangles of s where it can: flips an edge when that raises the
+/// smallest angle of its two triangles; collapses a short edge into one of its points when
+/// the point that goes is free (lock 0) or slides on the cut line of a planar Ω face, the
+/// surface stays manifold (link condition), and no remaining triangle turns by more than
+/// max_normal_turn or ends with a smaller smallest angle than the worst one it replaces;
+/// else moves a free point of the triangle within the plane of its triangles towards the
+/// mean of its neighbours when that raises their smallest angle. Locked points keep their
+/// positions; tags keep their meaning. Returns the counts and which points stayed.
+RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {});
+
+}  // namespace topopt::result

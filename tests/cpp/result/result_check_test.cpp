@@ -1,0 +1,153 @@
+// The result surface's check (exact self-intersection, closedness, angles by region), the repair
+// of crossings that moving points made, and the remeshing of badly shaped triangles.
+#include "result/result_check.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mesh/core/structured_box.h"
+#include "result/design_surface.h"
+#include "result/remesh.h"
+#include "simp/density_filter.h"
+
+namespace topopt::result {
+namespace {
+
+TriSurface with_tags(MatX3d V, MatX3i F) {
+  TriSurface s;
+  s.V = std::move(V), s.F = std::move(F);
+  s.tag = VecXi::Zero(s.F.rows());
+  s.lock = VecXi::Zero(s.V.rows());
+  s.point_face = VecXi::Zero(s.V.rows());
+  return s;
+}
+
+/// The closed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1), oriented outwards.
+TriSurface tetrahedron() {
+  MatX3d V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  MatX3i F(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  return with_tags(V, F);
+}
+
+TEST(ResultCheck, ATetrahedronsTouchingNeighboursAreNoCrossing) {
+  const ResultCheck c = check_result(tetrahedron());
+  EXPECT_TRUE(c.crossings.empty());
+  EXPECT_TRUE(c.valid());
+  EXPECT_NEAR(c.closed.volume, 1.0 / 6, 1e-15);
+  EXPECT_NEAR(c.min_angle_free, 45.0, 1e-9);  // the right isosceles faces' smallest angle
+}
+
+TEST(ResultCheck, APiercingPairIsFoundAndOnlyIt) {
+  // triangle 0 in z = 0; triangle 1 stands through it; triangle 2 shares a node with 0 and
+  // lies beside it in its plane (touching at that node only)
+  MatX3d V(8, 3);
+  V << 0, 0, 0, 4, 0, 0, 0, 4, 0,  // 0
+      1, 1, -1, 1, 1, 1, 2, 1, 0,  // 1: pierces 0 at (1, 1, 0)-(1.5, 1, 0)
+      -3, 0, 0, -1, -2, 0;         // 2: with node 0
+  MatX3i F(3, 3);
+  F << 0, 1, 2, 3, 4, 5, 0, 6, 7;
+  const ResultCheck c = check_result(with_tags(V, F));
+  ASSERT_EQ(c.crossings.size(), 1u);
+  EXPECT_EQ(c.crossings[0], std::make_pair(0, 1));
+  EXPECT_FALSE(c.valid());
+  // moved clear of triangle 0, triangle 1 crosses nothing; a point of it exactly on
+  // triangle 0 (touching) counts as a crossing: the check is exact
+  V.row(5) << 2, 1, 0.5;
+  V.row(3) << 1, 1, 0.25;
+  EXPECT_TRUE(check_result(with_tags(V, F)).crossings.empty());
+  V.row(3) << 1, 1, 0;
+  EXPECT_EQ(check_result(with_tags(V, F)).crossings.size(), 1u);
+}
+
+TEST(ResultCheck, FoldedNeighboursSharingAnEdgeAreACrossing) {
+  // two triangles on edge (0, 1), the second folded flat onto the first
+  MatX3d V(4, 3);
+  V << 0, 0, 0, 2, 0, 0, 1, 1, 0, 1, 0.5, 0;
+  MatX3i F(2, 3);
+  F << 0, 1, 2, 1, 0, 3;
+  EXPECT_EQ(check_result(with_tags(V, F)).crossings.size(), 1u);
+  V.row(3) << 1, -0.5, 0;  // unfolded: a flat pair, no crossing
+  EXPECT_TRUE(check_result(with_tags(V, F)).crossings.empty());
+}
+
+/// The bar of iso_surface_test: a 40x20x10 box, non-design blocks at both ends, a round bar of
+/// varying radius between them; its marching-tetrahedra surface at 15 % of the design volume.
+TriSurface bar_surface(double* kept_volume = nullptr, double margin = 0) {
+  mesh::StructuredBoxParams p;
+  p.size = {40, 20, 10};
+  p.cells = {20, 10, 5};
+  p.nondesign = {{0, 6, 2, 4, 14, 8}, {36, 6, 2, 40, 14, 8}};
+  const TetMesh mesh = mesh::structured_box_mesh(p);
+  const MatX3d c = simp::tet_centroids(mesh);
+  VecXd density(mesh.T.rows());
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    const double r = std::hypot(c(t, 1) - 10, c(t, 2) - 5), radius = 3.5 + 1.5 * std::sin(c(t, 0) / 6);
+    density[t] = mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (r - radius)));
+  }
+  const VecXd nd = node_densities(mesh, density);
+  const double t = threshold_for_volume(mesh, nd, 0.15);
+  if (kept_volume) *kept_volume = kept_design_volume(mesh, nd, t) + 2 * 4 * 8 * 6;
+  return extract_iso_surface(mesh, nd, t, margin);
+}
+
+TEST(ResultCheck, UntangleUndoesTheMovesThatMadeACrossing) {
+  TriSurface s = bar_surface();
+  ASSERT_TRUE(check_result(s).valid());
+  const MatX3d before = s.V;
+  // push a free point of the bar through the bar (3 mm, more than its radius)
+  int moved = -1;
+  for (long i = 0; i < s.V.rows() && moved < 0; ++i)
+    if (s.lock[i] == 0 && std::abs(s.V(i, 0) - 20) < 2 && s.V(i, 2) > 7) moved = static_cast<int>(i);
+  ASSERT_GE(moved, 0);
+  // every free point moved a little (no crossing from that), the one point pushed through
+  for (long i = 0; i < s.V.rows(); ++i)
+    if (s.lock[i] == 0) s.V(i, 1) += 0.01;
+  s.V(moved, 2) -= 6;
+  ASSERT_FALSE(check_result(s).crossings.empty());
+  EXPECT_TRUE(untangle(s, before).empty());
+  EXPECT_TRUE(check_result(s).valid());
+  // the pushed point went (at least partly) back; points far from it kept their small move
+  EXPECT_GE(s.V(moved, 2), before(moved, 2) - 3 - 1e-9);
+  long far = 0, far_kept = 0;
+  for (long i = 0; i < s.V.rows(); ++i)
+    if (s.lock[i] == 0 && (before.row(i) - before.row(moved)).norm() > 8) {
+      ++far;
+      far_kept += std::abs(s.V(i, 1) - before(i, 1) - 0.01) < 1e-12;
+    }
+  EXPECT_GT(far, 0);
+  EXPECT_EQ(far_kept, far);
+}
+
+TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
+  double kept = 0;
+  TriSurface s = bar_surface(&kept);
+  const ResultCheck c0 = check_result(s);
+  const MatX3d V0 = s.V;
+  const VecXi lock0 = s.lock;
+  const RemeshReport r = remesh_surface(s);
+  const ResultCheck c1 = check_result(s);
+  EXPECT_GT(r.collapses + r.flips, 0);
+  EXPECT_TRUE(c1.valid()) << c1.crossings.size() << " crossings";
+  EXPECT_GT(c1.min_angle_free, c0.min_angle_free);
+  EXPECT_NEAR(c1.closed.volume, kept, 0.01 * kept);
+  // locked points keep their places (free points may move within their triangles' plane)
+  for (size_t i = 0; i < r.kept_points.size(); ++i)
+    if (s.lock[i] != 0) EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
+  long locked_before = (lock0.array() == 2).count(), locked_after = (s.lock.array() == 2).count();
+  EXPECT_EQ(locked_after, locked_before);
+}
+
+TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
+  double kept = 0;
+  TriSurface s = bar_surface(&kept, SmoothParams{}.crossing_margin);  // cut as pipeline::result_surface cuts
+  const DesignSurfaceReport r = finish_design_surface(s, SmoothParams{});
+  EXPECT_TRUE(r.check.valid());
+  EXPECT_GE(r.check.min_angle_free, 10.0);
+  EXPECT_NEAR(r.check.closed.volume, kept, 0.03 * kept);
+}
+
+}  // namespace
+}  // namespace topopt::result
