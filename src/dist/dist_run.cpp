@@ -16,12 +16,41 @@ namespace {
 
 enum class Command : int { Stop = 0, Solve = 1, Optimize = 2 };
 
+/// The part of simp::SimpParams the distributed loop runs with (check_distributable refuses
+/// the rest: responses beyond compliance, geometry controls), as plain bytes.
+struct SimpCore {
+  double volume_fraction = 0.3;
+  simp::SimpLaw law;
+  simp::FilterParams filter;
+  bool sensitivity_filter = false;
+  simp::ProjectionParams projection;
+  simp::UpdateKind update = simp::UpdateKind::OC;
+  double move = 0.2;
+  int max_iterations = 100;
+  double tol_change = 0.01;
+  double tol_objective = 1e-4;
+  fem::SolverParams solver;
+
+  static SimpCore of(const simp::SimpParams& p) {
+    return {p.volume_fraction, p.law,           p.filter, p.sensitivity_filter,
+            p.projection,      p.update,        p.move,   p.max_iterations,
+            p.tol_change,      p.tol_objective, p.solver};
+  }
+  simp::SimpParams params() const {
+    simp::SimpParams p;
+    p.volume_fraction = volume_fraction, p.law = law, p.filter = filter, p.sensitivity_filter = sensitivity_filter;
+    p.projection = projection, p.update = update, p.move = move, p.max_iterations = max_iterations;
+    p.tol_change = tol_change, p.tol_objective = tol_objective, p.solver = solver;
+    return p;
+  }
+};
+
 /// What every rank needs to know of a run, broadcast as bytes.
 struct Settings {
   Command command = Command::Stop;
   fem::Material material;
   DistSolverParams solver;
-  simp::SimpParams simp;
+  SimpCore simp;
   int cases = 0;
 };
 static_assert(std::is_trivially_copyable_v<Settings>, "Settings are broadcast as bytes");
@@ -83,7 +112,8 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
     a.U = gather_nodes(s, dm, U.topRows(3 * dm.owned_nodes));
     for (long k = 0; k < U.cols(); ++k) a.von_mises.push_back(gather_tets(s, dm, fe.von_mises(U.col(k))));
   } else {
-    a.simp = optimize_mesh(s, dm, settings.material, weights, settings.simp, settings.solver, progress, on_iteration);
+    a.simp = optimize_mesh(s, dm, settings.material, weights, settings.simp.params(), settings.solver, progress,
+                           on_iteration);
   }
   mine.seconds_run = seconds_since(t0);
   mine.peak_bytes = peak_memory_bytes();
@@ -121,7 +151,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
   Settings settings;
   settings.command = Command::Optimize;
   settings.material = material;
-  settings.simp = params;
+  settings.simp = SimpCore::of(params);
   settings.solver.tolerance = params.solver.tolerance;
   settings.solver.max_iterations = params.solver.max_iterations;
   settings.cases = static_cast<int>(loads.cols());

@@ -151,6 +151,14 @@ void check_distributable(const simp::SimpParams& params, bool gravity) {
   if (gravity)
     throw Error(ErrorCode::InvalidParameter,
                 "under mpirun self-weight (a \"gravity\" load) is not available yet: remove it or run without mpirun");
+  if (params.controls.any())
+    throw Error(ErrorCode::InvalidParameter,
+                "under mpirun the geometry controls are not available yet: remove \"controls\" or run without mpirun");
+  if (params.responses.objective != simp::Objective::Compliance || params.responses.stress_limit > 0 ||
+      !params.responses.displacements.empty())
+    throw Error(ErrorCode::InvalidParameter,
+                "under mpirun only compliance under a volume fraction is optimised: remove \"objective\" and the "
+                "limits, or run without mpirun");
 }
 
 simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, const fem::Material& material,
