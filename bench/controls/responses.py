@@ -16,34 +16,22 @@ usage: bench/controls/responses.py [--build build] [--work /tmp/topopt-bench-res
                                    [--only cantilever,bracket] [--iterations 120]
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, resource, struct, subprocess, sys, time
+import argparse, json, os, struct, sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import benchlib  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
 
-EXAMPLES = {
-    "cantilever": (2.0, {"supports": [{"type": "fixed", "faces": ["Face1"]}],
-                         "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["NonDesign:Face12"],
-                                                                   "vector": [0, 0, -1000]}]}]}),
-    # bolt bores Face10-13 fixed; pin bore Face7: 5000 N along +x, and separately along -z
-    "bracket": (3.0, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
-                      "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
-                                     {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
-}
+EXAMPLES = benchlib.EXAMPLE_PROBLEMS
 
 
 def run(cmd, threads):
     """Runs a command; returns (wall s, CPU s of the child)."""
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode:
-        sys.exit(" ".join(cmd) + " failed:\n" + p.stdout[-3000:] + p.stderr[-3000:])
-    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    wall, cpu, _ = benchlib.run_threads(cmd, threads)
+    return wall, cpu
 
 
 def optimize(a, name, tag, optimization):

@@ -10,6 +10,8 @@ usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--onl
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, re, struct, subprocess, sys, time
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import benchlib  # noqa: E402
 
 import numpy as np
 
@@ -19,16 +21,7 @@ DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
 if not os.path.isdir(DATA):
     DATA = "/work/shared/data/examples"
 
-EXAMPLES = {
-    # 60 x 20 x 10 mm, x = 0 fixed, 1000 N in -z on the load pad (y in [7, 13])
-    "cantilever": (2.0, {"supports": [{"type": "fixed", "faces": ["Face1"]}],
-                         "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["NonDesign:Face12"],
-                                                                   "vector": [0, 0, -1000]}]}]}),
-    # bolt bores Face10-13 fixed; pin bore Face7: 5000 N along +x, and separately along -z
-    "bracket": (3.0, {"supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}],
-                      "load_cases": [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
-                                     {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}]}),
-}
+EXAMPLES = benchlib.EXAMPLE_PROBLEMS
 
 
 def controls_for(name, box):

@@ -26,12 +26,14 @@ usage: bench/result/run.py [--build build] [--work /tmp/topopt-bench-result] [--
                            [--surface [--size MM] [--max-iterations N]]
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, resource, subprocess, sys, time
+import argparse, json, os, sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.dirname(HERE))
+import benchlib  # noqa: E402
 import crisp  # noqa: E402
 
 EXAMPLES = {
@@ -58,15 +60,7 @@ SURFACE_SETTINGS = {"surface before": {"surface_remesh": False, "surface_repair"
 
 def run(cmd):
     """Runs a topopt command with 2 threads; returns (wall s, CPU s of the child, stdout)."""
-    env = dict(os.environ, OMP_NUM_THREADS="2")
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode:
-        sys.exit(" ".join(cmd) + " failed:\n" + p.stdout[-3000:] + p.stderr[-3000:])
-    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), p.stdout
+    return benchlib.run_threads(cmd, 2)
 
 
 def optimize(build, work, name, setting, options, size=None):
