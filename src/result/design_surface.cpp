@@ -7,6 +7,9 @@ namespace topopt::result {
 
 namespace {
 
+/// The smallest free-form angle the design surface aims at (issue 19: no triangle below 10°).
+constexpr double kMinDesignAngle = 10.0;
+
 /// Remeshes s, and keeps the remeshed surface only when it crosses nothing (a flip across a
 /// bent edge, a collapse or a move can fold the surface onto a neighbour); counts into report.
 void remesh_unless_crossing(TriSurface& s, const RemeshParams& params, DesignSurfaceReport& report) {
@@ -29,7 +32,10 @@ DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smo
   if (smooth.iterations > 0) {
     smooth_surface(s, smooth);
     report.crossings_smoothed = static_cast<long>(mesh::self_intersections(s.V, s.F, 1L << 40).size());
-    if (report.crossings_smoothed > 0 && smooth.repair) untangle(s, before);
+    // where smoothing made needles or caps (a small cut loop shrinking to a point), undo it
+    // locally; then the crossings (pulling points back can itself cross a smoothed neighbour)
+    if (smooth.repair) unsharpen(s, before, kMinDesignAngle);
+    if (smooth.repair && !mesh::self_intersections(s.V, s.F, 1).empty()) untangle(s, before);
     // smoothing bent some triangles: flip, collapse and move again
     if (smooth.remesh) remesh_unless_crossing(s, remesh, report);
   }

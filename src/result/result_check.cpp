@@ -37,12 +37,11 @@ ResultCheck check_result(const TriSurface& s, long max_crossings) {
 
 namespace {
 
-/// The points of the crossing triangles and, `ring` times, their neighbours through F.
-std::vector<char> around_crossings(const TriSurface& s, const std::vector<std::pair<int, int>>& crossings, int ring) {
+/// The points of the triangles `tris` and, `ring` times, their neighbours through F.
+std::vector<char> around_triangles(const TriSurface& s, const std::vector<int>& tris, int ring) {
   std::vector<char> mark(s.V.rows(), 0);
-  for (const auto& [a, b] : crossings)
-    for (int t : {a, b})
-      for (int k = 0; k < 3; ++k) mark[s.F(t, k)] = 1;
+  for (int t : tris)
+    for (int k = 0; k < 3; ++k) mark[s.F(t, k)] = 1;
   for (int r = 0; r < ring; ++r) {
     std::vector<char> grown = mark;
     for (long t = 0; t < s.F.rows(); ++t) {
@@ -55,17 +54,49 @@ std::vector<char> around_crossings(const TriSurface& s, const std::vector<std::p
   return mark;
 }
 
+/// The triangles of both sides of every crossing.
+std::vector<int> crossing_triangles(const std::vector<std::pair<int, int>>& crossings) {
+  std::vector<int> tris;
+  for (const auto& [a, b] : crossings) tris.push_back(a), tris.push_back(b);
+  return tris;
+}
+
+/// Free-form triangles sharper than `floor` degrees in s and sharper than they were in `before`.
+std::vector<int> sharpened(const TriSurface& s, const MatX3d& before, double floor) {
+  std::vector<int> tris;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    if (s.tag.size() == s.F.rows() && s.tag[t] != 0) continue;
+    const double now = min_triangle_angle(s.V, s.F(t, 0), s.F(t, 1), s.F(t, 2));
+    if (now < floor && now < min_triangle_angle(before, s.F(t, 0), s.F(t, 1), s.F(t, 2)) - 1e-9)
+      tris.push_back(static_cast<int>(t));
+  }
+  return tris;
+}
+
+/// Moves the points marked back towards `before`, keeping `keep` of their displacement.
+void pull_back(TriSurface& s, const MatX3d& before, const std::vector<char>& mark, double keep) {
+  for (long i = 0; i < s.V.rows(); ++i)
+    if (mark[i]) s.V.row(i) = before.row(i) + keep * (s.V.row(i) - before.row(i));
+}
+
 }  // namespace
+
+long unsharpen(TriSurface& s, const MatX3d& before, double floor, const UntangleParams& params) {
+  for (int round = 0; round < 2 * params.rounds; ++round) {
+    const std::vector<int> tris = sharpened(s, before, floor);
+    if (tris.empty()) return 0;
+    pull_back(s, before, around_triangles(s, tris, params.ring), round < params.rounds ? 0.5 : 0.0);
+  }
+  return static_cast<long>(sharpened(s, before, floor).size());
+}
 
 std::vector<std::pair<int, int>> untangle(TriSurface& s, const MatX3d& before, const UntangleParams& params) {
   constexpr long kAll = 1L << 40;
   for (int round = 0; round < 2 * params.rounds; ++round) {
     const std::vector<std::pair<int, int>> crossings = mesh::self_intersections(s.V, s.F, kAll);
     if (crossings.empty()) return crossings;
-    const std::vector<char> mark = around_crossings(s, crossings, params.ring);
     const double keep = round < params.rounds ? 0.5 : 0.0;  // share of the smoothing displacement kept
-    for (long i = 0; i < s.V.rows(); ++i)
-      if (mark[i]) s.V.row(i) = before.row(i) + keep * (s.V.row(i) - before.row(i));
+    pull_back(s, before, around_triangles(s, crossing_triangles(crossings), params.ring), keep);
   }
   return mesh::self_intersections(s.V, s.F, kAll);
 }

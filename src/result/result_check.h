@@ -40,4 +40,11 @@ struct UntangleParams {
 /// (none when repaired; the caller reports them).
 std::vector<std::pair<int, int>> untangle(TriSurface& s, const MatX3d& before, const UntangleParams& params = {});
 
+/// Undoes the smoothing around the free-form triangles it sharpened: a triangle whose smallest
+/// angle fell below `floor` degrees and below what it had in `before` (a small loop of the cut
+/// line shrinks towards a point under smoothing, leaving needles and caps the remesher cannot
+/// collapse). Round by round as untangle: the points of such triangles (and their `ring`
+/// neighbours) go halfway back, then all the way. Returns how many such triangles remain.
+long unsharpen(TriSurface& s, const MatX3d& before, double floor, const UntangleParams& params = {});
+
 }  // namespace topopt::result

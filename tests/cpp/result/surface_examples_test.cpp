@@ -23,10 +23,9 @@ struct Example {
   std::string name;
   double size;          // mesh size (mm)
   std::string problem;  // supports and load cases
-  /// The smallest free-form angle asserted (issue 19 asks 10°). Bracket and mount (5 mm) still
-  /// have near-zero angles where the iso-surface pokes through a planar face in a loop of two or
-  /// three cut points that coincide (a tiny cap the collapses cannot remove): measured 2e-6° to
-  /// 0.98°, left open in issue 19; for them only "not below 0" is asserted until that is fixed.
+  /// The smallest free-form angle asserted (issue 19 asks 10°). The mount at threshold 0.4 with
+  /// 60 smoothing pairs measures 7.3° (its default setting and the other three examples reach
+  /// 10°): left open in issue 19, asserted at what is measured so it cannot get worse unseen.
   double min_angle = 10.0;
 };
 
@@ -122,8 +121,7 @@ TEST(SurfaceExamples, Bracket) {
   check_example({"bracket", 5.0,
                  R"("supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}], "load_cases":
                   [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
-                   {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}])",
-                 0.0});
+                   {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}])"});
 }
 
 TEST(SurfaceExamples, Mount) {
@@ -132,7 +130,7 @@ TEST(SurfaceExamples, Mount) {
                  R"("supports": [{"type": "fixed", "faces": ["Face28", "Face29", "Face30", "Face31"]}], "load_cases":
                   [{"name": "down", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 0, -10000]}]},
                    {"name": "side", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 5000, 0]}]}])",
-                 0.0});
+                 7.0});
 }
 
 }  // namespace
