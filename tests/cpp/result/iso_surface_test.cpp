@@ -7,36 +7,18 @@
 #include <cmath>
 
 #include "common/error.h"
-#include "mesh/core/structured_box.h"
 #include "result/smoothing.h"
 #include "simp/density_filter.h"
+#include "testing/bar_field.h"
 
 namespace topopt::result {
 namespace {
 
-struct Fixture {
-  TetMesh mesh;
-  VecXd density;
-};
+using Fixture = testing::BarField;
 
 /// A 40x20x10 box with a non-design block at each end and a smooth density field: a
 /// bar of material along the x axis whose thickness varies, void elsewhere.
-Fixture bar_fixture() {
-  mesh::StructuredBoxParams p;
-  p.size = {40, 20, 10};
-  p.cells = {20, 10, 5};
-  p.nondesign = {{0, 6, 2, 4, 14, 8}, {36, 6, 2, 40, 14, 8}};
-  Fixture f;
-  f.mesh = mesh::structured_box_mesh(p);
-  MatX3d c = simp::tet_centroids(f.mesh);
-  f.density.resize(f.mesh.T.rows());
-  for (long t = 0; t < f.mesh.T.rows(); ++t) {
-    double r = std::hypot(c(t, 1) - 10, c(t, 2) - 5);
-    double radius = 3.5 + 1.5 * std::sin(c(t, 0) / 6);
-    f.density[t] = f.mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (r - radius)));
-  }
-  return f;
-}
+Fixture bar_fixture() { return testing::bar_field(4, testing::wavy_radius); }
 
 TEST(IsoSurface, ClosedManifoldOrientedWithTheTargetVolume) {
   Fixture f = bar_fixture();

@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "mesh/core/structured_box.h"
 #include "result/design_surface.h"
 #include "result/remesh.h"
 #include "simp/density_filter.h"
+#include "testing/bar_field.h"
 
 namespace topopt::result {
 namespace {
@@ -76,18 +76,9 @@ TEST(ResultCheck, FoldedNeighboursSharingAnEdgeAreACrossing) {
 /// The bar of iso_surface_test: a 40x20x10 box, non-design blocks at both ends, a round bar of
 /// varying radius between them; its marching-tetrahedra surface at 15 % of the design volume.
 TriSurface bar_surface(double* kept_volume = nullptr, double margin = 0) {
-  mesh::StructuredBoxParams p;
-  p.size = {40, 20, 10};
-  p.cells = {20, 10, 5};
-  p.nondesign = {{0, 6, 2, 4, 14, 8}, {36, 6, 2, 40, 14, 8}};
-  const TetMesh mesh = mesh::structured_box_mesh(p);
-  const MatX3d c = simp::tet_centroids(mesh);
-  VecXd density(mesh.T.rows());
-  for (long t = 0; t < mesh.T.rows(); ++t) {
-    const double r = std::hypot(c(t, 1) - 10, c(t, 2) - 5), radius = 3.5 + 1.5 * std::sin(c(t, 0) / 6);
-    density[t] = mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (r - radius)));
-  }
-  const VecXd nd = node_densities(mesh, density);
+  const testing::BarField bar = testing::bar_field(4, testing::wavy_radius);
+  const TetMesh& mesh = bar.mesh;
+  const VecXd nd = node_densities(mesh, bar.density);
   const double t = threshold_for_volume(mesh, nd, 0.15);
   if (kept_volume) *kept_volume = kept_design_volume(mesh, nd, t) + 2 * 4 * 8 * 6;
   return extract_iso_surface(mesh, nd, t, margin);

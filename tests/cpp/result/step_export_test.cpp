@@ -16,8 +16,8 @@
 #include <gp_Pln.hxx>
 
 #include "common/error.h"
-#include "mesh/core/structured_box.h"
 #include "simp/density_filter.h"
+#include "testing/bar_field.h"
 
 namespace topopt::result {
 namespace {
@@ -25,18 +25,8 @@ namespace {
 /// A 40x20x10 box, a non-design block at each end (x in [0, 6] and [36, 40]) and between them
 /// a round bar of varying radius: the unsmoothed iso-surface of that density field.
 TriSurface bar_surface() {
-  mesh::StructuredBoxParams p;
-  p.size = {40, 20, 10};
-  p.cells = {20, 10, 5};
-  p.nondesign = {{0, 6, 2, 6, 14, 8}, {36, 6, 2, 40, 14, 8}};
-  const TetMesh mesh = mesh::structured_box_mesh(p);
-  const MatX3d c = simp::tet_centroids(mesh);
-  VecXd density(mesh.T.rows());
-  for (long t = 0; t < mesh.T.rows(); ++t) {
-    const double r = std::hypot(c(t, 1) - 10, c(t, 2) - 5), radius = 3.5 + 1.5 * std::sin(c(t, 0) / 6);
-    density[t] = mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (r - radius)));
-  }
-  return extract_iso_surface(mesh, node_densities(mesh, density), 0.5);
+  const testing::BarField bar = testing::bar_field(6, testing::wavy_radius);
+  return extract_iso_surface(bar.mesh, node_densities(bar.mesh, bar.density), 0.5);
 }
 
 /// The faces of `shape` on the plane x = x0 (normal along x).

@@ -9,8 +9,8 @@
 
 #include "common/error.h"
 #include "fem/elasticity.h"
-#include "mesh/core/structured_box.h"
 #include "simp/density_filter.h"
+#include "testing/bar_field.h"
 
 namespace topopt::result {
 namespace {
@@ -26,16 +26,10 @@ struct Fixture {
 /// round bar of radius about 4 (a smooth density field); fixed at Ω's Face1 (x = 0), pulled down by 100 N on the second
 /// block's end face (NonDesign:Face8, part of Ω's Face2).
 Fixture bar_fixture() {
-  mesh::StructuredBoxParams p;
-  p.size = {40, 20, 10};
-  p.cells = {20, 10, 5};
-  p.nondesign = {{0, 6, 2, 6, 14, 8}, {36, 6, 2, 40, 14, 8}};
+  testing::BarField bar = testing::bar_field(6, [](double) { return 4.0; });
   Fixture f;
-  f.mesh = mesh::structured_box_mesh(p);
-  const MatX3d c = simp::tet_centroids(f.mesh);
-  f.density.resize(f.mesh.T.rows());
-  for (long t = 0; t < f.mesh.T.rows(); ++t)
-    f.density[t] = f.mesh.domain[t] ? 1.0 : 1.0 / (1.0 + std::exp(2.0 * (std::hypot(c(t, 1) - 10, c(t, 2) - 5) - 4)));
+  f.mesh = std::move(bar.mesh);
+  f.density = std::move(bar.density);
   f.surface = extract_iso_surface(f.mesh, node_densities(f.mesh, f.density), 0.5);
   fem::SupportSpec fixed;
   fixed.faces = {1};
