@@ -53,3 +53,43 @@ def run_threads(cmd, threads, check=True):
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OPENBLAS_NUM_THREADS=str(threads))
     out, cpu, wall, _ = run(cmd, env, check)
     return wall, cpu, out
+
+
+def read_stl(path):
+    """Triangles (n, 3, 3) of a binary or ASCII STL, as a numpy array."""
+    import struct
+    import numpy as np
+    data = open(path, "rb").read()
+    if data[:5] == b"solid" and b"facet" in data[:300]:
+        v = [list(map(float, l.split()[1:4])) for l in data.decode().splitlines() if l.strip().startswith("vertex")]
+        return np.array(v, dtype=float).reshape(-1, 3, 3)
+    n = struct.unpack("<I", data[80:84])[0]
+    a = np.frombuffer(data[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    return a["v"].astype(float)
+
+
+def picture(stl, png, title):
+    """An isometric, shaded picture of the surface in stl (equal axes), written to png."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    tris = read_stl(stl)
+    if len(tris) == 0:
+        return
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1)[:, None], 1e-30)
+    light = np.array([0.4, -0.5, 0.75])
+    shade = 0.35 + 0.65 * np.clip(n @ (light / np.linalg.norm(light)), 0, 1)
+    fig = plt.figure(figsize=(8, 6))
+    ax = fig.add_subplot(projection="3d")
+    ax.add_collection3d(Poly3DCollection(tris, facecolors=np.outer(shade, [0.55, 0.65, 0.85]), edgecolor="none"))
+    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
+    c, r = (lo + hi) / 2, (hi - lo).max() / 2
+    ax.set_xlim(c[0] - r, c[0] + r), ax.set_ylim(c[1] - r, c[1] + r), ax.set_zlim(c[2] - r, c[2] + r)
+    ax.view_init(elev=25, azim=-60)
+    ax.set_title(title, fontsize=9)
+    ax.set_axis_off()
+    fig.savefig(png, dpi=110, bbox_inches="tight")
+    plt.close(fig)

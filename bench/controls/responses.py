@@ -16,7 +16,7 @@ usage: bench/controls/responses.py [--build build] [--work /tmp/topopt-bench-res
                                    [--only cantilever,bracket] [--iterations 120]
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, struct, sys
+import argparse, json, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import benchlib  # noqa: E402
@@ -47,51 +47,6 @@ def optimize(a, name, tag, optimization):
     wall, cpu = run([os.path.join(a.build, "topopt"), "optimize", path, "--quiet"], a.threads)
     h = json.load(open(os.path.join(out, "history.json")))
     return h, wall, cpu, out
-
-
-def read_stl(path):
-    """Triangles (n, 3, 3) of a binary or ASCII STL."""
-    data = open(path, "rb").read()
-    if data[:5] != b"solid" or b"facet" not in data[:300]:
-        n = struct.unpack("<I", data[80:84])[0]
-        return [[struct.unpack("<3f", data[84 + 50 * i + 12 + 12 * k:84 + 50 * i + 24 + 12 * k]) for k in range(3)]
-                for i in range(n)]
-    tris, cur = [], []
-    for line in data.decode().splitlines():
-        w = line.split()
-        if w and w[0] == "vertex":
-            cur.append(tuple(float(x) for x in w[1:4]))
-            if len(cur) == 3:
-                tris.append(cur)
-                cur = []
-    return tris
-
-
-def picture(stl, png, title):
-    """An isometric, shaded picture of the result surface."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    tris = np.array(read_stl(stl))
-    if len(tris) == 0:
-        return
-    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1)[:, None], 1e-30)
-    light = np.array([0.4, -0.5, 0.75])
-    shade = 0.35 + 0.65 * np.clip(n @ (light / np.linalg.norm(light)), 0, 1)
-    fig = plt.figure(figsize=(8, 6))
-    ax = fig.add_subplot(projection="3d")
-    ax.add_collection3d(Poly3DCollection(tris, facecolors=np.outer(shade, [0.55, 0.65, 0.85]), edgecolor="none"))
-    lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
-    c, r = (lo + hi) / 2, (hi - lo).max() / 2
-    ax.set_xlim(c[0] - r, c[0] + r), ax.set_ylim(c[1] - r, c[1] + r), ax.set_zlim(c[2] - r, c[2] + r)
-    ax.view_init(elev=25, azim=-60)
-    ax.set_title(title)
-    ax.set_axis_off()
-    fig.savefig(png, dpi=110, bbox_inches="tight")
-    plt.close(fig)
 
 
 def main():
@@ -130,7 +85,7 @@ def main():
         for tag, limit, h, wall, cpu, out in runs:
             last = h["history"][-1]
             png = out + ".png"
-            picture(os.path.join(out, "result.stl"), png, "%s: %s" % (name, tag))
+            benchlib.picture(os.path.join(out, "result.stl"), png, "%s: %s" % (name, tag))
             freq = "%.1f → %.1f" % (h["history"][0]["frequency"], last["frequency"]) if last.get("frequency") else "–"
             stress = "%.1f" % last["stress"] if last.get("stress") else "–"
             print("| %s | %s | %s | %.3f | %.4g | %s | %s | %d | %.1f | %.1f | %s |"

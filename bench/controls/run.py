@@ -9,7 +9,7 @@ the result surface (result.stl, rendered with matplotlib) in the work folder.
 usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, re, struct, subprocess, sys, time
+import argparse, json, os, re, subprocess, sys, time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import benchlib  # noqa: E402
 
@@ -51,39 +51,6 @@ def run(cmd):
     return time.perf_counter() - t0, p
 
 
-def read_stl(path):
-    data = open(path, "rb").read()
-    if data[:5] == b"solid" and b"facet" in data[:300]:
-        v = [list(map(float, l.split()[1:4])) for l in data.decode().splitlines() if l.strip().startswith("vertex")]
-        return np.array(v).reshape(-1, 3, 3)
-    n = struct.unpack("<I", data[80:84])[0]
-    a = np.frombuffer(data[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
-    return a["v"].astype(float)
-
-
-def picture(stl, png, title):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    tri = read_stl(stl)
-    fig = plt.figure(figsize=(7, 5))
-    ax = fig.add_subplot(111, projection="3d")
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n /= np.maximum(1e-12, np.linalg.norm(n, axis=1))[:, None]
-    shade = 0.35 + 0.65 * np.clip(n @ np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8]), 0, 1)
-    ax.add_collection3d(Poly3DCollection(tri, facecolors=np.c_[shade * 0.5, shade * 0.7, shade, np.ones_like(shade)],
-                                         edgecolor="none"))
-    lo, hi = tri.reshape(-1, 3).min(0), tri.reshape(-1, 3).max(0)
-    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(hi - lo)
-    ax.view_init(elev=25, azim=-60)
-    ax.set_title(title, fontsize=9)
-    ax.set_axis_off()
-    fig.savefig(png, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -97,7 +64,7 @@ def main():
             stl = os.path.join(a.work, d, "result.stl")
             if os.path.exists(stl):
                 h = json.load(open(os.path.join(a.work, d, "history.json")))
-                picture(stl, os.path.join(a.work, d + ".png"), "%s: compliance %.4g" % (d, h["history"][-1]["compliance"]))
+                benchlib.picture(stl, os.path.join(a.work, d + ".png"), "%s: compliance %.4g" % (d, h["history"][-1]["compliance"]))
         return
     os.makedirs(a.work, exist_ok=True)
     topopt = os.path.join(a.build, "topopt")
@@ -131,7 +98,7 @@ def main():
             tets = re.search(r"(\d+) tets", p.stdout + p.stderr)
             nvar = re.search(r"(\d+) variables for", p.stdout + p.stderr)
             png = out + ".png"
-            picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
+            benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
             print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
                 "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, os.path.basename(png)))
