@@ -52,6 +52,17 @@ nodes #V x 3 (mm), tets #T x 4 (0-based), tris #F x 3 boundary triangles with tr
 job file text (material, supports, load_cases; see docs/job-format.md). Returns a dict:
 case_names, displacement (one #V x 3 array per case), von_mises (#T per case), compliance.
 Raises TopOptError (.code "NoSupport", "FaceNotFound", ...) naming what to fix.)doc");
+  m.def(
+      "check_job",
+      [](const pybind11::object& job_arg) {
+        const std::string job_json = text_arg(job_arg, "job_json");
+        pybind11::gil_scoped_release release;
+        pipeline::parse_job(job_json, "");
+      },
+      pybind11::arg("job_json"),
+      R"doc(Checks a job as `topopt optimize` does before it starts (parse_job: every key and
+value, no shapes read, nothing run). job_json: the job file text. Returns None; raises
+TopOptError (.code "InvalidParameter", ...) naming the key and what to give instead.)doc");
 }
 
 }  // namespace topopt::py

@@ -26,6 +26,7 @@
 #include "pipeline/job.h"
 #include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
+#include "pipeline/result_files.h"
 #include "pipeline/run_job.h"
 #include "pipeline/solve_job.h"
 #include "pipeline/surface_job.h"
@@ -226,6 +227,17 @@ void put_last_iterate(json& result, const fs::path& dir, const pipeline::Job& jo
   put_array(result, dir, "von_mises", s.von_mises[0]);
 }
 
+/// As the job's "output" asks (step, verification): result.step, verification.json and
+/// verification.vtu written into DIR (pipeline::write_result_files; each may fail alone with a
+/// warning). Their names go to result["files"], for the workbench to keep them.
+void put_result_files(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
+                      const Progress& progress) {
+  const pipeline::ResultFiles files =
+      pipeline::write_result_files(job, run.mesh, run.optimization, dir.string(), {}, progress);
+  result["files"] = json::array();
+  for (const std::string& path : files.written) result["files"].push_back(fs::path(path).filename().string());
+}
+
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
   const pipeline::Job job = job_of(r);
@@ -246,11 +258,14 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
                  {"status", o.simp.status},
                  {"seconds", {o.seconds_simp, o.seconds_surface}},
                  {"warnings", warnings}};
-  put_last_iterate(result, r.output, job, run.mesh, o.simp.density, ch, ch.make_progress(warnings));
+  const Progress progress = ch.make_progress(warnings);
+  put_last_iterate(result, r.output, job, run.mesh, o.simp.density, ch, progress);
   ch.progress("write", -1, "writing the results");
   put_tet_mesh(result, r.output, run.mesh);
   put_array(result, r.output, "densities", o.simp.density);
   put_result_surface(result, r.output, o.surface);
+  put_result_files(result, r.output, job, run, progress);
+  result["warnings"] = warnings;  // with those of the last iterate's analysis and the result files
   return result;
 }
 

@@ -7,6 +7,7 @@ FreeCAD, and comes back as a TopOptError. Arguments are checked here before anyt
 """
 import json
 import os
+import shutil
 
 import Part
 
@@ -253,8 +254,89 @@ def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=No
         c["extrusion"] = _vector(extrusion, "extrusion")
     if checks.in_range(tolerance, "tolerance", 0, None) > 0:
         c["tolerance"] = float(tolerance)
+    check_optimization(study, controls=c)
     study.GeometryControls = json.dumps(c) if c else ""
     return c
+
+
+def check_optimization(study, controls=None, responses=None, update=None):
+    """Checks the study's optimisation settings with `controls` and/or `responses` (dicts as
+    the job has them; None: the study's own) exactly as a job file is checked (the core's
+    parser), without running anything. update: the update scheme to check with (None: the
+    study's Update). Raises TopOptError naming the job key and the value to
+    give, e.g. "optimization.stress_limit must be a positive von Mises stress in MPa"."""
+    from . import core
+    from . import job as jobmod
+    opt = {"volume_fraction": checks.in_range(study.VolumeFraction, "VolumeFraction", 0, 1, True, True)}
+    if (update or study.Update) == "mma":
+        opt["update"] = "mma"
+    opt.update(jobmod.study_responses(study) if responses is None else responses)
+    controls = jobmod.study_controls(study) if controls is None else controls
+    if controls:
+        opt["controls"] = controls
+    probe = {"supports": [{"type": "fixed", "faces": ["Face1"]}],
+             "load_cases": [{"name": "check", "loads": [{"type": "force", "faces": ["Face1"], "vector": [0, 0, 1]}]}],
+             "optimization": opt}
+    core.check_job(probe)
+
+
+def _limit_faces(study, faces, i):
+    """The job's face names of displacement limit i from the job's own names ("Face7",
+    "NonDesign:Face2") or picked references [(obj, ("Face7",)), ...] on the part or a
+    non-design solid; vertices and edges are refused (the limit is a faces' mean)."""
+    from . import job as jobmod
+    what = "displacement limit %d" % i
+    if isinstance(faces, str):
+        faces = [faces]
+    if faces and all(isinstance(f, str) for f in faces):
+        nd = [f for f in faces if f.startswith("NonDesign:")]
+        total = sum(len(o.Shape.Faces) for o in study.NonDesign)
+        for f in nd:
+            n = f[len("NonDesign:Face"):]
+            if not f.startswith("NonDesign:Face") or not n.isdigit() or not 1 <= int(n) <= total:
+                raise TopOptError("%s: the non-design solids have no face %r (NonDesign:Face1 to NonDesign:Face%d)"
+                                  % (what, f, total), "FaceNotFound")
+        part = [f for f in faces if f not in nd]
+        return (jobmod.face_names(study, _faces(study, part, None), what) if part else []) + nd
+    refs = [(obj, (subs,) if isinstance(subs, str) else tuple(subs)) for obj, subs in (faces or [])]
+    for obj, subs in refs:
+        for sub in subs:
+            if sub.startswith("Vertex") or sub.startswith("Edge"):
+                raise TopOptError("%s is on %s of %s: displacement limits go on faces (their mean "
+                                  "displacement is limited); pick a face" % (what, sub, obj.Label), "FaceNotFound")
+    return jobmod.face_names(study, refs, what)
+
+
+def set_responses(study, objective="compliance", compliance_limit=None, stress_limit=None, displacement_limits=()):
+    """Sets what the study optimises and its limits (docs/optimization.md); called with no
+    arguments it goes back to the stiffest design of the volume fraction.
+
+    objective: "compliance" (stiffest design of VolumeFraction), "mass" (lightest design
+    within the limits; needs at least one) or "frequency" (highest first eigenfrequency).
+    compliance_limit: N·mm (with "mass" only). stress_limit: von Mises, MPa.
+    displacement_limits: [(faces, direction [x, y, z], limit mm), ...] with faces as part face
+    names ("Face7" or a list) or picked references [(obj, ("Face7",))]. Checked as a job file
+    is; anything beyond compliance needs MMA, so the study's Update becomes "mma". Returns the
+    responses as the job's dict. Raises TopOptError naming the value at fault."""
+    r = {}
+    if objective != "compliance":
+        r["objective"] = str(objective)
+    if compliance_limit is not None:
+        r["compliance_limit"] = checks.number(compliance_limit, "compliance_limit (N·mm)")
+    if stress_limit is not None:
+        r["stress_limit"] = checks.number(stress_limit, "stress_limit (MPa)")
+    limits = []
+    for i, (faces, direction, limit) in enumerate(displacement_limits or (), 1):
+        limits.append({"faces": _limit_faces(study, faces, i),
+                       "direction": _vector(direction, "displacement limit %d direction" % i),
+                       "limit": checks.number(limit, "displacement limit %d (mm)" % i)})
+    if limits:
+        r["displacement_limits"] = limits
+    check_optimization(study, responses=r, update="mma" if r else None)
+    if r and study.Update == "oc":
+        study.Update = "mma"  # OC handles one volume constraint only; visible in the property editor
+    study.Responses = json.dumps(r) if r else ""
+    return r
 
 
 def job_of(study):
@@ -281,10 +363,10 @@ def save(doc, path=None):
     return quiet.save(doc, path)
 
 
-def export_stl(study, path):
-    """Writes the study's result shape to an STL file at `path`. Raises TopOptError if the
-    study has no result, if the folder does not exist, or if the file cannot be written."""
-    if study.Result is None:
+def _output_path(study, path, suffix):
+    """`path` made absolute, checked before anything is written: the study has a result, the
+    folder exists, the path is not a folder. Raises TopOptError saying what to fix."""
+    if getattr(study, "Result", None) is None:
         raise TopOptError("the study has no result yet: run it first", "InvalidParameter")
     path = os.path.abspath(os.path.expanduser(str(path)))
     folder = os.path.dirname(path)
@@ -292,13 +374,55 @@ def export_stl(study, path):
         raise TopOptError("the folder %s does not exist: create it or pick another folder for %s"
                           % (folder, os.path.basename(path)), "Io")
     if os.path.isdir(path):
-        raise TopOptError("%s is a folder: give a file name ending in .stl" % path, "Io")
+        raise TopOptError("%s is a folder: give a file name ending in %s" % (path, suffix), "Io")
+    return path
+
+
+def _written(path, write):
+    """Runs write(); a failure or a missing file afterwards becomes TopOptError("Io")."""
     try:
         with quiet.no_progress_lines():
-            study.Result.Mesh.write(path)
+            write()
     except Exception as e:  # OSError, or FreeCAD's own exception types
         raise TopOptError("cannot write %s (%s): check that the folder is writable"
                           % (path, getattr(e, "strerror", None) or e), "Io") from None
     if not os.path.isfile(path):
         raise TopOptError("cannot write %s: check that the folder is writable" % path, "Io")
     return path
+
+
+def export_stl(study, path):
+    """Writes the study's result shape to an STL file at `path`. Raises TopOptError if the
+    study has no result, if the folder does not exist, or if the file cannot be written."""
+    path = _output_path(study, path, ".stl")
+    return _written(path, lambda: study.Result.Mesh.write(path))
+
+
+def export_step(study, path):
+    """Writes the study's result as one CAD solid to a STEP file at `path`: the result.step
+    its last run wrote (the shape at the run's threshold; the threshold slider does not change
+    it). Returns the path. Raises TopOptError if the study has no result, if its run wrote no
+    STEP file (saying which setting to turn on), if the folder does not exist, or if the file
+    cannot be written."""
+    from . import asbuilt
+    path = _output_path(study, path, ".step")
+    source = asbuilt.step_path(study)
+    return _written(path, lambda: shutil.copyfile(source, path))
+
+
+def result_solid(study):
+    """Adds (or refreshes) the study's ResultSolid: a Part::Feature holding the one solid read
+    from the result.step of its last run, in one undo step ("TopOpt result as solid"). Returns
+    the feature. Raises TopOptError if the study has no result or its run wrote no STEP file
+    (saying which setting to turn on), or if the file does not hold one valid solid; the
+    document is then unchanged."""
+    from . import asbuilt, runner
+    from .study import is_study
+    if not is_study(study):
+        raise TopOptError("%r is not a TopOpt study: pass the object api.new_study returned" % (study,),
+                          "InvalidParameter")
+    shape = asbuilt.read_step(asbuilt.step_path(study))
+    with runner.transaction(study.Document, "TopOpt result as solid"):
+        feature = asbuilt.make_solid_feature(study, shape)
+        quiet.recompute(study.Document)
+    return feature

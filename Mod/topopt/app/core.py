@@ -73,3 +73,9 @@ def extract_surface(nodes, tets, domain, densities, threshold=-1.0, volume_fract
         raise TopOptError("give a threshold in (0, 1) or a volume_fraction in (0, 1)", "InvalidParameter")
     smoothing = int(checks.in_range(smoothing_iterations, "smoothing_iterations", 0, 1000))
     return _call("extract_surface", nodes, tets, domain, densities, threshold, volume_fraction, smoothing)
+
+
+def check_job(job):
+    """Checks a job (a dict or its JSON text) as the core checks a job file before a run,
+    without reading shapes or running anything. Raises TopOptError naming the key at fault."""
+    return _call("check_job", checks.job_text(job))

@@ -135,6 +135,8 @@ def study_to_job(study):
     }
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]
+    job["output"] = {"step": bool(getattr(study, "WriteStep", True)), "verification": bool(getattr(study, "Verify", False))}
+    job["optimization"].update(study_responses(study))
     controls = study_controls(study)
     if controls:
         job["optimization"]["controls"] = controls
@@ -143,21 +145,33 @@ def study_to_job(study):
     return job
 
 
-def study_controls(study):
-    """The study's geometry controls (its GeometryControls property, JSON text) as a dict, {}
-    for none. Raises TopOptError naming the property when the text is not a JSON object."""
-    text = str(getattr(study, "GeometryControls", "") or "").strip()
+def _json_property(study, name, example):
+    """The study's JSON text property `name` as a dict, {} when empty. Raises TopOptError
+    naming the property when the text is not a JSON object."""
+    text = str(getattr(study, name, "") or "").strip()
     if not text:
         return {}
     try:
         value = json.loads(text)
     except ValueError as e:
-        raise errors.TopOptError("the study's GeometryControls is not valid JSON (%s): set it with "
-                                 "api.set_controls or clear it" % e, "InvalidParameter")
+        raise errors.TopOptError("the study's %s is not valid JSON (%s): set it with the API or the study's "
+                                 "panel, or clear it" % (name, e), "InvalidParameter")
     if not isinstance(value, dict):
-        raise errors.TopOptError("the study's GeometryControls must be a JSON object such as "
-                                 "{\"extrusion\": [0, 0, 1]}", "InvalidParameter")
+        raise errors.TopOptError("the study's %s must be a JSON object such as %s" % (name, example),
+                                 "InvalidParameter")
     return value
+
+
+def study_responses(study):
+    """The study's objective and limits (its Responses property, JSON text) as the job's
+    optimization keys, {} for the default (compliance of the volume fraction)."""
+    return _json_property(study, "Responses", '{"objective": "mass", "stress_limit": 200}')
+
+
+def study_controls(study):
+    """The study's geometry controls (its GeometryControls property, JSON text) as a dict, {}
+    for none. Raises TopOptError naming the property when the text is not a JSON object."""
+    return _json_property(study, "GeometryControls", '{"extrusion": [0, 0, 1]}')
 
 
 #: the study's numeric properties: (name, unit or None, low, high, open low, open high); None = no bound

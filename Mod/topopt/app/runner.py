@@ -9,6 +9,7 @@ import contextlib
 import FreeCAD
 import numpy as np
 
+from . import asbuilt
 from . import checks
 from . import job as jobmod
 from . import progress
@@ -145,6 +146,9 @@ def apply(study, result):
     feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
                               result.get("surface_tags"), nodes, tets, domain)
     results.update_fem_objects(study, result, study.Threshold)
+    asbuilt.store_files(study, result.get("files", {}))
+    asbuilt.update_verification(study)
+    asbuilt.refresh_solid(study)
     if study.DomainMeshes:
         results.show_domains(study, nodes, tets, domain)
     quiet.recompute(doc)
@@ -163,12 +167,15 @@ def where_results_are(study):
                      % (res.Label, max(res.DisplacementLengths), max(res.vonMises or [0.0])))
     if study.DensityView is not None:
         parts.append("%s (density view)" % study.DensityView.Label)
+    if study.VerificationResult is not None:
+        parts.append("%s (FEM result of the result solid)" % study.VerificationResult.Label)
     return "  results: " + ("; ".join(parts) if parts else "none")
 
 
 def report_run(study, result, tracker, seconds):
     """Prints the run summary to the report view (FreeCAD's console without the GUI)."""
-    lines = progress.run_summary(study, result, tracker, seconds) + [where_results_are(study)]
+    lines = progress.run_summary(study, result, tracker, seconds) + asbuilt.summary_lines(study)
+    lines.append(where_results_are(study))
     FreeCAD.Console.PrintMessage("\n".join(lines) + "\n")
     _report_warnings(result)
 

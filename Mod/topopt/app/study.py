@@ -18,6 +18,16 @@ RESULT_LINKS = [
     ("DensityView", "The material where the density reaches the threshold, coloured by density"),
 ]
 
+#: links to objects a run makes only when asked (verification) and to the solid "Result as
+#: solid" makes: (name, doc); None until made
+ASBUILT_LINKS = [
+    ("ResultSolid", "The result as a Part solid, read from the run's result.step (command Result as solid)"),
+    ("VerificationMesh", "The result solid's own tet mesh (the verification's FEM mesh)"),
+    ("VerificationResult", "The verification: the result solid analysed with the study's supports and loads "
+                           "(FEM result: displacement, von Mises stress)"),
+    ("VerificationFields", "The verification's fields for FEM's post-processing (colour bar, clip, probe)"),
+]
+
 
 def _add(obj, kind, name, group, doc, default=None):
     if name not in obj.PropertiesList:
@@ -140,14 +150,19 @@ class Study:
         _add(obj, "App::PropertyString", "GeometryControls", "Optimization",
              "Geometry controls as the job's \"controls\" object in JSON (symmetry planes, cyclic, "
              "patterns, extrusion; docs/optimization.md); empty = none. Set with api.set_controls", "")
+        _add(obj, "App::PropertyString", "Responses", "Optimization",
+             "Objective and limits as the job's optimization keys in JSON (objective, compliance_limit, "
+             "stress_limit, displacement_limits; docs/optimization.md); empty = the stiffest design of the "
+             "volume fraction. Set with api.set_responses or the study's panel", "")
 
     def _results(self, obj):
         doc_t = ("Density threshold of the shown result shape: the run's (the one that keeps the volume "
                  "fraction) until the threshold slider moves it; never an input of the next run")
         _add(obj, "App::PropertyFloat", "Threshold", "Result", doc_t, -1.0)
         obj.setDocumentationOfProperty("Threshold", doc_t)  # older documents: it used to be an input
-        for name, doc in RESULT_LINKS:
+        for name, doc in RESULT_LINKS + ASBUILT_LINKS:
             _add(obj, "App::PropertyLink", name, "Result", doc)
+        self._asbuilt(obj)
         _add(obj, "App::PropertyLinkList", "DomainMeshes", "Result",
              "The tagged mesh by domain (FEM meshes: design, then each non-design solid)")
         _add(obj, "App::PropertyFloatList", "ComplianceHistory", "Result", "Compliance per iteration (N·mm)")
@@ -160,10 +175,33 @@ class Study:
         _add(obj, "App::PropertyIntegerList", "MeshDomains", "Result", "0 design, i non-design solid i")
         _add(obj, "App::PropertyFloatList", "Densities", "Result", "Element densities of the last run")
         for name in ("Status", "MeshNodes", "MeshTets", "MeshDomains", "Densities", "ComplianceHistory",
-                     "VolumeHistory", "Threshold", "DomainMeshes") + tuple(n for n, _ in RESULT_LINKS):
+                     "VolumeHistory", "Threshold", "DomainMeshes") + tuple(n for n, _ in RESULT_LINKS + ASBUILT_LINKS):
             obj.setEditorMode(name, 1)  # read-only in the property editor
         for name in ("MeshNodes", "MeshTets", "MeshDomains", "Densities"):
             obj.setEditorMode(name, 2)  # and hidden: they are large
+
+    def _asbuilt(self, obj):
+        """What a run writes besides the shape: its options and the files it wrote, kept in the
+        document (an .FCStd holds the included files)."""
+        _add(obj, "App::PropertyBool", "WriteStep", "Output",
+             "Write the result as one CAD solid (result.step) with each run: Result as solid and Export STEP "
+             "need it", True)
+        _add(obj, "App::PropertyBool", "Verify", "Output",
+             "Analyse the result solid after each run (its own tet mesh, the study's supports and loads): "
+             "the as-built compliance and stresses", True)
+        _add(obj, "App::PropertyStringList", "ResultFiles", "Result",
+             "The files the last run wrote (result.step, verification.json, verification.vtu)")
+        _add(obj, "App::PropertyFileIncluded", "ResultStep", "Result", "The last run's result.step (one solid)")
+        _add(obj, "App::PropertyFileIncluded", "VerificationVtu", "Result", "The last run's verification.vtu")
+        _add(obj, "App::PropertyString", "VerificationReport", "Result",
+             "The last run's verification.json (compliance_as_built, max_von_mises, crisp, failed, ...)")
+        _add(obj, "App::PropertyFloat", "ComplianceAsBuilt", "Result",
+             "Compliance of the result solid, analysed on its own mesh (N·mm); 0 = not verified", 0.0)
+        _add(obj, "App::PropertyFloat", "ComplianceCrisp", "Result",
+             "Compliance of the crisp design (densities 0/1 at the threshold) on the FE mesh (N·mm); "
+             "0 = not verified", 0.0)
+        for name in ("ResultFiles", "ResultStep", "VerificationVtu", "VerificationReport", "ComplianceAsBuilt", "ComplianceCrisp"):
+            obj.setEditorMode(name, 1)
 
     def onDocumentRestored(self, obj):
         self.ensure_properties(obj)
@@ -214,6 +252,7 @@ def owned_objects(study):
         obj = getattr(study, name, None)
         if obj is not None and not (name == "DensityView" and study.Fields is not None):
             out.append(obj)  # the density view sits under the fields (FEM's pipeline claims it)
+    out += [getattr(study, n, None) for n, _ in ASBUILT_LINKS if getattr(study, n, None) is not None]
     return out
 
 

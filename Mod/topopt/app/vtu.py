@@ -45,3 +45,32 @@ def write_tets(path, nodes, tets, point_fields=(), cell_fields=()):
     with open(path, "w") as f:
         f.write("".join(parts))
     return path
+
+
+def _array(element):
+    """The numbers of an ASCII DataArray element, shaped #rows x NumberOfComponents (flat for
+    one component)."""
+    if element.get("format", "ascii") != "ascii":
+        raise ValueError("DataArray %s is not ASCII" % element.get("Name"))
+    values = np.array((element.text or "").split(), dtype=np.float64)
+    components = int(element.get("NumberOfComponents", "1"))
+    return values.reshape(-1, components) if components > 1 else values
+
+
+def read_tets(path):
+    """Reads an ASCII .vtu of linear tets (as write_tets and the core write them). Returns
+    (nodes #V x 3, tets #T x 4 0-based, {point field: array}, {cell field: array}). Raises
+    ValueError when the file holds other cells or no piece."""
+    import xml.etree.ElementTree as ET
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    if piece is None:
+        raise ValueError("%s holds no unstructured grid" % path)
+    nodes = _array(piece.find("Points/DataArray")).reshape(-1, 3)
+    cells = {a.get("Name"): a for a in piece.findall("Cells/DataArray")}
+    if np.any(_array(cells["types"]) != _VTK_TETRA):
+        raise ValueError("%s holds cells other than linear tets" % path)
+    tets = _array(cells["connectivity"]).astype(np.int64).reshape(-1, 4)
+    fields = []
+    for tag in ("PointData", "CellData"):
+        fields.append({a.get("Name"): _array(a) for a in piece.findall(tag + "/DataArray")})
+    return nodes, tets, fields[0], fields[1]

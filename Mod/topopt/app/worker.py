@@ -42,6 +42,10 @@ _STAGES = {
     "simp": ("the optimiser", "optimising", "try a coarser mesh size or fewer iterations"),
     "surface": ("the result-shape extraction", "extracting the result shape",
                 "try another threshold"),
+    "step": ("the STEP export", "writing the result as a STEP solid",
+             "turn off the study's WriteStep (Output) or try another mesh size"),
+    "verification": ("the verification", "meshing and analysing the result solid",
+                     "turn off the study's Verify (Output) or try another mesh size"),
     "write": ("the TopOpt worker", "writing the results",
               "check that the temporary folder has free space"),
 }
@@ -216,10 +220,17 @@ def _follow(worker, on_progress, cancel, timeout):
 
 
 def _load(out):
+    """result.json's values, its arrays (numpy) and, under "files", the contents (bytes) of
+    the files it lists (an optimisation's result.step, verification.json and .vtu)."""
     with open(os.path.join(out, "result.json")) as f:
         result = json.load(f)
     for name in result.pop("arrays", []):
         result[name] = np.load(os.path.join(out, name + ".npy"))
+    files = {}
+    for name in result.pop("files", []):
+        with open(os.path.join(out, os.path.basename(name)), "rb") as f:
+            files[os.path.basename(name)] = f.read()
+    result["files"] = files
     return result
 
 

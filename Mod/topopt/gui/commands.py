@@ -221,6 +221,49 @@ class ExportStl(_Command):
             FreeCAD.Console.PrintMessage("TopOpt: result written to %s\n" % path)
 
 
+class ExportStep(_Command):
+    menu, icon = "Export result as STEP", "TopOptExportStep.svg"
+    tip = "Write the study's result as one CAD solid to a STEP file (the result.step of its last run)"
+
+    def IsActive(self):
+        s = active_study()
+        return s is not None and s.Result is not None
+
+    @_guarded
+    def Activated(self):
+        study = active_study()
+        from topopt.app import asbuilt
+        asbuilt.step_path(study)  # refuses before the file dialog when the run wrote no STEP
+        from PySide import QtGui
+        path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), "Export result as STEP", "",
+                                                    "STEP (*.step *.stp)")
+        if path:
+            api.export_step(study, path)
+            FreeCAD.Console.PrintMessage("TopOpt: result solid written to %s\n" % path)
+
+
+class ResultAsSolid(_Command):
+    menu, icon = "Result as solid", "TopOptResultSolid.svg"
+    tip = ("Add the study's result as a Part solid (read from the result.step of its last run) to use in "
+           "further CAD work")
+
+    def IsActive(self):
+        s = active_study()
+        return s is not None and s.Result is not None
+
+    @_guarded
+    def Activated(self):
+        study = active_study()
+        feature = api.result_solid(study)
+        s = feature.Shape
+        FreeCAD.Console.PrintMessage("TopOpt: %s: one solid, %d faces, %.6g mm³\n" % (
+            feature.Label, len(s.Faces), s.Volume))
+        if FreeCAD.GuiUp and feature.ViewObject is not None:
+            feature.ViewObject.Visibility = True
+            if study.Result is not None and study.Result.ViewObject is not None:
+                study.Result.ViewObject.Visibility = False
+
+
 class BuildCore(_Command):
     menu, icon = "Build the native core", "TopOptBuildCore.svg"
 
@@ -241,12 +284,12 @@ class BuildCore(_Command):
 COMMANDS = [("TopOpt_NewStudy", NewStudy), ("TopOpt_Fixed", AddFixed), ("TopOpt_Force", AddForce),
             ("TopOpt_Pressure", AddPressure), ("TopOpt_Symmetry", AddSymmetry),
             ("TopOpt_Mesh", MeshStudy), ("TopOpt_Run", RunStudy), ("TopOpt_ExportStl", ExportStl),
-            ("TopOpt_BuildCore", BuildCore)]
+            ("TopOpt_ExportStep", ExportStep), ("TopOpt_ResultAsSolid", ResultAsSolid), ("TopOpt_BuildCore", BuildCore)]
 
 _STUDY = ["TopOpt_NewStudy"]
 _CONSTRAINTS = ["TopOpt_Fixed", "TopOpt_Force", "TopOpt_Pressure", "TopOpt_Symmetry"]
 _SOLVE = ["TopOpt_Mesh", "TopOpt_Run"]
-_RESULT = ["TopOpt_ExportStl"]
+_RESULT = ["TopOpt_ResultAsSolid", "TopOpt_ExportStl", "TopOpt_ExportStep"]
 
 #: toolbars: (title, command names with separators)
 TOOLBARS = [("Topology Optimization", _STUDY + ["Separator"] + _CONSTRAINTS + ["Separator"] + _SOLVE

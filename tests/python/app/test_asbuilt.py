@@ -1,0 +1,197 @@
+"""The result back in CAD and verified, in FreeCADCmd: a run keeps result.step and the
+verification's files in the study; api.result_solid makes a Part solid from the STEP (one undo
+step), api.export_step writes it, both refuse cleanly (naming the setting) when the run wrote
+no STEP; the verification becomes a FEM mesh, a FEM result and a fields pipeline whose largest
+von Mises stress is verification.json's; a re-run without the files removes what they made."""
+import json
+import os
+import tempfile
+import unittest
+
+import FreeCAD
+import Part
+from helpers import box_study
+
+from topopt.app import api, asbuilt, vtu
+from topopt.app.errors import TopOptError
+
+
+class ResultAsBuilt(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.doc, cls.study = box_study("AsBuilt", iterations=10, mesh_size=3.0)
+        cls.doc.UndoMode = 1
+        cls.study.WriteStep = True
+        cls.study.Verify = True
+        api.run(cls.study, verbose=False)
+        cls.folder = tempfile.mkdtemp(prefix="topopt-asbuilt-test-")
+
+    @classmethod
+    def tearDownClass(cls):
+        FreeCAD.closeDocument(cls.doc.Name)
+
+    def test_the_job_asks_for_the_files(self):
+        self.assertEqual(api.job_of(self.study)["output"], {"step": True, "verification": True})
+
+    def test_result_solid_is_one_valid_closed_solid_of_the_result_mesh_volume(self):
+        feature = api.result_solid(self.study)
+        self.assertEqual(feature.TypeId, "Part::Feature")
+        self.assertIs(self.study.ResultSolid, feature)
+        shape = feature.Shape
+        self.assertEqual(len(shape.Solids), 1)
+        self.assertTrue(shape.isValid())
+        self.assertTrue(all(s.isClosed() for s in shape.Solids[0].Shells))
+        mesh_volume = self.study.Result.Mesh.Volume
+        self.assertGreater(mesh_volume, 0)
+        self.assertLess(abs(shape.Volume - mesh_volume) / mesh_volume, 0.005)
+        from topopt.app.study import owned_objects
+        self.assertIn(feature, owned_objects(self.study))
+
+    def test_result_solid_is_one_undo_step(self):
+        before = len(self.doc.Objects)
+        had = self.study.ResultSolid is not None
+        api.result_solid(self.study)
+        self.assertEqual(self.doc.UndoNames[0], "TopOpt result as solid")
+        if not had:
+            self.assertEqual(len(self.doc.Objects), before + 1)
+            self.doc.undo()
+            self.assertIsNone(self.study.ResultSolid)
+            self.assertEqual(len(self.doc.Objects), before)
+            self.doc.redo()
+            self.assertIsNotNone(self.study.ResultSolid)
+
+    def test_export_step_writes_the_solid(self):
+        path = api.export_step(self.study, os.path.join(self.folder, "beam.step"))
+        shape = Part.read(path)
+        self.assertEqual(len(shape.Solids), 1)
+        self.assertLess(abs(shape.Volume - self.study.Result.Mesh.Volume) / shape.Volume, 0.005)
+
+    def test_export_step_refuses_a_missing_folder(self):
+        with self.assertRaises(TopOptError) as e:
+            api.export_step(self.study, os.path.join(self.folder, "no", "such", "beam.step"))
+        self.assertIn("does not exist", str(e.exception))
+
+    def test_verification_of_the_run_is_in_fem_or_its_failure_is_named(self):
+        report = json.loads(self.study.VerificationReport)
+        if "verification" in report.get("failed", {}):  # the core could not verify this result
+            self.assertIsNone(self.study.VerificationResult)
+            self.assertEqual(self.study.ComplianceAsBuilt, 0.0)
+            message = report["failed"]["verification"]["message"]
+            self.assertTrue(any(message in line for line in asbuilt.summary_lines(self.study)))
+        else:
+            check_verification_objects(self, self.study, report)
+
+    def test_vtu_reader_reads_what_the_writer_wrote(self):
+        nodes = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]
+        tets = [[0, 1, 2, 3], [1, 2, 3, 4]]
+        path = vtu.write_tets(os.path.join(self.folder, "t.vtu"), nodes, tets,
+                              [("u", [[i, 2 * i, 3 * i] for i in range(5)])], [("s", [1.5, 2.5])])
+        n, t, points, cells = vtu.read_tets(path)
+        self.assertEqual(t.tolist(), tets)
+        self.assertEqual(n.tolist(), nodes)
+        self.assertEqual(points["u"][4].tolist(), [4, 8, 12])
+        self.assertEqual(cells["s"].tolist(), [1.5, 2.5])
+        self.assertEqual(asbuilt.nodal_maximum(t, cells["s"], 5).tolist(), [1.5, 2.5, 2.5, 2.5, 2.5])
+
+    def test_zz_rerun_without_the_files_removes_what_they_made_and_refuses(self):
+        api.result_solid(self.study)
+        self.study.WriteStep = False
+        self.study.Verify = False
+        api.run(self.study, verbose=False)
+        for name in ("ResultSolid", "VerificationMesh", "VerificationResult", "VerificationFields"):
+            self.assertIsNone(getattr(self.study, name), name)
+        self.assertEqual(self.study.ComplianceAsBuilt, 0.0)
+        for call in (lambda: api.result_solid(self.study),
+                     lambda: api.export_step(self.study, os.path.join(self.folder, "x.step"))):
+            with self.assertRaises(TopOptError) as e:
+                call()
+            self.assertIn("WriteStep", str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(self.folder, "x.step")))
+
+
+def check_verification_objects(test, study, report):
+    """The study's verification FEM objects match verification.json's figures."""
+    res, mesh, pipe = study.VerificationResult, study.VerificationMesh, study.VerificationFields
+    test.assertEqual(res.TypeId, "Fem::FemResultObjectPython")
+    test.assertEqual(mesh.TypeId, "Fem::FemMeshObjectPython")
+    test.assertEqual(pipe.TypeId, "Fem::FemPostPipeline")
+    test.assertIs(res.Mesh, mesh)
+    test.assertEqual(mesh.FemMesh.VolumeCount, report["tets"])
+    test.assertEqual(len(res.vonMises), mesh.FemMesh.NodeCount)
+    test.assertAlmostEqual(max(res.vonMises), report["max_von_mises"], delta=1e-6 * report["max_von_mises"])
+    test.assertAlmostEqual(max(res.DisplacementLengths), report["max_displacement"],
+                           delta=1e-6 * report["max_displacement"])
+    test.assertEqual(study.ComplianceAsBuilt, report["compliance_as_built"])
+    test.assertEqual(study.ComplianceCrisp, report["crisp"]["compliance"])
+    from topopt.app.study import owned_objects
+    for obj in (res, mesh, pipe):
+        test.assertIn(obj, owned_objects(study))
+
+
+def core_verification_files(folder):
+    """verification.vtu and verification.json as the core writes them (src/io/vtu.cpp,
+    src/pipeline/result_files.cpp) for two tets under one load case named "tip": the VTU
+    with Int32 cell domain, displacement_tip per point, von_mises_tip per tet. Returns
+    ({name: bytes}, report dict)."""
+    nodes = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10], [10, 10, 10]]
+    tets = [[0, 1, 2, 3], [1, 2, 3, 4]]
+    u = [[0, 0, 0], [0, 0, -0.25], [0, 0, -0.1], [0, 0, 0], [0.02, 0, -0.5]]
+    vm = [40.5, 120.25]
+    text = ['<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">\n'
+            '  <UnstructuredGrid>\n    <Piece NumberOfPoints="5" NumberOfCells="2">\n      <Points>\n'
+            '        <DataArray type="Float64" NumberOfComponents="3" format="ascii">\n']
+    text += [" %g %g %g\n" % tuple(p) for p in nodes]
+    text.append('        </DataArray>\n      </Points>\n      <Cells>\n'
+                '        <DataArray type="Int64" Name="connectivity" format="ascii">\n')
+    text += [" %d %d %d %d\n" % tuple(t) for t in tets]
+    text.append('        </DataArray>\n        <DataArray type="Int64" Name="offsets" format="ascii">\n 4 8\n'
+                '        </DataArray>\n        <DataArray type="UInt8" Name="types" format="ascii">\n 10 10\n'
+                '        </DataArray>\n      </Cells>\n      <PointData>\n'
+                '        <DataArray type="Float64" Name="displacement_tip" NumberOfComponents="3" format="ascii">\n')
+    text += [" %g %g %g\n" % tuple(d) for d in u]
+    text.append('        </DataArray>\n      </PointData>\n      <CellData>\n'
+                '        <DataArray type="Int32" Name="domain" format="ascii">\n 0 0\n        </DataArray>\n'
+                '        <DataArray type="Float64" Name="von_mises_tip" NumberOfComponents="1" format="ascii">\n'
+                ' 40.5\n 120.25\n        </DataArray>\n      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n'
+                '</VTKFile>\n')
+    max_u = max(sum(c * c for c in d) ** 0.5 for d in u)
+    report = {"compliance_as_built": 12.5, "max_displacement": max_u, "max_von_mises": max(vm), "tets": 2,
+              "crisp": {"compliance": 11.75}, "ratio": 12.5 / 11.75, "failed": {}}
+    return {asbuilt.VTU: "".join(text).encode(), asbuilt.REPORT: json.dumps(report).encode()}, report
+
+
+class VerificationInFem(unittest.TestCase):
+    def test_the_cores_verification_files_become_fem_objects_and_go_again(self):
+        doc, study = box_study("AsBuiltFem")
+        try:
+            files, report = core_verification_files(tempfile.mkdtemp(prefix="topopt-asbuilt-"))
+            asbuilt.store_files(study, files)
+            asbuilt.update_verification(study)
+            check_verification_objects(self, study, report)
+            self.assertEqual(max(study.VerificationResult.vonMises), 120.25)
+            self.assertTrue(any("as-built compliance 12.5 N·mm vs crisp 11.75" in line
+                                for line in asbuilt.summary_lines(study)))
+            asbuilt.store_files(study, {})  # a run without verification: nothing stale stays
+            asbuilt.update_verification(study)
+            self.assertIsNone(study.VerificationResult)
+            self.assertFalse([o for o in doc.Objects if o.Name.startswith(study.Name + "_Verification")])
+        finally:
+            FreeCAD.closeDocument(doc.Name)
+
+
+class NoResult(unittest.TestCase):
+    def test_a_study_without_a_run_is_refused(self):
+        doc, study = box_study("AsBuiltNoRun")
+        try:
+            for call in (lambda: api.result_solid(study),
+                         lambda: api.export_step(study, os.path.join(tempfile.gettempdir(), "none.step"))):
+                with self.assertRaises(TopOptError) as e:
+                    call()
+                self.assertIn("run it first", str(e.exception))
+            self.assertIsNone(study.ResultSolid)
+        finally:
+            FreeCAD.closeDocument(doc.Name)
+
+
+if __name__ == "__main__":
+    unittest.main()
