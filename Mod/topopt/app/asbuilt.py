@@ -6,7 +6,8 @@
 - ResultSolid: a Part::Feature holding the solid read from result.step ("Result as solid");
 - VerificationMesh / VerificationResult: the result solid's own tet mesh as a FEM mesh and
   the verification's displacement and von Mises stress as a FEM mechanical result;
-- VerificationFields: a FEM post-processing pipeline of the same fields (colour bar, clip).
+- VerificationFields: a FEM post-processing pipeline of the same fields, both per node
+  (colour bar, clip; FreeCAD 0.20 crashes when a pipeline is coloured by a cell field).
 
 A re-run refreshes these objects in place and removes those its files no longer support, so
 nothing stale is left. Works headless (no view settings then) and with the GUI.
@@ -212,11 +213,20 @@ def _verification_objects(study, nodes, tets, u, vm_nodes, path):
     res.vonMises = [float(x) for x in vm_nodes]
     from femresult import resulttools
     resulttools.fill_femresult_stats(res)
-    pipe = _link(study, "VerificationFields", "Fem::FemPostPipeline",
-                 lambda: doc.addObject("Fem::FemPostPipeline", name + "_VerificationFields"),
+    pipe = _link(study, "VerificationFields", "Fem::FemPostPipeline", lambda: _make_pipeline(doc, name),
                  "%s verification fields" % study.Label)
     pipe.read(path)
+    pipe.recomputeChildren()
     return res
+
+
+def _make_pipeline(doc, name):
+    """A FEM post pipeline shown as a surface: set before it holds data, as FEM's own solvers
+    do (FreeCAD 0.20's pipeline view crashes when its display mode changes on some data)."""
+    pipe = doc.addObject("Fem::FemPostPipeline", name + "_VerificationFields")
+    if pipe.ViewObject is not None:
+        pipe.ViewObject.DisplayMode = "Surface"
+    return pipe
 
 
 def update_verification(study):
@@ -231,11 +241,13 @@ def update_verification(study):
     nodes, tets, points, cells = vtu.read_tets(path)
     u = np.asarray(_first(points, "displacement", "displacement"), dtype=np.float64).reshape(-1, 3)
     vm = np.asarray(_first(cells, "von_mises", "von Mises stress"), dtype=np.float64).reshape(-1)
+    vm_nodes = nodal_maximum(tets, vm, len(nodes))
     folder = tempfile.mkdtemp(prefix="topopt-verification-")
     try:
+        # point data only: FreeCAD 0.20's pipeline view crashes when a cell field is chosen
         fields = vtu.write_tets(os.path.join(folder, "verification.vtu"), nodes, tets,
-                                [(DISPLACEMENT, u)], [(VON_MISES, vm)])
-        res = _verification_objects(study, nodes, tets, u, nodal_maximum(tets, vm, len(nodes)), fields)
+                                [(DISPLACEMENT, u), (VON_MISES, vm_nodes)])
+        res = _verification_objects(study, nodes, tets, u, vm_nodes, fields)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     _style_verification(study)
@@ -243,8 +255,8 @@ def update_verification(study):
 
 
 def _style_verification(study):
-    """With the GUI: the verification's mesh and result hidden, its fields shown as a surface
-    coloured by von Mises stress (FEM's colour bar) when the user turns them on."""
+    """With the GUI: the verification's mesh, result and fields hidden (the user turns the
+    fields on to see them as a coloured surface with FEM's colour bar)."""
     for name in ("VerificationMesh", "VerificationResult", "VerificationFields"):
         obj = getattr(study, name)
         if obj is not None and obj.ViewObject is not None:
@@ -252,10 +264,7 @@ def _style_verification(study):
     pipe = study.VerificationFields
     if pipe is not None and pipe.ViewObject is not None:
         quiet.recompute(study.Document)
-        vo = pipe.ViewObject
-        vo.DisplayMode = "Surface"
-        if VON_MISES in vo.getEnumerationsOfProperty("Field"):
-            vo.Field = VON_MISES
+        pipe.ViewObject.updateColorBars()
 
 
 def summary_lines(study):

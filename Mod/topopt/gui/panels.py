@@ -136,6 +136,11 @@ class StudyPanel:
         self.summary.setWordWrap(True)
         layout.addWidget(self.summary)
         layout.addWidget(self._settings_box())
+        from topopt.gui.controls_panel import ControlsBox, ResponsesBox
+        self.controls = ControlsBox(self.study)
+        self.responses = ResponsesBox(self.study)
+        layout.addWidget(self.controls.box)
+        layout.addWidget(self.responses.box)
         layout.addWidget(self._run_box())
         layout.addWidget(self._result_box())
         layout.addStretch(1)
@@ -213,6 +218,7 @@ class StudyPanel:
     def _commit(self):
         if self.doc.HasPendingTransaction:
             self.doc.commitTransaction()
+        _close_application_transaction(False)
 
     def _write(self, binding):
         self._begin_edit()
@@ -232,6 +238,10 @@ class StudyPanel:
         for b in self.bindings:
             if b.prop == prop:
                 b.show(self.study)
+        if prop == "GeometryControls":
+            self.controls.show()
+        if prop == "Responses":
+            self.responses.show()
         if prop in ("Constraints", "Part", "NonDesign"):
             self.summary.setText(self._summary_text())
         if prop in ("Densities", "Threshold", "MeshTets"):
@@ -248,8 +258,25 @@ class StudyPanel:
         for b in self.bindings:
             b.widget.setEnabled(not running)
 
+    def apply_controls(self):
+        """Writes the design controls and the objective and limits to the study (checked as a
+        job file is). Returns False, after saying what is wrong, when a value is refused."""
+        self._begin_edit()
+        self.writing = True
+        try:
+            self.controls.apply()
+            self.responses.apply()
+        except TopOptError as e:
+            report_error(e)
+            return False
+        finally:
+            self.writing = False
+        return True
+
     def start_run(self):
         if self.thread is not None:
+            return
+        if not self.apply_controls():
             return
         self._commit()  # the settings the run uses are one undo step
         try:
@@ -411,8 +438,11 @@ class StudyPanel:
             vp.panel = None
 
     def accept(self):
-        """OK: keeps the edits (one undo step). A run still going is stopped first."""
+        """OK: keeps the edits (one undo step). A run still going is stopped first. A design
+        control or limit the study refuses keeps the panel open, saying what to fix."""
         self._stop_run()
+        if not self.apply_controls():
+            return False
         self._commit()
         self._close()
         return True
@@ -423,6 +453,7 @@ class StudyPanel:
         self._stop_run()
         if self.doc.HasPendingTransaction:
             self.doc.abortTransaction()
+        _close_application_transaction(True)
         self._close()
         return True
 
@@ -430,6 +461,15 @@ class StudyPanel:
         if self.thread is not None:
             self.request_cancel()
             self.wait(30)
+
+
+def _close_application_transaction(abort):
+    """Ends the application's active transaction that doc.openTransaction started. FreeCAD
+    keeps it open when nothing changed (the document then has no pending transaction), and a
+    document made afterwards would put its new objects into it: Cancel would delete them."""
+    name = FreeCAD.getActiveTransaction() if hasattr(FreeCAD, "getActiveTransaction") else None
+    if name and name[0] == EDIT:
+        FreeCAD.closeActiveTransaction(abort)
 
 
 def open_study_panel(study):

@@ -31,6 +31,25 @@ def box_study(name="Box", iterations=6, mesh_size=4.0):
     return doc, study
 
 
+def top_loaded_box_study(name):
+    """A 60 x 10 x 10 mm box fixed at x = 0 (Face1) and pressed down on its top (Face6, 100 N):
+    both faces stay on the result, as the verification needs (a tip load on the end face
+    Face2 does not: the design leaves that face). Returns (doc, study)."""
+    import FreeCAD
+    import Part
+    from topopt.app import api
+    doc = FreeCAD.newDocument(name)
+    part = doc.addObject("Part::Feature", "Beam")
+    part.Shape = Part.makeBox(60, 10, 10)
+    doc.recompute()
+    study = api.new_study(doc, part, (), volume_fraction=0.4, mesh_size=3.0)
+    study.MaxIterations = 10
+    api.add_fixed(study, "Face1")
+    api.add_force(study, "Face6", (0, 0, -100))
+    doc.recompute()
+    return doc, study
+
+
 def _describe(value):
     """A comparable stand-in for a property value (objects by name, shapes and meshes by
     their counts and volume)."""

@@ -1,0 +1,278 @@
+"""The study panel's design controls and responses: symmetry planes (from a picked planar
+face or datum plane), cyclic repetition (axis from a picked cylindrical face or edge), a
+linear pattern, an extrusion direction (typed or picked), the objective and its limits
+(compliance, stress, displacement on picked faces along a direction). The widgets show the
+study's GeometryControls and Responses; apply() writes them through api.set_controls and
+api.set_responses, which check every value as a job file is checked (a bad value raises a
+TopOptError naming it, and the study is left as it was)."""
+import FreeCADGui
+from PySide import QtGui
+
+from topopt.app import api, picking
+from topopt.app import job as jobmod
+from topopt.app.errors import TopOptError
+
+
+def selection():
+    """[(obj, sub)] of FreeCAD's selection: each picked sub-element, or the object itself
+    (a datum plane or line picked in the tree)."""
+    out = []
+    for s in FreeCADGui.Selection.getSelectionEx():
+        subs = [n for n in s.SubElementNames if n] or [""]
+        out += [(s.Object, n) for n in subs]
+    return out
+
+
+def _picked(what):
+    picked = selection()
+    if not picked:
+        raise TopOptError("nothing is selected: pick %s in the 3D view first" % what, "InvalidParameter")
+    return picked
+
+
+def _number(low, high, decimals, suffix="", special=""):
+    w = QtGui.QDoubleSpinBox()
+    w.setRange(low, high)
+    w.setDecimals(decimals)
+    w.setSuffix(suffix)
+    w.setSpecialValueText(special)
+    w.setMinimumWidth(60)
+    return w
+
+
+class VectorEdit(QtGui.QWidget):
+    """Three number fields (x, y, z)."""
+
+    def __init__(self, value=(0.0, 0.0, 1.0)):
+        super().__init__()
+        layout = QtGui.QHBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        self.fields = [_number(-1e9, 1e9, 4) for _ in range(3)]
+        for f, axis in zip(self.fields, "xyz"):
+            f.setPrefix(axis + " ")
+            layout.addWidget(f)
+        self.set(value)
+
+    def set(self, value):
+        for f, x in zip(self.fields, value):
+            f.setValue(float(x))
+
+    def value(self):
+        return [f.value() for f in self.fields]
+
+
+def _fmt(v):
+    return "(%s)" % ", ".join("%.4g" % x for x in v)
+
+
+class _ItemList:
+    """A list widget whose rows stand for items (dicts) kept beside it."""
+
+    def __init__(self, describe):
+        self.widget = QtGui.QListWidget()
+        self.widget.setMaximumHeight(70)
+        self.describe = describe
+        self.items = []
+
+    def set(self, items):
+        self.items = list(items)
+        self.widget.clear()
+        for item in self.items:
+            self.widget.addItem(self.describe(item))
+
+    def add(self, item):
+        self.set(self.items + [item])
+
+    def remove_selected(self):
+        rows = sorted({i.row() for i in self.widget.selectedIndexes()}, reverse=True)
+        items = list(self.items)
+        for r in rows:
+            del items[r]
+        self.set(items)
+
+
+def _buttons(*pairs):
+    row = QtGui.QHBoxLayout()
+    out = []
+    for text, tip in pairs:
+        b = QtGui.QPushButton(text)
+        b.setToolTip(tip)
+        row.addWidget(b)
+        out.append(b)
+    return row, out
+
+
+class ControlsBox:
+    """The "Design controls" group: symmetry planes, cyclic repetition, a pattern, extrusion."""
+
+    def __init__(self, study):
+        self.study = study
+        self.box = QtGui.QGroupBox("Design controls")
+        layout = QtGui.QFormLayout(self.box)
+        layout.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
+        self.planes = _ItemList(lambda p: "point %s normal %s" % (_fmt(p["point"]), _fmt(p["normal"])))
+        layout.addRow("Symmetry planes", self.planes.widget)
+        row, (add, rem) = _buttons(("Add picked plane", "Add the plane of the selected planar face or datum plane"),
+                                   ("Remove", "Remove the selected symmetry plane"))
+        add.clicked.connect(self._guard(self.add_plane))
+        self.add_plane_button = add
+        rem.clicked.connect(self.planes.remove_selected)
+        layout.addRow(row)
+        self.cyclic = _ItemList(lambda c: "%d sectors about %s through %s" % (c["sectors"], _fmt(c["axis"]),
+                                                                              _fmt(c["point"])))
+        layout.addRow("Cyclic", self.cyclic.widget)
+        self.sectors = QtGui.QSpinBox()
+        self.sectors.setRange(2, 360)
+        self.sectors.setValue(4)
+        layout.addRow("Sectors", self.sectors)
+        row, (add, rem) = _buttons(("Add picked axis", "Repeat the design about the axis of the selected cylindrical "
+                                    "face or edge, in the sectors above"), ("Remove", "Remove the selected cyclic "
+                                                                            "repetition"))
+        add.clicked.connect(self._guard(self.add_cyclic))
+        self.add_cyclic_button = add
+        rem.clicked.connect(self.cyclic.remove_selected)
+        layout.addRow(row)
+        self._pattern_rows(layout)
+        self._extrusion_rows(layout)
+        self.show()
+
+    def _pattern_rows(self, layout):
+        self.pattern_on = QtGui.QCheckBox("Linear pattern")
+        self.pattern_dir = VectorEdit((1, 0, 0))
+        self.pattern_pitch = _number(0, 1e6, 3, " mm")
+        self.pattern_count = QtGui.QSpinBox()
+        self.pattern_count.setRange(2, 10000)
+        layout.addRow(self.pattern_on)
+        layout.addRow("Pattern direction", self.pattern_dir)
+        layout.addRow("Pitch", self.pattern_pitch)
+        layout.addRow("Copies", self.pattern_count)
+
+    def _extrusion_rows(self, layout):
+        self.extrusion_on = QtGui.QCheckBox("Extrusion (constant cross-section)")
+        self.extrusion_dir = VectorEdit((0, 0, 1))
+        pick = QtGui.QPushButton("Picked direction")
+        pick.setToolTip("The normal of the selected planar face or the direction of the selected straight edge")
+        pick.clicked.connect(self._guard(self.pick_extrusion))
+        layout.addRow(self.extrusion_on)
+        layout.addRow("Extrusion direction", self.extrusion_dir)
+        layout.addRow(pick)
+
+    @staticmethod
+    def _guard(f):
+        def run(*args):
+            try:
+                f()
+            except TopOptError as e:
+                from topopt.gui.panels import report_error
+                report_error(e)
+        return run
+
+    def add_plane(self):
+        for obj, sub in _picked("a planar face or a datum plane"):
+            point, normal = picking.plane_of(obj, sub)
+            self.planes.add({"point": point, "normal": normal})
+
+    def add_cyclic(self):
+        for obj, sub in _picked("a cylindrical face or an edge"):
+            point, axis = picking.axis_of(obj, sub)
+            self.cyclic.add({"point": point, "axis": axis, "sectors": self.sectors.value()})
+
+    def pick_extrusion(self):
+        obj, sub = _picked("a planar face or a straight edge")[0]
+        self.extrusion_dir.set(picking.direction_of(obj, sub))
+        self.extrusion_on.setChecked(True)
+
+    def show(self):
+        """Shows the study's GeometryControls."""
+        c = jobmod.study_controls(self.study)
+        self.planes.set(c.get("symmetry_planes", []))
+        self.cyclic.set(c.get("cyclic", []))
+        patterns = c.get("patterns", [])
+        self.pattern_on.setChecked(bool(patterns))
+        if patterns:
+            self.pattern_dir.set(patterns[0]["direction"])
+            self.pattern_pitch.setValue(float(patterns[0]["pitch"]))
+            self.pattern_count.setValue(int(patterns[0]["count"]))
+        self.extrusion_on.setChecked("extrusion" in c)
+        if "extrusion" in c:
+            self.extrusion_dir.set(c["extrusion"])
+        self.tolerance = float(c.get("tolerance", 0.0))
+
+    def apply(self):
+        """Writes the controls to the study (api.set_controls: checked; raises TopOptError)."""
+        patterns = [(self.pattern_dir.value(), self.pattern_pitch.value(), self.pattern_count.value())] \
+            if self.pattern_on.isChecked() else []
+        return api.set_controls(
+            self.study, symmetry_planes=[(p["point"], p["normal"]) for p in self.planes.items],
+            cyclic=[(c["point"], c["axis"], c["sectors"]) for c in self.cyclic.items], patterns=patterns,
+            extrusion=self.extrusion_dir.value() if self.extrusion_on.isChecked() else None,
+            tolerance=self.tolerance)
+
+
+OBJECTIVES = [("compliance", "Stiffest design of the volume fraction"),
+              ("mass", "Lightest design within the limits below"),
+              ("frequency", "Highest first eigenfrequency of the volume fraction")]
+
+
+class ResponsesBox:
+    """The "Objective and limits" group: objective, compliance limit, stress limit, and
+    displacement limits on picked faces along a direction."""
+
+    def __init__(self, study):
+        self.study = study
+        self.box = QtGui.QGroupBox("Objective and limits")
+        layout = QtGui.QFormLayout(self.box)
+        layout.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
+        self.objective = QtGui.QComboBox()
+        for name, tip in OBJECTIVES:
+            self.objective.addItem(name)
+            self.objective.setItemData(self.objective.count() - 1, tip, 3)  # Qt.ToolTipRole
+        layout.addRow("Objective", self.objective)
+        self.compliance_limit = _number(0, 1e15, 3, " N·mm", "none")
+        self.compliance_limit.setToolTip("With the mass objective: the largest compliance allowed")
+        layout.addRow("Compliance limit", self.compliance_limit)
+        self.stress_limit = _number(0, 1e9, 2, " MPa", "none")
+        self.stress_limit.setToolTip("The largest von Mises stress allowed (e.g. yield stress / safety factor)")
+        layout.addRow("Stress limit", self.stress_limit)
+        self.limits = _ItemList(lambda d: "%s along %s ≤ %.4g mm" % (", ".join(d["label"]), _fmt(d["direction"]),
+                                                                      d["limit"]))
+        layout.addRow("Displacement limits", self.limits.widget)
+        self.limit_dir = VectorEdit((0, 0, -1))
+        layout.addRow("Direction", self.limit_dir)
+        self.limit_value = _number(0, 1e6, 4, " mm")
+        layout.addRow("Largest displacement", self.limit_value)
+        row, (add, rem) = _buttons(("Limit picked faces", "Limit the mean displacement of the selected faces along "
+                                    "the direction above to the value above"), ("Remove", "Remove the selected limit"))
+        add.clicked.connect(ControlsBox._guard(self.add_limit))
+        rem.clicked.connect(self.limits.remove_selected)
+        layout.addRow(row)
+        self.show()
+
+    def add_limit(self):
+        picked = _picked("the faces whose displacement to limit")
+        refs = {}
+        for obj, sub in picked:
+            refs.setdefault(obj, []).append(sub)
+        references = [(obj, tuple(subs)) for obj, subs in refs.items()]
+        faces = jobmod.face_names(self.study, references, "the displacement limit")  # checks now: faces only
+        self.limits.add({"faces": faces, "references": references, "direction": self.limit_dir.value(),
+                         "limit": self.limit_value.value(), "label": faces})
+
+    def show(self):
+        """Shows the study's Responses."""
+        r = jobmod.study_responses(self.study)
+        self.objective.setCurrentText(str(r.get("objective", "compliance")))
+        self.compliance_limit.setValue(float(r.get("compliance_limit", 0.0)))
+        self.stress_limit.setValue(float(r.get("stress_limit", 0.0)))
+        self.limits.set([dict(d, label=d["faces"]) for d in r.get("displacement_limits", [])])
+
+    def _limit_args(self):
+        """(faces, direction, limit) per limit: picked references, or the job's face names of
+        limits read from the study."""
+        return [(d.get("references") or d["faces"], d["direction"], d["limit"]) for d in self.limits.items]
+
+    def apply(self):
+        """Writes the responses to the study (api.set_responses: checked; raises TopOptError)."""
+        return api.set_responses(self.study, objective=self.objective.currentText(),
+                                 compliance_limit=self.compliance_limit.value() or None,
+                                 stress_limit=self.stress_limit.value() or None, displacement_limits=self._limit_args())

@@ -1,0 +1,208 @@
+"""The study panel's design controls and objective/limits, and the result as CAD, in a real
+FreeCAD window (under Xvfb): values set in the panel (planes and axes picked from faces and
+edges) reach the study and its job on OK; a refused value keeps the panel open and the study
+unchanged; "Result as solid" and "Export result as STEP" work from the toolbar's commands;
+the verification's von Mises shows in FEM's post-processing. Screenshots go to
+TOPOPT_SCREENSHOTS (default /tmp/topopt-screenshots) for a person to look at."""
+import json
+import os
+import tempfile
+import unittest
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtGui
+
+from app.helpers import box_study, top_loaded_box_study
+from topopt.app import api
+from topopt.gui import panels
+
+SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
+
+
+def settle(n=20):
+    for _ in range(n):
+        QtGui.QApplication.processEvents()
+
+
+def screenshot(name, fit=True):
+    """The main window (widgets) and the 3D view rendered offscreen. Returns both paths."""
+    os.makedirs(SHOTS, exist_ok=True)
+    mw = FreeCADGui.getMainWindow()
+    mw.resize(1280, 960)
+    if fit:
+        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
+        FreeCADGui.ActiveDocument.ActiveView.fitAll()
+    settle()
+    window = os.path.join(SHOTS, name)
+    mw.grab().save(window)
+    view = os.path.join(SHOTS, name.replace(".png", "_3d.png"))
+    FreeCADGui.ActiveDocument.ActiveView.saveImage(view, 1000, 750, "White")
+    return window, view
+
+
+def select(obj, *subs):
+    FreeCADGui.Selection.clearSelection()
+    for sub in subs:
+        FreeCADGui.Selection.addSelection(obj, sub)
+
+
+class Panel(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        FreeCAD.ConfigSet("TopOptNoDialogs", "1")  # errors go to the report view only
+        FreeCADGui.getMainWindow().show()
+        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        settle()
+
+    def setUp(self):
+        self.doc, self.study = box_study("PanelControls")
+        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
+        self.panel = panels.open_study_panel(self.study)
+        settle()
+
+    def tearDown(self):
+        if self.panel.is_open():
+            self.panel.reject()
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def test_values_set_in_the_panel_reach_the_study_and_its_job(self):
+        p, part = self.panel, self.study.Part
+        select(part, "Face3")  # y = 0: the plane y = 0, normal -y
+        p.controls.add_plane()
+        select(part, "Edge1")  # a straight edge along z at x = y = 0
+        p.controls.sectors.setValue(2)
+        p.controls.add_cyclic()
+        p.controls.pattern_on.setChecked(True)
+        p.controls.pattern_dir.set((1, 0, 0))
+        p.controls.pattern_pitch.setValue(20.0)
+        p.controls.pattern_count.setValue(3)
+        select(part, "Face6")  # z = 10: extrusion along +z
+        p.controls.pick_extrusion()
+        p.responses.objective.setCurrentText("mass")
+        p.responses.stress_limit.setValue(250.0)
+        p.responses.limit_dir.set((0, 0, -1))
+        p.responses.limit_value.setValue(0.5)
+        select(part, "Face2")
+        p.responses.add_limit()
+        settle()
+        screenshot("panel_controls.png", fit=False)
+        self.assertTrue(p.accept())
+        self.assertFalse(p.is_open())
+        c = json.loads(self.study.GeometryControls)
+        plane = c["symmetry_planes"][0]
+        self.assertEqual(len(c["symmetry_planes"]), 1)
+        self.assertVector(plane["point"], [30, 0, 5])
+        self.assertVector(plane["normal"], [0, -1, 0])
+        self.assertEqual(c["cyclic"][0]["sectors"], 2)
+        self.assertVector([abs(x) for x in c["cyclic"][0]["axis"]], [0, 0, 10])
+        self.assertEqual(c["patterns"], [{"direction": [1.0, 0.0, 0.0], "pitch": 20.0, "count": 3}])
+        self.assertEqual(c["extrusion"], [0.0, 0.0, 1.0])
+        opt = api.job_of(self.study)["optimization"]
+        self.assertEqual(opt["controls"], c)
+        self.assertEqual(opt["objective"], "mass")
+        self.assertEqual(opt["stress_limit"], 250.0)
+        self.assertEqual(opt["update"], "mma")
+        self.assertEqual(opt["displacement_limits"], [{"faces": ["Face2"], "direction": [0.0, 0.0, -1.0],
+                                                       "limit": 0.5}])
+        reopened = panels.open_study_panel(self.study)  # the panel shows what the study holds
+        self.assertEqual(len(reopened.controls.planes.items), 1)
+        self.assertEqual(reopened.responses.objective.currentText(), "mass")
+        self.assertEqual(len(reopened.responses.limits.items), 1)
+        self.assertTrue(reopened.accept())  # unchanged values are written back unchanged
+        self.assertEqual(json.loads(self.study.GeometryControls), c)
+        self.panel = reopened
+
+    def assertVector(self, got, expected):
+        for g, e in zip(got, expected):
+            self.assertAlmostEqual(g, e, places=9)
+        self.assertEqual(len(got), len(expected))
+
+    def test_a_refused_value_keeps_the_panel_open_and_the_study_unchanged(self):
+        self.panel.responses.objective.setCurrentText("mass")  # no limit: the job parser refuses
+        self.assertFalse(self.panel.accept())
+        self.assertTrue(self.panel.is_open())
+        self.assertEqual(self.study.Responses, "")
+        self.assertEqual(self.study.Update, "oc")
+
+    def test_picking_the_wrong_kind_of_element_is_said_not_added(self):
+        select(self.study.Part, "Edge1")
+        self.panel.controls.add_plane_button.click()  # an edge is no plane: reported, nothing added
+        select(self.study.Part, "Face1")
+        self.panel.controls.add_cyclic_button.click()  # a planar face has no axis
+        self.assertEqual(self.panel.controls.planes.items, [])
+        self.assertEqual(self.panel.controls.cyclic.items, [])
+
+
+class ResultAsCad(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        FreeCAD.ConfigSet("TopOptNoDialogs", "1")
+        FreeCADGui.getMainWindow().show()
+        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        cls.doc, cls.study = top_loaded_box_study("ResultAsCad")
+        api.run(cls.study, verbose=False)
+        settle()
+
+    @classmethod
+    def tearDownClass(cls):
+        FreeCAD.closeDocument(cls.doc.Name)
+
+    def test_result_as_solid_command(self):
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(self.study)
+        FreeCADGui.runCommand("TopOpt_ResultAsSolid")
+        settle()
+        solid = self.study.ResultSolid
+        self.assertIsNotNone(solid)
+        self.assertEqual(len(solid.Shape.Solids), 1)
+        self.assertTrue(solid.ViewObject.Visibility)
+        self.assertFalse(self.study.Result.ViewObject.Visibility)
+        self.assertEqual(self.doc.UndoNames[0] if self.doc.UndoMode else "TopOpt result as solid",
+                         "TopOpt result as solid")
+        screenshot("result_solid.png")
+
+    def test_verification_von_mises_in_fem_post_processing(self):
+        from topopt.app import asbuilt
+        pipe, res = self.study.VerificationFields, self.study.VerificationResult
+        self.assertIsNotNone(pipe)
+        report = json.loads(self.study.VerificationReport)
+        self.assertAlmostEqual(max(res.vonMises), report["max_von_mises"], delta=1e-6 * report["max_von_mises"])
+        for obj in self.doc.Objects:
+            if obj.ViewObject is not None:
+                obj.ViewObject.Visibility = False
+        vo = pipe.ViewObject
+        vo.Visibility = True
+        self.assertIn(asbuilt.VON_MISES, vo.getEnumerationsOfProperty("Field"))
+        self.assertEqual(vo.DisplayMode, "Surface")
+        vo.Field = asbuilt.VON_MISES  # as a user picks it in the property editor (a cell field crashed 0.20)
+        settle()
+        import ObjectsFem
+        clip = ObjectsFem.makePostVtkFilterClipScalar(self.doc, pipe)  # FEM's own clip works on it
+        self.doc.recompute()
+        clip.Scalars = asbuilt.VON_MISES
+        clip.Value = report["max_von_mises"] / 4
+        self.doc.recompute()
+        clip.ViewObject.Visibility = False
+        screenshot("verification_von_mises.png")
+        self.doc.removeObject(clip.Name)
+        vo.Visibility = False
+
+    def test_export_step_command_writes_the_file(self):
+        from topopt.gui import commands
+        path = os.path.join(tempfile.mkdtemp(prefix="topopt-gui-step-"), "result.step")
+        original = QtGui.QFileDialog.getSaveFileName
+        QtGui.QFileDialog.getSaveFileName = staticmethod(lambda *a, **k: (path, "STEP (*.step *.stp)"))
+        try:
+            FreeCADGui.Selection.clearSelection()
+            FreeCADGui.Selection.addSelection(self.study)
+            commands.ExportStep().Activated()
+        finally:
+            QtGui.QFileDialog.getSaveFileName = original
+        self.assertTrue(os.path.getsize(path) > 1000)
+        with open(path) as f:
+            self.assertIn("ISO-10303-21", f.readline())
+
+
+if __name__ == "__main__":
+    unittest.main()
