@@ -48,7 +48,8 @@ const char* kUsage =
     "  progress {\"stage\", \"fraction\", \"message\"}, iterations {\"iteration\", \"compliance\",\n"
     "  \"volume\", \"change\", \"seconds\"}, {\"warning\"}, and last {\"done\": true} or {\"error\":\n"
     "  {\"code\", \"message\", \"stage\"}}. Writes DIR/result.json (scalars, history, warnings, and\n"
-    "  \"arrays\": the names of the DIR/NAME.npy files written).\n"
+    "  \"arrays\": the names of the DIR/NAME.npy files written; optimize: \"files\", the result files\n"
+    "  written as the job's \"output\" asks: result.step, verification.json, verification.vtu).\n"
     "  TOPOPT_FAULT=STAGE[/WORD]:abort|segv|hang (tests only) makes the worker fail at that stage.";
 
 /// A request as the workbench writes it (see kUsage), with its paths made absolute.

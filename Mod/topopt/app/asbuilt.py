@@ -193,7 +193,7 @@ def _link(study, link, kind, make, label):
     return obj
 
 
-def _verification_objects(study, nodes, tets, u, vm_nodes, path):
+def _verification_objects(study, u, vm_nodes, path):
     import Fem
     import ObjectsFem
     doc, name = study.Document, study.Name
@@ -206,13 +206,8 @@ def _verification_objects(study, nodes, tets, u, vm_nodes, path):
     res = _link(study, "VerificationResult", "Fem::FemResultObjectPython",
                 lambda: ObjectsFem.makeResultMechanical(doc, name + "_VerificationResult"),
                 "%s verification (as built)" % study.Label)
-    res.Mesh = mesh_obj
-    res.NodeNumbers = list(range(1, len(nodes) + 1))
-    res.DisplacementVectors = [FreeCAD.Vector(*map(float, d)) for d in u]
-    res.DisplacementLengths = [float(x) for x in np.linalg.norm(u, axis=1)]
-    res.vonMises = [float(x) for x in vm_nodes]
-    from femresult import resulttools
-    resulttools.fill_femresult_stats(res)
+    from .results import fill_mechanical_result
+    fill_mechanical_result(res, mesh_obj, u, vm_nodes)
     pipe = _link(study, "VerificationFields", "Fem::FemPostPipeline", lambda: _make_pipeline(doc, name),
                  "%s verification fields" % study.Label)
     pipe.read(path)
@@ -247,7 +242,7 @@ def update_verification(study):
         # point data only: FreeCAD 0.20's pipeline view crashes when a cell field is chosen
         fields = vtu.write_tets(os.path.join(folder, "verification.vtu"), nodes, tets,
                                 [(DISPLACEMENT, u), (VON_MISES, vm_nodes)])
-        res = _verification_objects(study, nodes, tets, u, vm_nodes, fields)
+        res = _verification_objects(study, u, vm_nodes, fields)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     _style_verification(study)

@@ -193,8 +193,14 @@ def _fem_result(study, mesh_obj, nodes, displacement, von_mises_nodes):
     res = _object(doc, study, "FemResult", "Fem::FemResultObjectPython", "FemResult",
                   "%s last iterate" % study.Label,
                   lambda: ObjectsFem.makeResultMechanical(doc, study.Name + "_FemResult"))
+    return fill_mechanical_result(res, mesh_obj, displacement, von_mises_nodes)
+
+
+def fill_mechanical_result(res, mesh_obj, displacement, von_mises_nodes):
+    """Fills FEM's mechanical result `res` on `mesh_obj` (nodes numbered 1..#V in order):
+    displacement #V x 3 (mm), von_mises_nodes #V (MPa), and FEM's statistics. Returns res."""
     res.Mesh = mesh_obj
-    res.NodeNumbers = list(range(1, len(nodes) + 1))
+    res.NodeNumbers = list(range(1, len(displacement) + 1))
     res.DisplacementVectors = [FreeCAD.Vector(*map(float, u)) for u in displacement]
     res.DisplacementLengths = [float(x) for x in np.linalg.norm(displacement, axis=1)]
     res.vonMises = [float(x) for x in von_mises_nodes]

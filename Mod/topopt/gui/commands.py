@@ -205,63 +205,57 @@ class MeshStudy(_Command):
             ", ".join(o.Label for o in study.DomainMeshes)))
 
 
-class ExportStl(_Command):
-    menu, tip, icon = "Export result as STL", "Write the study's result shape to an STL file", "TopOptExportStl.svg"
+class _ResultCommand(_Command):
+    """A command on the study's result: active when the study has one."""
 
     def IsActive(self):
         s = active_study()
         return s is not None and s.Result is not None
 
+
+def _export(title, file_filter, write):
+    """Asks for a file name and writes it with write(study, path), reporting where it went."""
+    from PySide import QtGui
+    study = active_study()
+    path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), title, "", file_filter)
+    if path:
+        write(study, path)
+        FreeCAD.Console.PrintMessage("TopOpt: %s written to %s\n" % (title.lower().replace("export ", ""), path))
+
+
+class ExportStl(_ResultCommand):
+    menu, tip, icon = "Export result as STL", "Write the study's result shape to an STL file", "TopOptExportStl.svg"
+
     @_guarded
     def Activated(self):
-        from PySide import QtGui
-        path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), "Export result", "", "STL (*.stl)")
-        if path:
-            api.export_stl(active_study(), path)
-            FreeCAD.Console.PrintMessage("TopOpt: result written to %s\n" % path)
+        _export("Export result", "STL (*.stl)", api.export_stl)
 
 
-class ExportStep(_Command):
+class ExportStep(_ResultCommand):
     menu, icon = "Export result as STEP", "TopOptExportStep.svg"
     tip = "Write the study's result as one CAD solid to a STEP file (the result.step of its last run)"
 
-    def IsActive(self):
-        s = active_study()
-        return s is not None and s.Result is not None
-
     @_guarded
     def Activated(self):
-        study = active_study()
         from topopt.app import asbuilt
-        asbuilt.step_path(study)  # refuses before the file dialog when the run wrote no STEP
-        from PySide import QtGui
-        path, _ = QtGui.QFileDialog.getSaveFileName(FreeCADGui.getMainWindow(), "Export result as STEP", "",
-                                                    "STEP (*.step *.stp)")
-        if path:
-            api.export_step(study, path)
-            FreeCAD.Console.PrintMessage("TopOpt: result solid written to %s\n" % path)
+        asbuilt.step_path(active_study())  # refuses before the file dialog when the run wrote no STEP
+        _export("Export result solid", "STEP (*.step *.stp)", api.export_step)
 
 
-class ResultAsSolid(_Command):
+class ResultAsSolid(_ResultCommand):
     menu, icon = "Result as solid", "TopOptResultSolid.svg"
     tip = ("Add the study's result as a Part solid (read from the result.step of its last run) to use in "
            "further CAD work")
-
-    def IsActive(self):
-        s = active_study()
-        return s is not None and s.Result is not None
 
     @_guarded
     def Activated(self):
         study = active_study()
         feature = api.result_solid(study)
-        s = feature.Shape
         FreeCAD.Console.PrintMessage("TopOpt: %s: one solid, %d faces, %.6g mm³\n" % (
-            feature.Label, len(s.Faces), s.Volume))
-        if FreeCAD.GuiUp and feature.ViewObject is not None:
-            feature.ViewObject.Visibility = True
-            if study.Result is not None and study.Result.ViewObject is not None:
-                study.Result.ViewObject.Visibility = False
+            feature.Label, len(feature.Shape.Faces), feature.Shape.Volume))
+        feature.ViewObject.Visibility = True  # the solid in place of the result mesh
+        if study.Result is not None:
+            study.Result.ViewObject.Visibility = False
 
 
 class BuildCore(_Command):
@@ -318,5 +312,5 @@ def tell_if_core_missing():
         box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "TopOpt: native core missing", problem,
                                 QtGui.QMessageBox.Ok, mw)
         box.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)  # the command can be copied
-        box.exec_()
+        (getattr(box, "exec", None) or box.exec_)()  # exec_ is PySide2's; Qt 6's PySide (FreeCAD 1.x) has exec
     return True

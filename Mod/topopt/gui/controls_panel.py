@@ -6,7 +6,7 @@ study's GeometryControls and Responses; apply() writes them through api.set_cont
 api.set_responses, which check every value as a job file is checked (a bad value raises a
 TopOptError naming it, and the study is left as it was)."""
 import FreeCADGui
-from PySide import QtGui
+from PySide import QtCore, QtGui
 
 from topopt.app import api, picking
 from topopt.app import job as jobmod
@@ -70,7 +70,9 @@ class _ItemList:
 
     def __init__(self, describe):
         self.widget = QtGui.QListWidget()
-        self.widget.setMaximumHeight(70)
+        self.widget.setMaximumHeight(64)
+        self.widget.setWordWrap(True)  # the panel is narrow: rows wrap instead of scrolling sideways
+        self.widget.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
         self.describe = describe
         self.items = []
 
@@ -110,8 +112,9 @@ class ControlsBox:
         self.box = QtGui.QGroupBox("Design controls")
         layout = QtGui.QFormLayout(self.box)
         layout.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
-        self.planes = _ItemList(lambda p: "point %s normal %s" % (_fmt(p["point"]), _fmt(p["normal"])))
-        layout.addRow("Symmetry planes", self.planes.widget)
+        self.planes = _ItemList(lambda p: "through %s, normal %s" % (_fmt(p["point"]), _fmt(p["normal"])))
+        layout.addRow(QtGui.QLabel("Symmetry planes"))
+        layout.addRow(self.planes.widget)
         row, (add, rem) = _buttons(("Add picked plane", "Add the plane of the selected planar face or datum plane"),
                                    ("Remove", "Remove the selected symmetry plane"))
         add.clicked.connect(self._guard(self.add_plane))
@@ -120,7 +123,8 @@ class ControlsBox:
         layout.addRow(row)
         self.cyclic = _ItemList(lambda c: "%d sectors about %s through %s" % (c["sectors"], _fmt(c["axis"]),
                                                                               _fmt(c["point"])))
-        layout.addRow("Cyclic", self.cyclic.widget)
+        layout.addRow(QtGui.QLabel("Cyclic"))
+        layout.addRow(self.cyclic.widget)
         self.sectors = QtGui.QSpinBox()
         self.sectors.setRange(2, 360)
         self.sectors.setValue(4)
@@ -226,7 +230,7 @@ class ResponsesBox:
         self.objective = QtGui.QComboBox()
         for name, tip in OBJECTIVES:
             self.objective.addItem(name)
-            self.objective.setItemData(self.objective.count() - 1, tip, 3)  # Qt.ToolTipRole
+            self.objective.setItemData(self.objective.count() - 1, tip, QtCore.Qt.ToolTipRole)
         layout.addRow("Objective", self.objective)
         self.compliance_limit = _number(0, 1e15, 3, " N·mm", "none")
         self.compliance_limit.setToolTip("With the mass objective: the largest compliance allowed")
@@ -236,7 +240,8 @@ class ResponsesBox:
         layout.addRow("Stress limit", self.stress_limit)
         self.limits = _ItemList(lambda d: "%s along %s ≤ %.4g mm" % (", ".join(d["label"]), _fmt(d["direction"]),
                                                                       d["limit"]))
-        layout.addRow("Displacement limits", self.limits.widget)
+        layout.addRow(QtGui.QLabel("Displacement limits"))
+        layout.addRow(self.limits.widget)
         self.limit_dir = VectorEdit((0, 0, -1))
         layout.addRow("Direction", self.limit_dir)
         self.limit_value = _number(0, 1e6, 4, " mm")

@@ -192,6 +192,13 @@ TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
   }
   ASSERT_GT(at_tip, 0);
   EXPECT_LT(tip / at_tip, 0.0);
+  // the result files the job's output asks for by default (output.step): written and listed
+  // for the workbench to keep, each an existing file of the output folder
+  ASSERT_TRUE(result["files"].is_array());
+  const auto& files = result["files"];
+  EXPECT_NE(std::find(files.begin(), files.end(), "result.step"), files.end());
+  EXPECT_NE(std::find(files.begin(), files.end(), "verification.json"), files.end());
+  for (const auto& name : files) EXPECT_GT(std::filesystem::file_size(dir_ / "out" / name.get<std::string>()), 0u);
 }
 
 TEST_F(CliWorker, ExtractSurfaceOfAFullCubeIsTheCube) {

@@ -13,7 +13,7 @@ def bundled(name):
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "examples", name)
 
 
-def box_study(name="Box", iterations=6, mesh_size=4.0):
+def box_study(name="Box", iterations=6, mesh_size=4.0, load_face="Face2"):
     """A document with a 60 x 10 x 10 mm box fixed at x = 0 (Face1) and pulled down at x = 60
     (Face2), and a study on it that runs in a few seconds. Returns (doc, study)."""
     import FreeCAD
@@ -26,28 +26,16 @@ def box_study(name="Box", iterations=6, mesh_size=4.0):
     study = api.new_study(doc, part, (), volume_fraction=0.4, mesh_size=mesh_size)
     study.MaxIterations = iterations
     api.add_fixed(study, "Face1")
-    api.add_force(study, "Face2", (0, 0, -100))
+    api.add_force(study, load_face, (0, 0, -100))
     doc.recompute()
     return doc, study
 
 
 def top_loaded_box_study(name):
-    """A 60 x 10 x 10 mm box fixed at x = 0 (Face1) and pressed down on its top (Face6, 100 N):
-    both faces stay on the result, as the verification needs (a tip load on the end face
-    Face2 does not: the design leaves that face). Returns (doc, study)."""
-    import FreeCAD
-    import Part
-    from topopt.app import api
-    doc = FreeCAD.newDocument(name)
-    part = doc.addObject("Part::Feature", "Beam")
-    part.Shape = Part.makeBox(60, 10, 10)
-    doc.recompute()
-    study = api.new_study(doc, part, (), volume_fraction=0.4, mesh_size=3.0)
-    study.MaxIterations = 10
-    api.add_fixed(study, "Face1")
-    api.add_force(study, "Face6", (0, 0, -100))
-    doc.recompute()
-    return doc, study
+    """box_study's box fixed at x = 0 (Face1) but pressed down on its top (Face6, 100 N), 10
+    iterations at 3 mm: both faces stay on the result, as the verification needs (a tip load
+    on the end face Face2 does not: the design leaves that face). Returns (doc, study)."""
+    return box_study(name, iterations=10, mesh_size=3.0, load_face="Face6")
 
 
 def _describe(value):

@@ -86,7 +86,10 @@ class Panel(unittest.TestCase):
         select(part, "Face2")
         p.responses.add_limit()
         settle()
-        screenshot("panel_controls.png", fit=False)
+        screenshot("panel_controls.png")
+        form = p.form
+        form.resize(max(form.width(), 330), form.sizeHint().height())
+        form.grab().save(os.path.join(SHOTS, "panel_controls_whole.png"))  # the whole panel, unscrolled
         self.assertTrue(p.accept())
         self.assertFalse(p.is_open())
         c = json.loads(self.study.GeometryControls)
@@ -158,6 +161,9 @@ class ResultAsCad(unittest.TestCase):
         self.assertEqual(len(solid.Shape.Solids), 1)
         self.assertTrue(solid.ViewObject.Visibility)
         self.assertFalse(self.study.Result.ViewObject.Visibility)
+        for obj in self.doc.Objects:  # the part (coincident faces) and the arrows would hide the solid
+            if obj is not solid and obj.ViewObject is not None:
+                obj.ViewObject.Visibility = False
         self.assertEqual(self.doc.UndoNames[0] if self.doc.UndoMode else "TopOpt result as solid",
                          "TopOpt result as solid")
         screenshot("result_solid.png")
