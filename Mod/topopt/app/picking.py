@@ -43,7 +43,7 @@ def plane_of(obj, sub=""):
 
 def axis_of(obj, sub=""):
     """(point, axis) of a picked cylindrical or conical face, a circular edge (its axis) or a
-    straight edge (along it)."""
+    straight edge (along it, a unit vector)."""
     element, what = _element(obj, sub)
     if element.ShapeType == "Face":
         surface = element.Surface
@@ -56,7 +56,7 @@ def axis_of(obj, sub=""):
             return _vec(curve.Center), _vec(curve.Axis)
         if kind in ("Line", "LineSegment"):
             a, b = element.Vertexes[0].Point, element.Vertexes[-1].Point
-            return _vec(a), _vec(b - a)
+            return _vec(a), _vec((b - a).normalize())
     raise TopOptError("%s has no axis: pick a cylindrical face, a circular edge or a straight edge" % what,
                       "InvalidParameter")
 

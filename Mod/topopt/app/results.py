@@ -187,7 +187,7 @@ def style_result(feature):
 
 # --- FEM result and fields -----------------------------------------------------------------
 
-def _fem_result(study, mesh_obj, nodes, displacement, von_mises_nodes):
+def _fem_result(study, mesh_obj, displacement, von_mises_nodes):
     import ObjectsFem
     doc = study.Document
     res = _object(doc, study, "FemResult", "Fem::FemResultObjectPython", "FemResult",
@@ -258,7 +258,7 @@ def update_fem_objects(study, result, threshold):
         mesh_obj = _object(doc, study, "AnalysisMesh", "Fem::FemMeshObjectPython", "AnalysisMesh",
                            "%s analysis mesh" % study.Label, lambda: _make_mesh_result(doc, study))
         mesh_obj.FemMesh = mesh
-        res = _fem_result(study, mesh_obj, nodes, displacement, nodal_average(tets, von_mises, len(nodes), vol))
+        res = _fem_result(study, mesh_obj, displacement, nodal_average(tets, von_mises, len(nodes), vol))
         pipe, clip = _fields(study, path, threshold)
     finally:
         shutil.rmtree(folder, ignore_errors=True)

@@ -62,7 +62,7 @@ class VectorEdit(QtGui.QWidget):
 
 
 def _fmt(v):
-    return "(%s)" % ", ".join("%.4g" % x for x in v)
+    return "(%s)" % ", ".join("%.4g" % (x + 0.0) for x in v)  # + 0.0: no "-0"
 
 
 class _ItemList:

@@ -98,7 +98,7 @@ class Panel(unittest.TestCase):
         self.assertVector(plane["point"], [30, 0, 5])
         self.assertVector(plane["normal"], [0, -1, 0])
         self.assertEqual(c["cyclic"][0]["sectors"], 2)
-        self.assertVector([abs(x) for x in c["cyclic"][0]["axis"]], [0, 0, 10])
+        self.assertVector([abs(x) for x in c["cyclic"][0]["axis"]], [0, 0, 1])
         self.assertEqual(c["patterns"], [{"direction": [1.0, 0.0, 0.0], "pitch": 20.0, "count": 3}])
         self.assertEqual(c["extrusion"], [0.0, 0.0, 1.0])
         opt = api.job_of(self.study)["optimization"]
