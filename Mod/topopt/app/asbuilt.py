@@ -21,6 +21,7 @@ import FreeCAD
 import numpy as np
 
 from . import quiet, vtu
+from .results import nodal_maximum
 from .errors import TopOptError
 
 STEP = "result.step"
@@ -165,15 +166,6 @@ def _first(fields, prefix, what):
     raise TopOptError("the verification's VTU holds no %s field: run the study again" % what, "Io")
 
 
-def nodal_maximum(tets, values, count):
-    """#V: at each node the largest value of the tets around it (0 where no tet is), so that
-    the largest nodal value is the largest tet value (the verification's max_von_mises)."""
-    out = np.zeros(count)
-    for k in range(4):
-        np.maximum.at(out, tets[:, k], values)
-    return out
-
-
 def _remove_verification(study):
     doc = study.Document
     for name in ("VerificationFields", "VerificationResult", "VerificationMesh"):
@@ -236,7 +228,7 @@ def update_verification(study):
     nodes, tets, points, cells = vtu.read_tets(path)
     u = np.asarray(_first(points, "displacement", "displacement"), dtype=np.float64).reshape(-1, 3)
     vm = np.asarray(_first(cells, "von_mises", "von Mises stress"), dtype=np.float64).reshape(-1)
-    vm_nodes = nodal_maximum(tets, vm, len(nodes))
+    vm_nodes = nodal_maximum(tets, vm, len(nodes))  # its maximum is the JSON's max_von_mises
     folder = tempfile.mkdtemp(prefix="topopt-verification-")
     try:
         # point data only: FreeCAD 0.20's pipeline view crashes when a cell field is chosen

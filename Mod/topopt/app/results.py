@@ -5,8 +5,9 @@
 - AnalysisMesh: the tagged analysis mesh as a FEM mesh;
 - FemResult: the last SIMP iterate as a FEM mechanical result on that mesh (displacement,
   von Mises stress): FEM's result panel and its post-processing work on it;
-- Fields: a FEM post-processing pipeline with the run's fields (Density and Displacement per
-  node, von Mises stress and Domain per tet), saved in the document;
+- Fields: a FEM post-processing pipeline with the run's fields, all per node (Density,
+  Displacement, von Mises stress averaged by volume, Domain: the largest around the node, so
+  a non-design solid's nodes count as its own), saved in the document;
 - DensityView: a scalar clip of Fields on Density at the result's threshold, coloured by
   density with FEM's colour bar: where the material stays;
 - DomainMeshes: the Mesh command's FEM meshes, one per domain (refreshed by a run).
@@ -61,6 +62,15 @@ def nodal_average(tets, values, count, weights):
         np.add.at(total, tets[:, k], values * weights)
         np.add.at(weight, tets[:, k], weights)
     return np.divide(total, weight, out=np.zeros(count), where=weight > 0)
+
+
+def nodal_maximum(tets, values, count):
+    """#V: at each node the largest value of the tets around it (0 where no tet is), so that
+    the largest nodal value is the largest tet value."""
+    out = np.zeros(count)
+    for k in range(4):
+        np.maximum.at(out, tets[:, k], values)
+    return out
 
 
 def kept_volume_fraction(nodes, tets, domain, densities, threshold):
@@ -247,18 +257,21 @@ def update_fem_objects(study, result, threshold):
     vol = tet_volumes(nodes, tets)
     node_density = nodal_average(tets, densities, len(nodes), vol)
     node_density[np.unique(tets[domain > 0])] = 1.0  # as the core does: non-design solids stay whole
+    node_von_mises = nodal_average(tets, von_mises, len(nodes), vol)
     folder = tempfile.mkdtemp(prefix="topopt-fields-")
     try:
+        # every field per node: FreeCAD 0.20's pipeline view crashes when a cell field is
+        # chosen as its Field (ViewProviderFemPostObject::updateProperties)
         path = vtu.write_tets(os.path.join(folder, "fields.vtu"), nodes, tets,
-                              [(DENSITY, node_density), (DISPLACEMENT, displacement)],
-                              [(VON_MISES, von_mises), (DOMAIN, domain)])
+                              [(DENSITY, node_density), (DISPLACEMENT, displacement), (VON_MISES, node_von_mises),
+                               (DOMAIN, nodal_maximum(tets, domain.astype(np.float64), len(nodes)))])
         import Fem
         mesh = Fem.FemMesh()
         mesh.read(path)
         mesh_obj = _object(doc, study, "AnalysisMesh", "Fem::FemMeshObjectPython", "AnalysisMesh",
                            "%s analysis mesh" % study.Label, lambda: _make_mesh_result(doc, study))
         mesh_obj.FemMesh = mesh
-        res = _fem_result(study, mesh_obj, displacement, nodal_average(tets, von_mises, len(nodes), vol))
+        res = _fem_result(study, mesh_obj, displacement, node_von_mises)
         pipe, clip = _fields(study, path, threshold)
     finally:
         shutil.rmtree(folder, ignore_errors=True)

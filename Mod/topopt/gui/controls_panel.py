@@ -36,7 +36,10 @@ def _number(low, high, decimals, suffix="", special=""):
     w.setDecimals(decimals)
     w.setSuffix(suffix)
     w.setSpecialValueText(special)
-    w.setMinimumWidth(60)
+    # a spin box asks for the width of its longest value (-1e9 with decimals): let the layout
+    # shrink it, so that the panel fits FreeCAD's default combo view
+    w.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
+    w.setMinimumWidth(50)
     return w
 
 
@@ -47,9 +50,9 @@ class VectorEdit(QtGui.QWidget):
         super().__init__()
         layout = QtGui.QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        self.fields = [_number(-1e9, 1e9, 4) for _ in range(3)]
+        self.fields = [_number(-1e6, 1e6, 3) for _ in range(3)]
         for f, axis in zip(self.fields, "xyz"):
-            f.setPrefix(axis + " ")
+            f.setToolTip("%s component" % axis)
             layout.addWidget(f)
         self.set(value)
 
@@ -71,6 +74,7 @@ class _ItemList:
     def __init__(self, describe):
         self.widget = QtGui.QListWidget()
         self.widget.setMaximumHeight(64)
+        self.widget.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Preferred)
         self.widget.setWordWrap(True)  # the panel is narrow: rows wrap instead of scrolling sideways
         self.widget.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
         self.describe = describe
@@ -126,6 +130,7 @@ class ControlsBox:
         layout.addRow(QtGui.QLabel("Cyclic"))
         layout.addRow(self.cyclic.widget)
         self.sectors = QtGui.QSpinBox()
+        self.sectors.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
         self.sectors.setRange(2, 360)
         self.sectors.setValue(4)
         layout.addRow("Sectors", self.sectors)
@@ -145,6 +150,7 @@ class ControlsBox:
         self.pattern_dir = VectorEdit((1, 0, 0))
         self.pattern_pitch = _number(0, 1e6, 3, " mm")
         self.pattern_count = QtGui.QSpinBox()
+        self.pattern_count.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
         self.pattern_count.setRange(2, 10000)
         layout.addRow(self.pattern_on)
         layout.addRow("Pattern direction", self.pattern_dir)
@@ -228,6 +234,7 @@ class ResponsesBox:
         layout = QtGui.QFormLayout(self.box)
         layout.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
         self.objective = QtGui.QComboBox()
+        self.objective.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
         for name, tip in OBJECTIVES:
             self.objective.addItem(name)
             self.objective.setItemData(self.objective.count() - 1, tip, QtCore.Qt.ToolTipRole)

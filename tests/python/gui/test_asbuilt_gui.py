@@ -86,6 +86,9 @@ class Panel(unittest.TestCase):
         select(part, "Face2")
         p.responses.add_limit()
         settle()
+        combo = FreeCADGui.getMainWindow().findChild(QtGui.QDockWidget, "Combo View")
+        if combo is not None:  # the panel fits FreeCAD's default combo view, nothing clipped
+            self.assertLessEqual(p.form.minimumSizeHint().width(), combo.width())
         screenshot("panel_controls.png")
         form = p.form
         form.resize(max(form.width(), 330), form.sizeHint().height())
@@ -193,6 +196,21 @@ class ResultAsCad(unittest.TestCase):
         screenshot("verification_von_mises.png")
         self.doc.removeObject(clip.Name)
         vo.Visibility = False
+
+    def test_every_field_of_the_pipelines_can_be_chosen(self):
+        # choosing a cell field crashed FreeCAD 0.20 (SIGSEGV in the pipeline's view): the
+        # run's pipelines hold point fields only, and each can be chosen as a user would
+        for pipe in (self.study.Fields, self.study.VerificationFields):
+            vo = pipe.ViewObject
+            vo.DisplayMode = "Surface"
+            settle(5)
+            fields = vo.getEnumerationsOfProperty("Field")
+            self.assertGreaterEqual(len(fields), 3, pipe.Label)
+            for f in fields:
+                vo.Field = f
+                settle(5)
+                self.assertEqual(vo.Field, f)
+            vo.Visibility = False
 
     def test_export_step_command_writes_the_file(self):
         from topopt.gui import commands
