@@ -119,7 +119,7 @@ class ControlsBox:
         self.planes = _ItemList(lambda p: "through %s, normal %s" % (_fmt(p["point"]), _fmt(p["normal"])))
         layout.addRow(QtGui.QLabel("Symmetry planes"))
         layout.addRow(self.planes.widget)
-        row, (add, rem) = _buttons(("Add picked plane", "Add the plane of the selected planar face or datum plane"),
+        row, (add, rem) = _buttons(("Add plane", "Add the plane of the selected planar face or datum plane (pick it first)"),
                                    ("Remove", "Remove the selected symmetry plane"))
         add.clicked.connect(self._guard(self.add_plane))
         self.add_plane_button = add
@@ -134,8 +134,8 @@ class ControlsBox:
         self.sectors.setRange(2, 360)
         self.sectors.setValue(4)
         layout.addRow("Sectors", self.sectors)
-        row, (add, rem) = _buttons(("Add picked axis", "Repeat the design about the axis of the selected cylindrical "
-                                    "face or edge, in the sectors above"), ("Remove", "Remove the selected cyclic "
+        row, (add, rem) = _buttons(("Add axis", "Repeat the design about the axis of the selected cylindrical face "
+                                    "or edge (pick it first), in the sectors above"), ("Remove", "Remove the selected cyclic "
                                                                             "repetition"))
         add.clicked.connect(self._guard(self.add_cyclic))
         self.add_cyclic_button = add
@@ -153,18 +153,19 @@ class ControlsBox:
         self.pattern_count.setSizePolicy(QtGui.QSizePolicy.Ignored, QtGui.QSizePolicy.Fixed)
         self.pattern_count.setRange(2, 10000)
         layout.addRow(self.pattern_on)
-        layout.addRow("Pattern direction", self.pattern_dir)
+        layout.addRow("Direction", self.pattern_dir)
         layout.addRow("Pitch", self.pattern_pitch)
         layout.addRow("Copies", self.pattern_count)
 
     def _extrusion_rows(self, layout):
-        self.extrusion_on = QtGui.QCheckBox("Extrusion (constant cross-section)")
+        self.extrusion_on = QtGui.QCheckBox("Extrusion")
+        self.extrusion_on.setToolTip("A constant cross-section along the direction below")
         self.extrusion_dir = VectorEdit((0, 0, 1))
-        pick = QtGui.QPushButton("Picked direction")
+        pick = QtGui.QPushButton("From selection")
         pick.setToolTip("The normal of the selected planar face or the direction of the selected straight edge")
         pick.clicked.connect(self._guard(self.pick_extrusion))
         layout.addRow(self.extrusion_on)
-        layout.addRow("Extrusion direction", self.extrusion_dir)
+        layout.addRow("Direction", self.extrusion_dir)
         layout.addRow(pick)
 
     @staticmethod
@@ -252,9 +253,9 @@ class ResponsesBox:
         self.limit_dir = VectorEdit((0, 0, -1))
         layout.addRow("Direction", self.limit_dir)
         self.limit_value = _number(0, 1e6, 4, " mm")
-        layout.addRow("Largest displacement", self.limit_value)
-        row, (add, rem) = _buttons(("Limit picked faces", "Limit the mean displacement of the selected faces along "
-                                    "the direction above to the value above"), ("Remove", "Remove the selected limit"))
+        layout.addRow("Limit", self.limit_value)
+        row, (add, rem) = _buttons(("Limit faces", "Limit the mean displacement of the selected faces (pick them "
+                                    "first) along the direction above to the value above"), ("Remove", "Remove the selected limit"))
         add.clicked.connect(ControlsBox._guard(self.add_limit))
         rem.clicked.connect(self.limits.remove_selected)
         layout.addRow(row)

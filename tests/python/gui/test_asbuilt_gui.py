@@ -88,7 +88,8 @@ class Panel(unittest.TestCase):
         settle()
         combo = FreeCADGui.getMainWindow().findChild(QtGui.QDockWidget, "Combo View")
         if combo is not None:  # the panel fits FreeCAD's default combo view, nothing clipped
-            self.assertLessEqual(p.form.minimumSizeHint().width(), combo.width())
+            widths = {b.title(): b.minimumSizeHint().width() for b in p.form.findChildren(QtGui.QGroupBox)}
+            self.assertLessEqual(p.form.minimumSizeHint().width(), combo.width(), widths)
         screenshot("panel_controls.png")
         form = p.form
         form.resize(max(form.width(), 330), form.sizeHint().height())
