@@ -65,7 +65,10 @@ def snapshot(doc):
         props = {}
         for p in o.PropertiesList:
             try:
-                props[p] = _describe(o.getPropertyByName(p))
+                value = o.getPropertyByName(p)
+                if o.getTypeIdOfProperty(p) == "App::PropertyFileIncluded":  # a copy in the document's own folder
+                    value = (os.path.basename(value), os.path.getsize(value)) if value else ""
+                props[p] = _describe(value)
             except Exception as e:  # a property that cannot be read is recorded as such
                 props[p] = "unreadable: %s" % type(e).__name__
         out[o.Name] = (o.TypeId, props)
