@@ -312,5 +312,5 @@ def tell_if_core_missing():
         box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, "TopOpt: native core missing", problem,
                                 QtGui.QMessageBox.Ok, mw)
         box.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)  # the command can be copied
-        (getattr(box, "exec", None) or box.exec_)()  # exec_ is PySide2's; Qt 6's PySide (FreeCAD 1.x) has exec
+        (getattr(box, "exec", None) or box.exec_)()  # exec_ in Qt 5 bindings; exec in the Qt 6 ones (FreeCAD 1.x)
     return True
