@@ -227,7 +227,12 @@ int run_on_ranks(int argc, char** argv) {
 #endif
 #ifdef TOPOPT_WITH_PETSC
   if (distributable) {
-    topopt::dist::MpiSession session;
+    // an error inside a run, on any rank, is printed by that rank as a serial run prints it
+    // (with the rank), then ends every rank with its exit code
+    const topopt::dist::MpiSession session([name](std::exception_ptr failure, int rank) {
+      const std::string label = std::string(name) + " (MPI rank " + std::to_string(rank) + ")";
+      return run_command([&](const Args&) -> int { std::rethrow_exception(failure); }, {}, label.c_str());
+    });
     if (session.rank() != 0) {
       topopt::dist::serve_ranks(session);
       return 0;

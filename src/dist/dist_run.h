@@ -4,6 +4,11 @@
 // mesh with its ghost layer (dist_mesh.h), run on every rank and gather the answer on rank 0 in
 // the serial mesh's numbering, so that the pipeline writes the same files as a serial run. The
 // other ranks sit in serve_ranks until rank 0 calls release_ranks.
+//
+// Errors: one raised on rank 0 before a run starts (reading, meshing, check_distributable) is
+// reported there as in a serial run, and release_ranks ends the others. One raised inside a run,
+// on any rank, ends every rank (MpiSession::end_run: the message, then MPI_Abort), since the
+// other ranks may be waiting for the failing one inside a collective call.
 #pragma once
 #include <functional>
 #include <string>
@@ -44,7 +49,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
                                    const Eigen::Matrix3Xd& gravity, std::vector<RankStats>* stats = nullptr);
 
 /// Ranks other than 0: takes part in every run rank 0 starts until it calls release_ranks. An
-/// error of a run is rank 0's to report; serving goes on.
+/// error inside a run ends every rank (MpiSession::end_run).
 void serve_ranks(const MpiSession& session);
 
 /// Rank 0: ends serve_ranks on the other ranks (once, at the end, also after an error).
