@@ -70,6 +70,13 @@ std::string serial_stats_json(long tets, double seconds_run) {
   return j.dump(2);
 }
 
+std::string amg_option(ArgReader& reader) {
+  const std::string amg = reader.option("amg", "gamg");
+  if (amg != "gamg" && amg != "boomeramg")
+    throw Error(ErrorCode::InvalidParameter, "--amg takes gamg or boomeramg, not '" + amg + "'");
+  return amg;
+}
+
 ArgReader::ArgReader(const Args& args, std::string usage)
     : args_(args), used_(args.size(), false), usage_(std::move(usage)) {
   for (size_t i = 0; i < args_.size(); ++i)

@@ -121,6 +121,7 @@ Answer run_here(const MpiSession& s, const Settings& settings, const TetMesh& me
   if (settings.command == Command::Solve) {
     DistElasticity fe(s, dm, settings.material, settings.solver);
     const Eigen::MatrixXd U = fe.solve(dm.loads);
+    mine.solver_iterations = fe.last_iterations();
     a.U = gather_nodes(s, dm, U.topRows(3 * dm.owned_nodes));
     for (long k = 0; k < U.cols(); ++k) a.von_mises.push_back(gather_tets(s, dm, fe.von_mises(U.col(k))));
   } else {
@@ -168,7 +169,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
                                    const std::vector<double>& weights, const simp::SimpParams& params,
                                    const Progress& progress,
                                    const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                                   const Eigen::Matrix3Xd& gravity, std::vector<RankStats>* stats) {
+                                   const Eigen::Matrix3Xd& gravity, Amg amg, std::vector<RankStats>* stats) {
   simp::check_params(params);
   simp::check_volume_fraction(params.volume_fraction);
   check_distributable(params, gravity.size() && !gravity.isZero());
@@ -178,6 +179,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
   settings.simp = SimpCore::of(params);
   settings.solver.tolerance = params.solver.tolerance;
   settings.solver.max_iterations = params.solver.max_iterations;
+  settings.solver.amg = amg;
   settings.cases = static_cast<int>(loads.cols());
   simp::FilterParams& f = settings.simp.filter;
   f.radius = simp::filter_radius(mesh, f);
@@ -220,7 +222,8 @@ std::string stats_json(const std::vector<RankStats>& stats) {
                              {"seconds_distribute", r.seconds_distribute},
                              {"seconds_run", r.seconds_run},
                              {"cpu_seconds", r.cpu_seconds},
-                             {"peak_mb", r.peak_bytes / 1e6}});
+                             {"peak_mb", r.peak_bytes / 1e6},
+                             {"solver_iterations", r.solver_iterations}});
   return j.dump(2);
 }
 

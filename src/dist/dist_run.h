@@ -28,6 +28,7 @@ struct RankStats {
   double seconds_run = 0;         ///< the solve, or SIMP
   double peak_bytes = 0;          ///< peak resident memory of the process so far
   double cpu_seconds = 0;         ///< user + system CPU time of the process so far
+  int solver_iterations = 0;      ///< CG iterations of the last FE solve (the largest over the cases)
 };
 
 /// Rank 0: solves the load cases ((3 #V) by #cases loads; supports at zero) on all ranks.
@@ -39,14 +40,15 @@ void solve_on_ranks(const MpiSession& session, const TetMesh& mesh, const fem::M
 
 /// Rank 0: SIMP on all ranks, as simp::optimize with the same arguments; the filter becomes
 /// the Helmholtz one (an explicit kind is replaced by the Helmholtz filter standing in for it,
-/// said through progress.info). Throws Error(InvalidParameter) before any distributed work for
-/// what check_distributable refuses. Collective with serve_ranks on the others.
+/// said through progress.info); amg: the preconditioner of the FE solves. Throws
+/// Error(InvalidParameter) before any distributed work for what check_distributable refuses.
+/// Collective with serve_ranks on the others.
 simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mesh, const fem::Material& material,
                                    const fem::Supports& supports, const Eigen::MatrixXd& loads,
                                    const std::vector<double>& weights, const simp::SimpParams& params,
                                    const Progress& progress,
                                    const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                                   const Eigen::Matrix3Xd& gravity, std::vector<RankStats>* stats = nullptr);
+                                   const Eigen::Matrix3Xd& gravity, Amg amg, std::vector<RankStats>* stats = nullptr);
 
 /// Ranks other than 0: takes part in every run rank 0 starts until it calls release_ranks. An
 /// error inside a run ends every rank (MpiSession::end_run).
@@ -56,7 +58,7 @@ void serve_ranks(const MpiSession& session);
 void release_ranks(const MpiSession& session);
 
 /// The per-rank figures as JSON text: {"ranks": N, "per_rank": [{rank, tets, owned_nodes,
-/// ghost_nodes, seconds_distribute, seconds_run, cpu_seconds, peak_mb}, ...]}.
+/// ghost_nodes, seconds_distribute, seconds_run, cpu_seconds, peak_mb, solver_iterations}, ...]}.
 std::string stats_json(const std::vector<RankStats>& stats);
 
 }  // namespace topopt::dist

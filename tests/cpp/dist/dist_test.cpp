@@ -195,7 +195,7 @@ TEST(DistSimp, OptimizeEqualsTheSerialRun) {
   params.solver.tolerance = 1e-9;
   if (!root()) return serve_ranks(session());
   const simp::SimpResult distributed =
-      optimize_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, {}, params, {}, {}, {});
+      optimize_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, {}, params, {}, {}, {}, Amg::GAMG);
   release_ranks(session());
   params.solver.kind = fem::SolverKind::Direct;
   const simp::SimpResult serial = simp::optimize(b.mesh, b.material, b.supports, b.loads, {}, params);
