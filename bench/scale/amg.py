@@ -4,7 +4,8 @@
 The cantilever example (its suggested load case) is meshed once per size with `topopt mesh`; on
 each mesh, in this one script, `mpirun -np 2 topopt solve --amg gamg` and `--amg boomeramg`
 run one after the other (one thread per rank; the same job, relative residual 1e-10). Each row:
-CG iterations, wall time of the solve (set-up of the multigrid included), CPU time per rank,
+CG iterations (of the solve; not reported for optimize), wall time of the solve (set-up of the
+multigrid included) or of SIMP, CPU time per rank,
 peak memory per rank, and the compliance of both (they must agree). With --optimize N, also N
 SIMP iterations of `topopt optimize` each way (the solver is set up again at every iteration).
 
@@ -45,7 +46,7 @@ def main():
                                   ["--amg", amg])
                 print("| %g | %s | %s | %s | %s | %.2f | %s | %s | %.6g |" % (
                     size, r["tets"], command + ("" if command == "solve" else " ×%d" % iterations), amg,
-                    r["cg"] if command == "solve" else "%d (last)" % r["cg"], r["simp"],
+                    r["cg"] if command == "solve" else "—", r["simp"],
                     " / ".join("%.2f" % x for x in r["cpus"]), " / ".join("%.0f" % x for x in r["peaks"]), r["c"]),
                       flush=True)
 
