@@ -11,7 +11,8 @@ iterations (convergence tests off). Each row: wall time of SIMP (history.json), 
 system) of each process, peak memory per rank (--stats: getrusage of each process) and the final compliance of
 both (they must agree to about 1e-3). `--solve` adds one static solve each way on the largest mesh.
 
-usage: bench/scale/run.py [--build build] [--sizes 0.86,0.5] [--iterations 10] [--solve]
+usage: bench/scale/run.py [--build build] [--sizes 0.86,0.5] [--iterations 10] [--solve] [--amg gamg]
+A mesh file of an earlier run in --work is used again.
 Prints Markdown for BENCHMARKS.md. As root, OpenMPI needs OMPI_ALLOW_RUN_AS_ROOT=1 and
 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1: the script sets them for its own mpirun only.
 """
@@ -44,10 +45,13 @@ def job_file(work, msh, name, iterations):
     return path
 
 
-def one_run(topopt, work, msh, name, iterations, ranks, command="optimize"):
+def one_run(topopt, work, msh, name, iterations, ranks, command="optimize", extra=()):
+    """One run of `topopt COMMAND` on the mesh file, serial (ranks 1, pinned to core 0) or under
+    mpirun; extra: more arguments. Returns wall, SIMP (or solve) seconds, per-rank peaks and
+    CPU, the final compliance, SIMP iterations and the last FE solve's CG iterations (0 serial)."""
     path = job_file(work, msh, name, iterations)
     stats = os.path.join(work, name + "_stats.json")
-    cmd = [topopt, command, path, "--stats", stats] + (["--quiet"] if command == "optimize" else [])
+    cmd = [topopt, command, path, "--stats", stats] + (["--quiet"] if command == "optimize" else []) + list(extra)
     if ranks == 1:
         log, wall = run(["taskset", "-c", "0"] + cmd)
     else:
@@ -55,13 +59,15 @@ def one_run(topopt, work, msh, name, iterations, ranks, command="optimize"):
     s = json.load(open(stats))
     peaks = [r["peak_mb"] for r in s["per_rank"]]
     cpus = [r["cpu_seconds"] for r in s["per_rank"]]
+    cg = s["per_rank"][0].get("solver_iterations", 0)
+    tets = sum(r["tets"] for r in s["per_rank"])
     if command == "optimize":
         h = json.load(open(os.path.join(work, name, "history.json")))
         return {"wall": wall, "simp": h["seconds"]["simp"], "peaks": peaks, "cpus": cpus,
-                "c": h["history"][-1]["compliance"], "its": len(h["history"])}
+                "c": h["history"][-1]["compliance"], "its": len(h["history"]), "cg": cg, "tets": tets}
     m = re.search(r"compliance ([0-9.eE+-]+)", log)
     return {"wall": wall, "simp": s["per_rank"][0]["seconds_run"], "peaks": peaks, "cpus": cpus,
-            "c": float(m.group(1)), "its": 0}
+            "c": float(m.group(1)), "its": 0, "cg": cg, "tets": tets}
 
 
 def main():
@@ -71,6 +77,7 @@ def main():
     ap.add_argument("--sizes", default="0.86,0.5")
     ap.add_argument("--iterations", type=int, default=10)
     ap.add_argument("--solve", action="store_true")
+    ap.add_argument("--amg", default="gamg", help="the multigrid of the 2-rank runs (topopt --amg)")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     topopt = os.path.join(a.build, "topopt")
@@ -80,26 +87,29 @@ def main():
     print("Cantilever, Helmholtz filter r = 1.5 mm, OC, %d SIMP iterations; serial pinned to one core "
           "(taskset), 2 ranks one thread each; load average at the start %.1f (the machine is shared).\n"
           % (a.iterations, load[0]))
-    print("| size (mm) | tets | serial SIMP wall (s) | serial CPU (s) | 2 ranks SIMP wall (s) | 2 ranks CPU per rank (s) "
-          "| wall ratio serial / 2 ranks | serial peak (MB) | 2 ranks peak per rank (MB) | compliance 2 ranks / serial |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| size (mm) | tets | SIMP iterations serial / 2 ranks | serial SIMP wall (s) | serial CPU (s) "
+          "| 2 ranks SIMP wall (s) | 2 ranks CPU per rank (s) | wall ratio serial / 2 ranks | serial peak (MB) "
+          "| 2 ranks peak per rank (MB) | CG iterations, last solve (2 ranks) | compliance 2 ranks / serial "
+          "| load average after |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     last = None
     for size in [float(x) for x in a.sizes.split(",")]:
         msh = os.path.join(a.work, "cantilever_%g.msh" % size)
-        out, _ = run([topopt, "mesh", "--part", os.path.join(ex, "cantilever.step"), "--non-design",
-                      os.path.join(ex, "cantilever_nondesign.step"), "--size", str(size), "--out", msh])
-        tets = int(re.search(r"(\d+) tets", out).group(1))
+        if not os.path.exists(msh):  # a mesh of an earlier run is used again
+            run([topopt, "mesh", "--part", os.path.join(ex, "cantilever.step"), "--non-design",
+                 os.path.join(ex, "cantilever_nondesign.step"), "--size", str(size), "--out", msh])
         s = one_run(topopt, a.work, msh, "serial_%g" % size, a.iterations, 1)
-        p = one_run(topopt, a.work, msh, "ranks2_%g" % size, a.iterations, 2)
-        print("| %g | %d | %.1f | %.1f | %.1f | %s | %.2f | %.0f | %s | %.6f |" % (
-            size, tets, s["simp"], s["cpus"][0], p["simp"], " / ".join("%.1f" % x for x in p["cpus"]),
-            s["simp"] / p["simp"], s["peaks"][0], " / ".join("%.0f" % x for x in p["peaks"]), p["c"] / s["c"]),
-              flush=True)
+        p = one_run(topopt, a.work, msh, "ranks2_%g" % size, a.iterations, 2, extra=["--amg", a.amg])
+        tets = s["tets"]
+        print("| %g | %d | %d / %d | %.1f | %.1f | %.1f | %s | %.2f | %.0f | %s | %d | %.6f | %.1f |" % (
+            size, tets, s["its"], p["its"], s["simp"], s["cpus"][0], p["simp"],
+            " / ".join("%.1f" % x for x in p["cpus"]), s["simp"] / p["simp"], s["peaks"][0],
+            " / ".join("%.0f" % x for x in p["peaks"]), p["cg"], p["c"] / s["c"], os.getloadavg()[0]), flush=True)
         last = (size, tets, msh)
     if a.solve and last:
         size, tets, msh = last
         s = one_run(topopt, a.work, msh, "solve1_%g" % size, 1, 1, "solve")
-        p = one_run(topopt, a.work, msh, "solve2_%g" % size, 1, 2, "solve")
+        p = one_run(topopt, a.work, msh, "solve2_%g" % size, 1, 2, "solve", ["--amg", a.amg])
         print("\nOne static solve, %d tets: serial %.1f s wall, %.1f s CPU (peak %.0f MB); 2 ranks %.1f s wall, CPU "
               "per rank %s s (peaks %s MB); compliance ratio %.6f." % (
                   tets, s["simp"], s["cpus"][0], s["peaks"][0], p["simp"], " / ".join("%.1f" % x for x in p["cpus"]),

@@ -18,23 +18,24 @@ namespace {
 
 /// Sets options.simp to SIMP on all MPI ranks (session not null) and the ranks it runs on;
 /// the per-rank figures go to stats_text.
-void use_ranks(const dist::MpiSession* session, pipeline::RunOptions& options, std::string* stats_text) {
+void use_ranks(const dist::MpiSession* session, const std::string& amg, pipeline::RunOptions& options,
+               std::string* stats_text) {
 #ifdef TOPOPT_WITH_PETSC
   if (!session) return;
   options.ranks = session->size();
-  options.simp = [session, stats_text](
+  options.simp = [session, amg, stats_text](
                      const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
                      const Eigen::MatrixXd& loads, const std::vector<double>& weights, const simp::SimpParams& params,
                      const Progress& progress, const std::function<void(const simp::IterationRecord&)>& on_iteration,
                      const Eigen::Matrix3Xd& gravity) {
     std::vector<dist::RankStats> stats;
     simp::SimpResult r = dist::optimize_on_ranks(*session, mesh, material, supports, loads, weights, params, progress,
-                                                 on_iteration, gravity, &stats);
+                                                 on_iteration, gravity, dist::amg_named(amg), &stats);
     *stats_text = dist::stats_json(stats);
     return r;
   };
 #else
-  (void)session, (void)options, (void)stats_text;
+  (void)session, (void)amg, (void)options, (void)stats_text;
 #endif
 }
 
@@ -43,6 +44,7 @@ void use_ranks(const dist::MpiSession* session, pipeline::RunOptions& options, s
 int cmd_optimize(const Args& args, const dist::MpiSession* session) {
   ArgReader a(args,
               "usage: topopt optimize JOB.json [--out-dir DIR] [--quiet] [--verbose] [--stats STATS.json]\n"
+              "                             [--amg gamg|boomeramg]\n"
               "  Meshes the part (or reads the job's mesh file), runs SIMP with the job's supports,\n"
               "  loads and \"optimization\" settings (docs/optimization.md), extracts the shape at the\n"
               "  threshold that keeps the volume fraction and smooths it. Writes DIR/density.vtu,\n"
@@ -56,11 +58,12 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
               "  --verbose  also the solver's timings\n"
               "  --stats    time and peak memory per MPI rank (one entry when serial), JSON\n"
               "  Under mpirun (a build with PETSc) rank 0 reads and meshes the job, then the FE solve\n"
-              "  (CG + GAMG), the Helmholtz density filter and the OC update run on all ranks; the files\n"
+              "  (CG + multigrid), the Helmholtz density filter and the OC update run on all ranks; the files\n"
               "  are the serial run's, written by rank 0 (history.json records \"ranks\"). MMA, the\n"
-              "  sensitivity filter and self-weight are serial only.");
+              "  sensitivity filter and self-weight are serial only.\n"
+              "  --amg      the multigrid under mpirun: " TOPOPT_AMG_CHOICES);
   if (a.print_help()) return 0;
-  std::string out = a.option("out-dir"), stats = a.option("stats");
+  std::string out = a.option("out-dir"), stats = a.option("stats"), amg = amg_option(a);
   bool quiet = a.flag("quiet"), verbose = a.flag("verbose");
   std::vector<std::string> pos = a.positionals();
   if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one job file\n" + a.usage());
@@ -79,7 +82,7 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
   pipeline::RunOptions options;
   options.write_outputs = true;
   std::string stats_text;
-  use_ranks(session, options, &stats_text);
+  use_ranks(session, amg, options, &stats_text);
   const pipeline::RunResult run = pipeline::run_job(job, {}, progress, {}, options);
   const pipeline::OptimizeResult& r = run.optimization;
   const auto& last = r.simp.history.back();

@@ -18,19 +18,21 @@ namespace {
 
 /// The distributed solve for solve_job under mpirun (nullptr session: none). Its relative
 /// residual is 1e-10, so that the displacements match a direct solve to about 1e-8.
-pipeline::AnalysisRunner distributed_runner(const dist::MpiSession* session, std::string* stats_text) {
+pipeline::AnalysisRunner distributed_runner(const dist::MpiSession* session, const std::string& amg,
+                                            std::string* stats_text) {
 #ifdef TOPOPT_WITH_PETSC
   if (!session) return {};
-  return [session, stats_text](const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
-                               const Eigen::MatrixXd& loads, Eigen::MatrixXd& U, std::vector<VecXd>& von_mises) {
+  return [session, amg, stats_text](const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
+                                    const Eigen::MatrixXd& loads, Eigen::MatrixXd& U, std::vector<VecXd>& von_mises) {
     dist::DistSolverParams params;
     params.tolerance = 1e-10;
+    params.amg = dist::amg_named(amg);
     std::vector<dist::RankStats> stats;
     dist::solve_on_ranks(*session, mesh, material, supports, loads, params, U, von_mises, &stats);
     *stats_text = dist::stats_json(stats);
   };
 #else
-  (void)session, (void)stats_text;
+  (void)session, (void)amg, (void)stats_text;
   return {};
 #endif
 }
@@ -40,7 +42,7 @@ pipeline::AnalysisRunner distributed_runner(const dist::MpiSession* session, std
 int cmd_solve(const Args& args, const dist::MpiSession* session) {
   ArgReader a(args,
               "usage: topopt solve JOB.json [--out-dir DIR] [--solver auto|direct|iterative] [--inp FILE]\n"
-              "                          [--stats STATS.json]\n"
+              "                          [--stats STATS.json] [--amg gamg|boomeramg]\n"
               "  Solves the job's load cases (linear elasticity on tets) and writes DIR/result.vtu\n"
               "  (displacements and von Mises stress per case) for ParaView. The job format is in\n"
               "  docs/job-format.md; the whole job is checked, and DIR made and tested, before any work.\n"
@@ -51,10 +53,11 @@ int cmd_solve(const Args& args, const dist::MpiSession* session) {
               "             the result with: ccx -i <name without .inp>\n"
               "  --stats    time and peak memory per MPI rank (one entry when serial), JSON\n"
               "  Under mpirun (a build with PETSc) the mesh is read or made on rank 0, distributed, and\n"
-              "  solved by CG with algebraic multigrid (PETSc GAMG) on all ranks; --solver is ignored.");
+              "  solved by CG with algebraic multigrid on all ranks; --solver is ignored.\n"
+              "  --amg      the multigrid under mpirun: " TOPOPT_AMG_CHOICES);
   if (a.print_help()) return 0;
   std::string out = a.option("out-dir"), solver = a.option("solver", "auto"), inp = a.option("inp"),
-              stats = a.option("stats");
+              stats = a.option("stats"), amg = amg_option(a);
   std::vector<std::string> pos = a.positionals();
   if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one job file\n" + a.usage());
   pipeline::Job job = pipeline::read_job(pos[0]);
@@ -79,7 +82,7 @@ int cmd_solve(const Args& args, const dist::MpiSession* session) {
   std::cout << "mesh: " << mesh.V.rows() << " nodes, " << mesh.T.rows() << " tets\n";
   std::string stats_text;
   pipeline::SolveResult r =
-      pipeline::solve_job(job, mesh, sp, VecXd(), progress, distributed_runner(session, &stats_text));
+      pipeline::solve_job(job, mesh, sp, VecXd(), progress, distributed_runner(session, amg, &stats_text));
   std::cout << std::setprecision(6);
   for (size_t c = 0; c < r.case_names.size(); ++c) {
     double umax = 0;

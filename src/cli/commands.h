@@ -40,6 +40,17 @@ void write_stats_file(const std::string& path, const std::string& json_text);
 /// (CPU time and peak memory of the whole process).
 std::string serial_stats_json(long tets, double seconds_run);
 
+class ArgReader;
+
+/// The choices of --amg, for the usage texts of solve and optimize.
+#define TOPOPT_AMG_CHOICES                                                                       \
+  "gamg (PETSc's smoothed aggregation with the rigid-body modes) or boomeramg (hypre's, nodal\n" \
+  "             coarsening); default gamg. Ignored by a serial run."
+
+/// --amg of solve and optimize: "gamg" (also when absent) or "boomeramg" (the multigrid under
+/// mpirun, dist::Amg). Throws Error(InvalidParameter) naming the choices for anything else.
+std::string amg_option(ArgReader& reader);
+
 /// Small argument reader shared by the sub-commands: `--name value` options, `--flag`
 /// switches and positionals. Unknown options are an error with the usage text.
 class ArgReader {

@@ -3,9 +3,13 @@
 #include <OSD.hxx>
 #include <Standard_Failure.hxx>
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -64,6 +68,13 @@ std::string serial_stats_json(long tets, double seconds_run) {
                     {"cpu_seconds", cpu},
                     {"peak_mb", usage.ru_maxrss / 1e3}}};
   return j.dump(2);
+}
+
+std::string amg_option(ArgReader& reader) {
+  const std::string amg = reader.option("amg", "gamg");
+  if (amg != "gamg" && amg != "boomeramg")
+    throw Error(ErrorCode::InvalidParameter, "--amg takes gamg or boomeramg, not '" + amg + "'");
+  return amg;
 }
 
 ArgReader::ArgReader(const Args& args, std::string usage)
@@ -186,15 +197,49 @@ int run_command(const std::function<int(const topopt::cli::Args&)>& command, con
   }
 }
 
+#ifdef TOPOPT_MPI_COMPANION
+/// The serial `topopt` under mpirun: replaces this process by the PETSc-linked companion
+/// (TOPOPT_MPI_COMPANION, built next to this executable) with the same arguments, so that the
+/// launcher's rank and environment carry over. Returns only when that fails, with the message
+/// for the user. argv: main's, null-terminated.
+std::string hand_over_to_companion(char** argv) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return "cannot find this executable's folder (/proc/self/exe) to start " TOPOPT_MPI_COMPANION;
+  const std::string companion = (self.parent_path() / TOPOPT_MPI_COMPANION).string();
+  std::vector<char*> arguments{const_cast<char*>(companion.c_str())};
+  for (char** a = argv + 1; *a; ++a) arguments.push_back(*a);
+  arguments.push_back(nullptr);
+  ::execv(companion.c_str(), arguments.data());
+  return "cannot start " + companion + " (" + std::strerror(errno) +
+         "), the build of topopt that runs on several MPI ranks: rebuild (scripts/build) or run without mpirun";
+}
+#endif
+
 /// mpirun -np N topopt COMMAND ...: solve and optimize on all ranks (rank 0 reads, meshes and
-/// writes; the others serve its runs); any other command, or a build without PETSc, is refused
-/// with a message from rank 0 and exit code 2 on every rank.
-int run_on_ranks(const char* name, const topopt::cli::Args& args) {
+/// writes; the others serve its runs); the serial build hands them over to its PETSc-linked
+/// companion (topopt-mpi). Any other command, or a build without PETSc, is refused with a
+/// message from rank 0 and exit code 2 on every rank.
+int run_on_ranks(int argc, char** argv) {
   using namespace topopt::cli;
+  const char* name = argv[1];
+  const Args args(argv + 2, argv + argc);
   const bool distributable = !std::strcmp(name, "solve") || !std::strcmp(name, "optimize");
+#ifdef TOPOPT_MPI_COMPANION
+  if (distributable) {
+    const std::string why = hand_over_to_companion(argv);
+    if (launched_rank() == 0) std::cerr << "topopt " << name << ": " << why << "\n";
+    return 2;
+  }
+#endif
 #ifdef TOPOPT_WITH_PETSC
   if (distributable) {
-    topopt::dist::MpiSession session;
+    // an error inside a run, on any rank, is printed by that rank as a serial run prints it
+    // (with the rank), then ends every rank with its exit code
+    const topopt::dist::MpiSession session([name](std::exception_ptr failure, int rank) {
+      const std::string label = std::string(name) + " (MPI rank " + std::to_string(rank) + ")";
+      return run_command([&](const Args&) -> int { std::rethrow_exception(failure); }, {}, label.c_str());
+    });
     if (session.rank() != 0) {
       topopt::dist::serve_ranks(session);
       return 0;
@@ -243,6 +288,6 @@ int main(int argc, char** argv) {
   // No floating-point traps: the core relies on IEEE arithmetic. Foreign geometry is read in
   // child processes that reset these handlers (brep/foreign.h).
   OSD::SetSignal(Standard_False);
-  if (launched_ranks() > 1) return run_on_ranks(argv[1], Args(argv + 2, argv + argc));
+  if (launched_ranks() > 1) return run_on_ranks(argc, argv);
   return run_command(it->second, Args(argv + 2, argv + argc), argv[1]);
 }

@@ -11,6 +11,23 @@
 #include "fem/tet_element.h"
 
 namespace topopt::dist {
+namespace {
+
+/// Puts `name value` in PETSc's options database unless PETSC_OPTIONS already gave `name`.
+void option_unless_given(const char* name, const char* value) {
+  PetscBool given = PETSC_FALSE;
+  check_petsc(PetscOptionsHasName(nullptr, nullptr, name, &given), "PetscOptionsHasName");
+  if (!given) check_petsc(PetscOptionsSetValue(nullptr, name, value), "PetscOptionsSetValue");
+}
+
+}  // namespace
+
+Amg amg_named(const std::string& name) {
+  if (name == "gamg") return Amg::GAMG;
+  if (name == "boomeramg") return Amg::BoomerAMG;
+  throw Error(ErrorCode::InvalidParameter,
+              "--amg takes gamg (PETSc's smoothed aggregation) or boomeramg (hypre's), not '" + name + "'");
+}
 
 struct DistElasticity::Impl {
   const MpiSession& session;
@@ -129,7 +146,16 @@ void DistElasticity::Impl::create_solver() {
   check_petsc(KSPSetType(ksp, KSPCG), "KSPSetType");
   PC pc;
   KSPGetPC(ksp, &pc);
-  check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
+  if (params.amg == Amg::BoomerAMG) {
+    // nodal coarsening (the block of a node's 3 dofs, by the Frobenius norm) and interpolation
+    // that keeps the nodes' dofs together: hypre's settings for elasticity systems
+    check_petsc(PCSetType(pc, PCHYPRE), "PCSetType");
+    check_petsc(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+    option_unless_given("-pc_hypre_boomeramg_nodal_coarsen", "6");
+    option_unless_given("-pc_hypre_boomeramg_vec_interp_variant", "3");
+  } else {
+    check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
+  }
   check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
   check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
   check_petsc(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE), "KSPSetInitialGuessNonzero");

@@ -1,21 +1,33 @@
 // Linear elasticity on the distributed mesh, on PETSc: a MatMPIAIJ (block size 3) whose
 // pattern is preallocated once from the ranks' tets (MatPreallocator) and whose values are
-// refilled for every new set of element factors, solved by CG with algebraic multigrid (GAMG,
-// the six rigid-body modes as near-null space; PETSC_OPTIONS may name another, e.g.
-// "-pc_type hypre"). Held dofs (supports, unused nodes) are left out of the element matrices
-// and get a diagonal entry alone, so the matrix stays symmetric positive definite.
+// refilled for every new set of element factors, solved by CG with algebraic multigrid (GAMG
+// with the six rigid-body modes as near-null space, or hypre's BoomerAMG with nodal coarsening:
+// DistSolverParams::amg; PETSC_OPTIONS may override either). Held dofs (supports, unused nodes) are left out of the
+// element matrices and get a diagonal entry alone, so the matrix stays symmetric positive definite.
 #pragma once
 #include <memory>
+#include <string>
 
 #include "dist/dist_mesh.h"
 #include "fem/elasticity.h"
 
 namespace topopt::dist {
 
+/// The algebraic multigrid preconditioning CG (bench/scale/amg.py measured them, BENCHMARKS.md).
+enum class Amg : int {
+  GAMG,       ///< PETSc's smoothed aggregation, the six rigid-body modes as near-null space
+  BoomerAMG,  ///< hypre's classical AMG, nodal coarsening on the 3 dofs of a node
+};
+
 struct DistSolverParams {
   double tolerance = 1e-8;    ///< relative residual ‖b − K u‖ / ‖b‖
   int max_iterations = 5000;  ///< CG iterations per solve
+  Amg amg = Amg::GAMG;        ///< the preconditioner (PETSC_OPTIONS may still override it)
 };
+
+/// The Amg named `name` ("gamg" or "boomeramg"); throws Error(InvalidParameter) naming the
+/// choices for anything else.
+Amg amg_named(const std::string& name);
 
 class DistElasticity {
  public:

@@ -61,16 +61,39 @@ struct Layout {
   std::vector<char> fixed;         // 3 #V
 };
 
+}  // namespace
+
+std::vector<int> node_owners(const MatX4i& T, long nodes, const std::vector<int>& part, int ranks) {
+  std::vector<int> low(nodes, ranks), high(nodes, -1);
+  for (long t = 0; t < T.rows(); ++t)
+    for (int a = 0; a < 4; ++a) {
+      const int n = T(t, a);
+      low[n] = std::min(low[n], part[t]);
+      high[n] = std::max(high[n], part[t]);
+    }
+  // nodes inside one rank's tets first, then each shared node to the less loaded of its two
+  std::vector<int> owner(nodes, 0);
+  std::vector<long> load(ranks, 0);
+  for (long n = 0; n < nodes; ++n)
+    if (high[n] >= 0 && low[n] == high[n]) ++load[owner[n] = low[n]];
+  for (long n = 0; n < nodes; ++n)
+    if (high[n] >= 0 && low[n] != high[n]) ++load[owner[n] = load[high[n]] < load[low[n]] ? high[n] : low[n]];
+  return owner;
+}
+
+namespace {
+
 Layout make_layout(const TetMesh& mesh, const std::vector<int>& part, const fem::Supports& supports, int ranks,
                    DistMesh& d) {
   const long nv = mesh.V.rows();
   Layout L;
-  L.owner.assign(nv, ranks);
-  for (long t = 0; t < mesh.T.rows(); ++t)
-    for (int a = 0; a < 4; ++a) L.owner[mesh.T(t, a)] = std::min(L.owner[mesh.T(t, a)], part[t]);
+  L.owner = node_owners(mesh.T, nv, part, ranks);
   L.fixed.assign(3 * nv, 0);
+  std::vector<char> used(nv, 0);
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    for (int a = 0; a < 4; ++a) used[mesh.T(t, a)] = 1;
   for (long n = 0; n < nv; ++n)
-    if (L.owner[n] == ranks) L.owner[n] = 0, L.fixed[3 * n] = L.fixed[3 * n + 1] = L.fixed[3 * n + 2] = 1;
+    if (!used[n]) L.fixed[3 * n] = L.fixed[3 * n + 1] = L.fixed[3 * n + 2] = 1;
   for (size_t k = 0; k < supports.dofs.size(); ++k) {
     if (supports.values[k] != 0)
       throw Error(ErrorCode::InvalidParameter,

@@ -3,7 +3,9 @@
 // partition's), the nodes it owns and the ghost nodes — nodes of its tets owned by another
 // rank — so that a rank assembles, filters and differentiates its own tets without asking.
 //
-// Numbering: a node belongs to the lowest rank among its tets'. Global node numbers (PETSc's
+// Numbering: a node belongs to one of the ranks among its tets' (node_owners: a shared node to
+// the less loaded of the lowest and the highest, so that the ranks own about as many nodes
+// each as the partition allows). Global node numbers (PETSc's
 // rows, divided by 3 for the dofs) run rank by rank, each rank's owned nodes contiguous in the
 // serial order; on a rank the local nodes are its owned ones, then its ghosts by global number.
 #pragma once
@@ -33,6 +35,13 @@ struct DistMesh {
   std::vector<int> tets_per_rank;   ///< #ranks
   std::vector<int> nodes_per_rank;  ///< #ranks: owned nodes
 };
+
+/// The rank owning each node. A node inside one rank's tets: that rank; a node of no tet: rank 0;
+/// a shared node, in node order: of the lowest and the highest rank among its tets', the one that
+/// owns fewer nodes so far (the nodes inside a rank's tets counted first), so that the owned
+/// nodes, PETSc's rows, balance as well as the partition allows. T: #T by 4, nodes: #V, part:
+/// #T ranks in [0, ranks). Returns #V ranks.
+std::vector<int> node_owners(const MatX4i& T, long nodes, const std::vector<int>& part, int ranks);
 
 /// Distributes the serial mesh. Collective. On rank 0: mesh, part (#T ranks, partition_tets),
 /// supports (fixed dofs; prescribed values must be 0) and loads ((3 #V) by #cases); the other

@@ -2,6 +2,7 @@
 #include "dist/dist_run.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <thread>
 #include <type_traits>
@@ -85,11 +86,21 @@ std::vector<RankStats> gather_stats(const MpiSession& s, const RankStats& mine) 
   return all;
 }
 
+/// Test hook of tests/cpp/dist/cli_mpi_test.cpp: a rank started with TOPOPT_DIST_TEST_FAULT=1
+/// in its environment (which the test gives one rank only) fails here, after the distribution,
+/// as an error on that rank alone would: the other ranks are then inside collective calls.
+void test_fault(const MpiSession& s) {
+  const char* fault = std::getenv("TOPOPT_DIST_TEST_FAULT");
+  if (fault && std::string(fault) == "1")
+    throw Error(ErrorCode::Internal, "the fault TOPOPT_DIST_TEST_FAULT=1 asks for, on rank " +
+                                         std::to_string(s.rank()) + " only (a test of how errors end every rank)");
+}
+
 /// One run on every rank, the settings already shared (broadcast): rank 0 passes the serial
 /// problem, the others empty ones.
-Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, const fem::Supports& supports,
-           const Eigen::MatrixXd& loads, std::vector<double> weights, const Progress& progress,
-           const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+Answer run_here(const MpiSession& s, const Settings& settings, const TetMesh& mesh, const fem::Supports& supports,
+                const Eigen::MatrixXd& loads, std::vector<double> weights, const Progress& progress,
+                const std::function<void(const simp::IterationRecord&)>& on_iteration) {
   weights.resize(settings.cases);
   MPI_Bcast(weights.data(), settings.cases, MPI_DOUBLE, 0, s.comm());
   RankStats mine;
@@ -97,6 +108,7 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
   auto t0 = std::chrono::steady_clock::now();
   const DistMesh dm = distribute_mesh(s, mesh, partition_tets(s, mesh.T), supports, loads);
   mine.seconds_distribute = seconds_since(t0);
+  test_fault(s);
   mine.tets = dm.local.T.rows();
   mine.owned_nodes = dm.owned_nodes;
   mine.ghost_nodes = dm.local.V.rows() - dm.owned_nodes;
@@ -109,6 +121,7 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
   if (settings.command == Command::Solve) {
     DistElasticity fe(s, dm, settings.material, settings.solver);
     const Eigen::MatrixXd U = fe.solve(dm.loads);
+    mine.solver_iterations = fe.last_iterations();
     a.U = gather_nodes(s, dm, U.topRows(3 * dm.owned_nodes));
     for (long k = 0; k < U.cols(); ++k) a.von_mises.push_back(gather_tets(s, dm, fe.von_mises(U.col(k))));
   } else {
@@ -120,6 +133,18 @@ Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, c
   mine.cpu_seconds = cpu_seconds();
   a.stats = gather_stats(s, mine);
   return a;
+}
+
+/// run_here, where an error on any rank ends every rank (MpiSession::end_run) with its message:
+/// the failing rank cannot tell the others, which wait for it in a collective call.
+Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, const fem::Supports& supports,
+           const Eigen::MatrixXd& loads, const std::vector<double>& weights, const Progress& progress,
+           const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+  try {
+    return run_here(s, settings, mesh, supports, loads, weights, progress, on_iteration);
+  } catch (...) {
+    s.end_run(std::current_exception());
+  }
 }
 
 }  // namespace
@@ -144,7 +169,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
                                    const std::vector<double>& weights, const simp::SimpParams& params,
                                    const Progress& progress,
                                    const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                                   const Eigen::Matrix3Xd& gravity, std::vector<RankStats>* stats) {
+                                   const Eigen::Matrix3Xd& gravity, Amg amg, std::vector<RankStats>* stats) {
   simp::check_params(params);
   simp::check_volume_fraction(params.volume_fraction);
   check_distributable(params, gravity.size() && !gravity.isZero());
@@ -154,6 +179,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
   settings.simp = SimpCore::of(params);
   settings.solver.tolerance = params.solver.tolerance;
   settings.solver.max_iterations = params.solver.max_iterations;
+  settings.solver.amg = amg;
   settings.cases = static_cast<int>(loads.cols());
   simp::FilterParams& f = settings.simp.filter;
   f.radius = simp::filter_radius(mesh, f);
@@ -175,11 +201,7 @@ void serve_ranks(const MpiSession& session) {
     Settings settings;
     share_settings(session, settings);
     if (settings.command == Command::Stop) return;
-    try {
-      run(session, settings, TetMesh(), fem::Supports(), Eigen::MatrixXd(), {}, {}, {});
-    } catch (const Error&) {
-      // rank 0 meets the same error (every failure of a run is collective) and reports it
-    }
+    run(session, settings, TetMesh(), fem::Supports(), Eigen::MatrixXd(), {}, {}, {});
   }
 }
 
@@ -200,7 +222,8 @@ std::string stats_json(const std::vector<RankStats>& stats) {
                              {"seconds_distribute", r.seconds_distribute},
                              {"seconds_run", r.seconds_run},
                              {"cpu_seconds", r.cpu_seconds},
-                             {"peak_mb", r.peak_bytes / 1e6}});
+                             {"peak_mb", r.peak_bytes / 1e6},
+                             {"solver_iterations", r.solver_iterations}});
   return j.dump(2);
 }
 

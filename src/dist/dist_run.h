@@ -4,6 +4,11 @@
 // mesh with its ghost layer (dist_mesh.h), run on every rank and gather the answer on rank 0 in
 // the serial mesh's numbering, so that the pipeline writes the same files as a serial run. The
 // other ranks sit in serve_ranks until rank 0 calls release_ranks.
+//
+// Errors: one raised on rank 0 before a run starts (reading, meshing, check_distributable) is
+// reported there as in a serial run, and release_ranks ends the others. One raised inside a run,
+// on any rank, ends every rank (MpiSession::end_run: the message, then MPI_Abort), since the
+// other ranks may be waiting for the failing one inside a collective call.
 #pragma once
 #include <functional>
 #include <string>
@@ -23,6 +28,7 @@ struct RankStats {
   double seconds_run = 0;         ///< the solve, or SIMP
   double peak_bytes = 0;          ///< peak resident memory of the process so far
   double cpu_seconds = 0;         ///< user + system CPU time of the process so far
+  int solver_iterations = 0;      ///< CG iterations of the last FE solve (the largest over the cases)
 };
 
 /// Rank 0: solves the load cases ((3 #V) by #cases loads; supports at zero) on all ranks.
@@ -34,24 +40,25 @@ void solve_on_ranks(const MpiSession& session, const TetMesh& mesh, const fem::M
 
 /// Rank 0: SIMP on all ranks, as simp::optimize with the same arguments; the filter becomes
 /// the Helmholtz one (an explicit kind is replaced by the Helmholtz filter standing in for it,
-/// said through progress.info). Throws Error(InvalidParameter) before any distributed work for
-/// what check_distributable refuses. Collective with serve_ranks on the others.
+/// said through progress.info); amg: the preconditioner of the FE solves. Throws
+/// Error(InvalidParameter) before any distributed work for what check_distributable refuses.
+/// Collective with serve_ranks on the others.
 simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mesh, const fem::Material& material,
                                    const fem::Supports& supports, const Eigen::MatrixXd& loads,
                                    const std::vector<double>& weights, const simp::SimpParams& params,
                                    const Progress& progress,
                                    const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                                   const Eigen::Matrix3Xd& gravity, std::vector<RankStats>* stats = nullptr);
+                                   const Eigen::Matrix3Xd& gravity, Amg amg, std::vector<RankStats>* stats = nullptr);
 
 /// Ranks other than 0: takes part in every run rank 0 starts until it calls release_ranks. An
-/// error of a run is rank 0's to report; serving goes on.
+/// error inside a run ends every rank (MpiSession::end_run).
 void serve_ranks(const MpiSession& session);
 
 /// Rank 0: ends serve_ranks on the other ranks (once, at the end, also after an error).
 void release_ranks(const MpiSession& session);
 
 /// The per-rank figures as JSON text: {"ranks": N, "per_rank": [{rank, tets, owned_nodes,
-/// ghost_nodes, seconds_distribute, seconds_run, cpu_seconds, peak_mb}, ...]}.
+/// ghost_nodes, seconds_distribute, seconds_run, cpu_seconds, peak_mb, solver_iterations}, ...]}.
 std::string stats_json(const std::vector<RankStats>& stats);
 
 }  // namespace topopt::dist

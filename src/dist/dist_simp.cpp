@@ -183,7 +183,9 @@ simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, 
     auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn, nullptr) - params.volume_fraction; };
     const VecXd xnew = simp::oc_update(x, dc, dv.cwiseMax(1e-30), moves.at(x), excess);
     const double change = max_all(session, num_design ? (xnew - x).cwiseAbs().maxCoeff() : 0.0);
-    simp::IterationRecord rec{it, c, vol, change, schedule.beta(), problem.grey_share(x), 0};
+    simp::IterationRecord rec;
+    rec.iteration = it, rec.compliance = c, rec.volume_fraction = vol, rec.change = change;
+    rec.beta = schedule.beta(), rec.grey = problem.grey_share(x);
     x = xnew;
     rec.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     res.history.push_back(rec);

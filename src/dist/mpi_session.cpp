@@ -4,11 +4,14 @@
 #include <petscsys.h>
 #include <sys/resource.h>
 
+#include <cstdlib>
+#include <iostream>
+
 #include "common/error.h"
 
 namespace topopt::dist {
 
-MpiSession::MpiSession() {
+MpiSession::MpiSession(FailureReport report) : report_(std::move(report)) {
   check_petsc(PetscInitializeNoArguments(), "PetscInitialize");
   comm_ = PETSC_COMM_WORLD;
   MPI_Comm_rank(comm_, &rank_);
@@ -16,6 +19,24 @@ MpiSession::MpiSession() {
 }
 
 MpiSession::~MpiSession() { PetscFinalize(); }
+
+void MpiSession::end_run(std::exception_ptr failure) const {
+  int code = 1;
+  if (report_) {
+    code = report_(failure, rank_);
+  } else {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const std::exception& e) {
+      std::cerr << "error on MPI rank " << rank_ << ": " << e.what() << std::endl;
+    } catch (...) {
+      std::cerr << "error on MPI rank " << rank_ << std::endl;
+    }
+  }
+  std::cerr.flush();
+  MPI_Abort(comm_, code);
+  std::abort();  // MPI_Abort does not return; should it, no rank goes on
+}
 
 void check_petsc(int code, const char* what) {
   if (code == 0) return;

@@ -4,16 +4,23 @@
 #pragma once
 #include <mpi.h>
 
+#include <exception>
+#include <functional>
 #include <string>
 
 namespace topopt::dist {
 
+/// How an error that ends a distributed run is put to the user: `failure` (what was thrown on
+/// this rank), `rank` (this process's); prints the message and returns the exit code.
+using FailureReport = std::function<int(std::exception_ptr failure, int rank)>;
+
 class MpiSession {
  public:
   /// Initialises PETSc (and MPI) without command-line arguments; PETSc's own options come
-  /// from the environment variable PETSC_OPTIONS (e.g. "-pc_type hypre"). Throws
-  /// Error(Internal) when PETSc cannot start.
-  MpiSession();
+  /// from the environment variable PETSC_OPTIONS (e.g. "-pc_type hypre"). report: see
+  /// end_run (empty: the message alone on stderr, exit code 1). Throws Error(Internal) when
+  /// PETSc cannot start.
+  explicit MpiSession(FailureReport report = {});
   ~MpiSession();
   MpiSession(const MpiSession&) = delete;
   MpiSession& operator=(const MpiSession&) = delete;
@@ -22,7 +29,13 @@ class MpiSession {
   int rank() const { return rank_; }
   int size() const { return size_; }
 
+  /// Ends every rank after `failure` escaped this rank's part of a run: reports it (the
+  /// FailureReport, on this rank), then MPI_Abort with the exit code it returned. The other
+  /// ranks may be waiting for this one in a collective call and would otherwise wait forever.
+  [[noreturn]] void end_run(std::exception_ptr failure) const;
+
  private:
+  FailureReport report_;
   MPI_Comm comm_ = MPI_COMM_WORLD;
   int rank_ = 0, size_ = 1;
 };

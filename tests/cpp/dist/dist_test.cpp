@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <set>
 
 #include "dist/dist_elasticity.h"
@@ -60,7 +62,7 @@ TEST(DistMesh, PartitionIsBalancedAndGhostsHoldTheOwnersData) {
   EXPECT_EQ(tets[0] + tets[1], d.total_tets);
   // PT-Scotch balances the tets to a few per cent
   EXPECT_LT(std::abs(tets[0] - tets[1]), 0.1 * d.total_tets) << tets[0] << " and " << tets[1];
-  // a node belongs to the lowest of its tets' ranks: the ranks above hold the shared ones as ghosts
+  // a shared node is owned by one rank (node_owners) and a ghost on the other
   long ghosts = d.local.V.rows() - d.owned_nodes;
   MPI_Allreduce(MPI_IN_PLACE, &ghosts, 1, MPI_LONG, MPI_SUM, session().comm());
   EXPECT_GT(ghosts, 0) << "two parts of one beam share nodes";
@@ -86,6 +88,43 @@ TEST(DistMesh, PartitionIsBalancedAndGhostsHoldTheOwnersData) {
       for (int a = 0; a < 4; ++a)
         EXPECT_EQ(d.serial_node[d.node_global[d.local.T(t, a)]], b.mesh.T(d.tet_serial[t], a));
   }
+}
+
+/// node_owners on a box of 20 × 10 × 10 cells cut at x = cut into rank 0 (x < cut) and rank 1:
+/// checks that nodes off the cut belong to their side and returns how many of the 11 × 11
+/// nodes on the cut each rank owns.
+std::array<long, 2> owners_on_cut(double cut) {
+  mesh::StructuredBoxParams p;
+  p.size = {20, 10, 10};
+  p.cells = {20, 10, 10};
+  const TetMesh m = mesh::structured_box_mesh(p);
+  std::vector<int> part(m.T.rows());
+  for (long t = 0; t < m.T.rows(); ++t) {
+    double x = 0;
+    for (int a = 0; a < 4; ++a) x += m.V(m.T(t, a), 0) / 4;
+    part[t] = x < cut ? 0 : 1;
+  }
+  const std::vector<int> owner = node_owners(m.T, m.V.rows(), part, 2);
+  std::array<long, 2> on_cut{0, 0};
+  for (long n = 0; n < m.V.rows(); ++n) {
+    const double x = m.V(n, 0);
+    if (std::abs(x - cut) < 1e-9) {
+      ++on_cut[owner[n]];
+    } else {
+      EXPECT_EQ(owner[n], x < cut ? 0 : 1) << "node " << n << " at x = " << x << " lies in one rank's tets only";
+    }
+  }
+  EXPECT_EQ(on_cut[0] + on_cut[1], 121);
+  return on_cut;
+}
+
+TEST(DistMesh, SharedNodesGoToTheLessLoadedRank) {
+  // cut in the middle: both sides own 10 × 121 nodes of their own, the cut's split evenly
+  const std::array<long, 2> middle = owners_on_cut(10);
+  EXPECT_LE(std::abs(middle[0] - middle[1]), 1) << middle[0] << " and " << middle[1];
+  // cut at x = 6: rank 0 owns 6 × 121 nodes of its own, rank 1 14 × 121: the cut goes to rank 0
+  const std::array<long, 2> off = owners_on_cut(6);
+  EXPECT_EQ(off[0], 121) << off[1] << " shared nodes on the more loaded rank 1";
 }
 
 TEST(DistElasticity, DisplacementsEqualTheSerialSolve) {
@@ -156,7 +195,7 @@ TEST(DistSimp, OptimizeEqualsTheSerialRun) {
   params.solver.tolerance = 1e-9;
   if (!root()) return serve_ranks(session());
   const simp::SimpResult distributed =
-      optimize_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, {}, params, {}, {}, {});
+      optimize_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, {}, params, {}, {}, {}, Amg::GAMG);
   release_ranks(session());
   params.solver.kind = fem::SolverKind::Direct;
   const simp::SimpResult serial = simp::optimize(b.mesh, b.material, b.supports, b.loads, {}, params);
