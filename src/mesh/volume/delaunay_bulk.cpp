@@ -9,7 +9,6 @@
 
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
-#include "mesh/core/tet_quality.h"
 #include "mesh/volume/background_size.h"
 
 namespace topopt::mesh {
@@ -82,10 +81,12 @@ class Tets {
     return -1;
   }
 
-  /// The Bowyer–Watson cavity of node p, lying in tet t: the tets whose circumsphere holds it
-  /// strictly (connected, never through a wall) in cavity_, their faces on its boundary in
-  /// boundary_. False when p is not strictly inside t's circumsphere. Changes no tet.
-  bool find_cavity(int p, int t) {
+  /// Inserts node p, lying in tet t: the tets whose circumsphere holds it strictly (connected,
+  /// never through a wall) are replaced by the star of p on their boundary. Refused, mesh
+  /// unchanged, when p is an existing node, does not see every boundary face strictly (a
+  /// wall in the way) or comes nearer than sqrt(min_dist2) to a node of those faces (the
+  /// only nodes it would be joined to). The new tets go to `created` when given.
+  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0) {
     const double* q = x(p);
     auto in_sphere = [&](int s) {
       const auto& w = v[s];
@@ -111,34 +112,6 @@ class Tets {
         }
       }
     }
-    return true;
-  }
-
-  /// The worst radius ratio of the star that inserting node p in tet t would make, and whether
-  /// that star would replace tet `must_hold`; -1 when p is refused (not in t's circumsphere,
-  /// or not strictly inside every face of its cavity). Changes no tet.
-  double star_worst(int p, int t, int must_hold, bool& holds) {
-    holds = false;
-    if (!find_cavity(p, t)) return -1;
-    double worst = 1;
-    for (const auto& [s, i] : boundary_) {
-      const int* f = kFace[i];
-      const int a = v[s][f[0]], b = v[s][f[1]], c = v[s][f[2]];
-      if (orient3d(x(a), x(b), x(c), x(p)) >= 0) return -1;
-      worst = std::min(worst, radius_ratio(P_[a], P_[c], P_[b], P_[p]));
-    }
-    holds = std::find(cavity_.begin(), cavity_.end(), must_hold) != cavity_.end();
-    return worst;
-  }
-
-  /// Inserts node p, lying in tet t: the tets whose circumsphere holds it strictly (connected,
-  /// never through a wall) are replaced by the star of p on their boundary. Refused, mesh
-  /// unchanged, when p is an existing node, does not see every boundary face strictly (a
-  /// wall in the way) or comes nearer than sqrt(min_dist2) to a node of those faces (the
-  /// only nodes it would be joined to). The new tets go to `created` when given.
-  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0) {
-    const double* q = x(p);
-    if (!find_cavity(p, t)) return false;
     for (const auto& [s, i] : boundary_) {
       const int* f = kFace[i];
       const int a = v[s][f[0]], b = v[s][f[1]], c = v[s][f[2]];
@@ -457,82 +430,6 @@ long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const Delaun
   return points;
 }
 
-/// Radius ratio of tet t.
-double tet_rho(const Tets& m, const std::vector<Vec3>& P, int t) {
-  const auto& w = m.v[t];
-  return radius_ratio(P[w[0]], P[w[1]], P[w[2]], P[w[3]]);
-}
-
-/// Where a point may take sliver t out: its circumcentre, and its centroid moved along the
-/// normal of the pair of opposite edges that cross most squarely (the direction in which a
-/// sliver is flat) by up to 0.7 of its longest edge, either way.
-std::vector<Vec3> sliver_points(const Tets& m, const std::vector<Vec3>& P, int t) {
-  const auto& w = m.v[t];
-  std::vector<Vec3> out;
-  Vec3 c;
-  const Vec3 g = (P[w[0]] + P[w[1]] + P[w[2]] + P[w[3]]) / 4;
-  double longest = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (P[w[i]] - P[w[j]]).norm());
-  if (std::isfinite(circumcentre(m, P, t, c)) && (c - g).norm() < 2 * longest) out.push_back(c);
-  Vec3 n = Vec3::Zero();
-  constexpr int kOpposite[3][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}};
-  for (const auto& [i, j, k, l] : kOpposite) {
-    const Vec3 cr = (P[w[j]] - P[w[i]]).cross(P[w[l]] - P[w[k]]);
-    if (cr.norm() > n.norm()) n = cr;
-  }
-  if (!(n.norm() > 0)) return out;
-  n.normalize();
-  for (double s : {0.15, 0.3, 0.45, 0.6, 0.75})
-    for (double sign : {1.0, -1.0}) out.push_back(g + sign * s * longest * n);
-  return out;
-}
-
-/// Shape refinement after the size's: each tet below params.shape_below (worst first; the
-/// slivers the size never refines, e.g. four boundary nodes on a gently curved face) is
-/// taken out by the Delaunay insertion of the candidate point (sliver_points) whose star is
-/// best, when that star holds it and its worst tet reaches params.shape_target. Returns the
-/// points inserted.
-long refine_shape(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const DelaunayBulkParams& params,
-                  const Progress& progress) {
-  if (!(params.shape_below > 0)) return 0;
-  std::vector<std::pair<double, int>> slivers;
-  for (size_t t = 0; t < m.v.size(); ++t)
-    if (!m.dead[t]) {
-      const double r = tet_rho(m, P, static_cast<int>(t));
-      if (r < params.shape_below) slivers.push_back({r, static_cast<int>(t)});
-    }
-  std::sort(slivers.begin(), slivers.end());
-  std::vector<unsigned> gen0(slivers.size());
-  for (size_t k = 0; k < slivers.size(); ++k) gen0[k] = m.gen[slivers[k].second];
-  long points = 0;
-  for (size_t k = 0; k < slivers.size(); ++k) {
-    const int t = slivers[k].second;
-    if (m.dead[t] || m.gen[t] != gen0[k]) continue;  // taken out by an earlier insertion
-    if (k % 256 == 0) progress.check_cancel("volume meshing (bulk slivers)");
-    double best = params.shape_target;
-    Vec3 at = Vec3::Zero();
-    int in = -1;
-    for (const Vec3& q : sliver_points(m, P, t)) {
-      const int s = m.locate(t, q.data());
-      if (s < 0) continue;
-      P.push_back(q);
-      bool holds = false;
-      const double w = m.star_worst(static_cast<int>(P.size()) - 1, s, t, holds);
-      P.pop_back();
-      if (holds && w > best) best = w, at = q, in = s;
-    }
-    if (in < 0) continue;
-    P.push_back(at);
-    hs.push_back(std::min({hs[m.v[t][0]], hs[m.v[t][1]], hs[m.v[t][2]], hs[m.v[t][3]]}));
-    if (m.insert(static_cast<int>(P.size()) - 1, in, nullptr))
-      ++points;
-    else
-      P.pop_back(), hs.pop_back();
-  }
-  return points;
-}
-
 }  // namespace
 
 DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::array<int, 3>>& B,
@@ -554,7 +451,6 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
   }
   keep_inside(m, held, tets_near_missing(m, P, B, held.found), far0);
   out.points = refine(m, P, hs, params, progress);
-  out.shape_points = refine_shape(m, P, hs, params, progress);
   for (size_t t = 0; t < m.v.size(); ++t) {
     if (m.dead[t]) continue;
     out.tets.push_back(m.v[t]);

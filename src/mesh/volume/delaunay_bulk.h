@@ -24,10 +24,6 @@ struct DelaunayBulkParams {
   /// h has 0.61 h; 0.95 gives about as many tets as Gmsh and the front at the same size).
   double refine_above = 0.95;
   long max_tets = 20'000'000;  ///< stop refining beyond (the caller checks memory)
-  /// Then each tet below this radius ratio (0: none) is taken out by inserting a point near it
-  /// (its circumcentre or off its flat side) whose Delaunay star has no tet below shape_target.
-  double shape_below = 0.1;
-  double shape_target = 0.15;
   /// Give up before refining (no tets, P as it was) when more than this share of the boundary
   /// triangles is missing from the tetrahedralisation.
   double max_missing_share = 1.0;
@@ -38,8 +34,7 @@ struct DelaunayBulkResult {
   std::vector<std::array<int, 3>>
       free_faces;              ///< faces of one tet only, turned out of it: boundary triangles and the holes' faces
   long missing_triangles = 0;  ///< boundary triangles the tetrahedralisation lacked
-  long points = 0;             ///< points inserted inside for the size
-  long shape_points = 0;       ///< and to take slivers out (DelaunayBulkParams::shape_below)
+  long points = 0;             ///< points inserted inside
   bool gave_up = false;        ///< over max_missing_share missing: no tets, P as it was
 };
 

@@ -2,8 +2,7 @@
 // tetrahedralisation; a convex hull's faces are always held; refinement keeps the volume);
 // on the rocker's surface its tets lie inside, refined to the size; triangles it lacks are
 // left to the front, which closes the holes; past the allowed share of missing triangles it
-// gives up and leaves the nodes as they were; the slivers of boundary nodes under a curved
-// face, which the size never refines, are taken out by the shape refinement.
+// gives up and leaves the nodes as they were.
 #include "mesh/volume/delaunay_bulk.h"
 
 #include <gtest/gtest.h>
@@ -15,7 +14,6 @@
 
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
-#include "mesh/core/tet_quality.h"
 #include "mesh/volume/volume_checks.h"
 
 namespace topopt::mesh {
@@ -238,74 +236,6 @@ TEST(DelaunayBulk, GivesUpPastTheAllowedShareOfMissingTrianglesAndLeavesTheNodes
   EXPECT_GT(r.missing_triangles, 0);
   EXPECT_TRUE(r.tets.empty());
   EXPECT_EQ(static_cast<long>(P.size()), V.rows()) << "P as it was";
-}
-
-/// An icosphere of radius r: the icosahedron's faces split in four `levels` times, every node
-/// on the sphere; P: its nodes, B: its triangles turned outwards.
-void icosphere(double r, int levels, std::vector<Eigen::Vector3d>& P, std::vector<std::array<int, 3>>& B) {
-  const double g = (1 + std::sqrt(5.0)) / 2;
-  P = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
-       {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
-  B = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-       {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<int, int>, int> mid;
-    auto middle = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      P.push_back((P[a] + P[b]) / 2);
-      return mid[key] = static_cast<int>(P.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> finer;
-    for (const auto& [a, b, c] : B) {
-      const int ab = middle(a, b), bc = middle(b, c), ca = middle(c, a);
-      finer.insert(finer.end(), {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}});
-    }
-    B = std::move(finer);
-  }
-  for (Eigen::Vector3d& p : P) p *= r / p.norm();
-}
-
-TEST(DelaunayBulk, ShapeRefinementTakesOutTheSliversOfBoundaryNodesUnderACurvedFace) {
-  // a sphere of radius 16 with 1 mm triangles filled at size 9 (as NIST 6's half-cylinders:
-  // radius 15.9, 1 mm triangles, size 9.4): four nearby boundary nodes are nearly coplanar, and
-  // the Delaunay tets they make under the surface are slivers small enough for the size
-  std::vector<Eigen::Vector3d> P0;
-  std::vector<std::array<int, 3>> B;
-  icosphere(16, 4, P0, B);
-  auto fill = [&](double shape_below, std::vector<Eigen::Vector3d>& P) {
-    P = P0;
-    DelaunayBulkParams dp;
-    dp.size = [](const double*) { return 9.0; };
-    dp.shape_below = shape_below;
-    return delaunay_bulk(P, B, dp);
-  };
-  auto below = [](const std::vector<Eigen::Vector3d>& P, const DelaunayBulkResult& r, double floor) {
-    long n = 0;
-    for (const auto& t : r.tets) n += radius_ratio(P[t[0]], P[t[1]], P[t[2]], P[t[3]]) < floor;
-    return n;
-  };
-  std::vector<Eigen::Vector3d> P;
-  const DelaunayBulkResult without = fill(0, P);
-  ASSERT_EQ(without.missing_triangles, 0);
-  const long slivers = below(P, without, 0.1);
-  EXPECT_GT(slivers, 0) << "the case this test is about: slivers the size leaves";
-  EXPECT_EQ(without.shape_points, 0);
-  const DelaunayBulkResult with = fill(0.1, P);
-  EXPECT_GT(with.shape_points, 0);
-  EXPECT_EQ(below(P, with, 0.1), 0) << slivers << " slivers without the shape refinement";
-  double sum = 0, volume = 0;
-  for (const auto& t : with.tets) {
-    EXPECT_GT(predicates::orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data()), 0);
-    sum += tet_volume(P, t);
-  }
-  for (const auto& f : B) volume += P[f[0]].dot(P[f[1]].cross(P[f[2]])) / 6;
-  EXPECT_NEAR(sum, volume, 1e-9 * volume) << "the tets fill the sphere's polyhedron exactly";
-  std::map<std::array<int, 3>, int> free;
-  for (const auto& f : with.free_faces) ++free[face_key(f[0], f[1], f[2])];
-  EXPECT_EQ(free.size(), B.size()) << "the boundary is held: no hole for the front";
 }
 
 }  // namespace
