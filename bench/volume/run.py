@@ -123,11 +123,13 @@ def product_row(topopt, part, nd, factor, tmp):
                                          check=True).stdout)
         lo, hi = info["part"]["bbox"]["min"], info["part"]["bbox"]["max"]
         cmd += ["--size", repr(factor * sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5 / 50)]
-    t = time.perf_counter()
+    import resource
+    t, cpu0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
     p = subprocess.run(cmd, capture_output=True, text=True)
-    dt = time.perf_counter() - t
+    dt, cpu1 = time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)  # the load does not change it
     if not os.path.exists(stats):
-        return {"error": p.stderr.strip()[-400:], "seconds": dt}
+        return {"error": p.stderr.strip()[-400:], "seconds": dt, "cpu_seconds": round(cpu, 1)}
     s = json.load(open(stats))
     P, T = read_msh_tets(msh)
     rmin, below1, below2, dih = quality_shares(P, T)
@@ -135,7 +137,7 @@ def product_row(topopt, part, nd, factor, tmp):
     os.remove(stats)
     return {"tets": len(T), "rr_min": rmin, "below_0.1": below1, "below_0.2": below2, "dihedral_min": dih,
             "conformity": c["ok"], "flat": c.get("flat_tets", "-"), "inverted": c["inverted_tets"],
-            "seconds": round(dt, 1), "mesh_seconds": round(s["seconds"]["mesh"], 1)}
+            "seconds": round(dt, 1), "cpu_seconds": round(cpu, 1), "mesh_seconds": round(s["seconds"]["mesh"], 1)}
 
 
 def product(args):

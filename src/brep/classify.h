@@ -33,6 +33,9 @@ struct ClassifyParams {
   int edge_samples = 7;
   /// Upper bound on the samples taken on a face (from a coarse triangulation's centroids).
   int face_samples = 24;
+  /// CPU seconds (of the calling thread) the imprint of the part's boundary on the non-design
+  /// solids may take (imprint.h) before it stops with Error(Timeout); must be > 0.
+  double imprint_seconds = 120;
 };
 
 /// Classification of every entity of `other` against `base`.

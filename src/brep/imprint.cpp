@@ -5,11 +5,14 @@
 #include <BRepBuilderAPI_Copy.hxx>
 #include <BRep_Builder.hxx>
 #include <Bnd_Box.hxx>
+#include <Message_ProgressIndicator.hxx>
 #include <TopExp.hxx>
 #include <TopTools_DataMapOfShapeInteger.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopTools_ListOfShape.hxx>
 #include <TopoDS_Compound.hxx>
+#include <cmath>
+#include <ctime>
 #include <string>
 
 #include "common/error.h"
@@ -17,8 +20,37 @@
 namespace topopt::brep {
 namespace {
 
-/// Runs the General Fuse of Ω̄'s solids (objects) with Ω (tool); throws when OCCT refuses.
-void run_splitter(BOPAlgo_Splitter& splitter, const TopologyIndex& part, const TopologyIndex& nondesign, double fuzzy) {
+/// CPU seconds the calling thread has used (the splitter runs on it: SetRunParallel(false)).
+double thread_cpu_seconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// OCCT's progress indicator for the split: it asks OCCT to stop (UserBreak) once the thread
+/// has spent its CPU budget or the caller cancels, and remembers which of the two it was.
+class SplitBudget : public Message_ProgressIndicator {
+ public:
+  SplitBudget(double seconds, const Progress& progress) : end_(thread_cpu_seconds() + seconds), progress_(progress) {}
+  Standard_Boolean UserBreak() override {
+    if (progress_.cancelled && progress_.cancelled()) cancelled_ = true;
+    if (!cancelled_ && thread_cpu_seconds() > end_) expired_ = true;
+    return cancelled_ || expired_;
+  }
+  void Show(const Message_ProgressScope&, const Standard_Boolean) override {}
+  bool expired() const { return expired_; }
+  bool cancelled() const { return cancelled_; }
+
+ private:
+  double end_;
+  const Progress& progress_;
+  bool expired_ = false, cancelled_ = false;
+};
+
+/// Runs the General Fuse of Ω̄'s solids (objects) with Ω (tool) within `seconds` of CPU time;
+/// throws when OCCT refuses, when the budget is spent (Timeout) or on a cancel.
+void run_splitter(BOPAlgo_Splitter& splitter, const TopologyIndex& part, const TopologyIndex& nondesign, double fuzzy,
+                  double seconds, const Progress& progress) {
   TopTools_ListOfShape objects, tools;
   for (int i = 1; i <= nondesign.num_solids(); ++i) objects.Append(nondesign.solids(i));
   tools.Append(part.solids(1));
@@ -27,7 +59,16 @@ void run_splitter(BOPAlgo_Splitter& splitter, const TopologyIndex& part, const T
   splitter.SetFuzzyValue(fuzzy);
   splitter.SetNonDestructive(true);
   splitter.SetRunParallel(false);
-  splitter.Perform();
+  Handle(SplitBudget) budget = new SplitBudget(seconds, progress);
+  splitter.Perform(budget->Start());
+  if (budget->cancelled())
+    throw Error(ErrorCode::Cancelled, "cancelled during imprinting the part's boundary on the non-design solids");
+  if (budget->expired())
+    throw Error(ErrorCode::Timeout,
+                "imprinting the part's boundary on the non-design solids did not finish within its budget of " +
+                    std::to_string(static_cast<long>(std::ceil(seconds))) +
+                    " s of computing: simplify the non-design solids where they reach the part's surface (fewer, "
+                    "simpler faces there), or mesh with --mesher gmsh");
   if (splitter.HasErrors())
     throw Error(ErrorCode::InvalidShape,
                 "could not imprint the part's boundary on the non-design solids (where they reach the part's "
@@ -69,9 +110,9 @@ int count(const TopoDS_Shape& shape, TopAbs_ShapeEnum kind) {
 }  // namespace
 
 TopoDS_Shape split_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign, double fuzzy,
-                             std::vector<int>& face_origin) {
+                             std::vector<int>& face_origin, double seconds, const Progress& progress) {
   BOPAlgo_Splitter splitter;
-  run_splitter(splitter, part, nondesign, fuzzy);
+  run_splitter(splitter, part, nondesign, fuzzy, seconds, progress);
   TopoDS_Compound out;
   BRep_Builder builder;
   builder.MakeCompound(out);
@@ -112,13 +153,14 @@ MeshedNonDesign without_imprint(const TopologyIndex& nondesign, const Classifica
 
 MeshedNonDesign meshed_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign,
                                  const Classification& on_part, const ContainmentReport& relations,
-                                 const ClassifyParams& params) {
+                                 const ClassifyParams& params, const Progress& progress) {
   MeshedNonDesign m;
   bool changed = false;
   std::vector<int> origin;
   TopoDS_Shape split;
   if (nondesign.num_solids() > 0) {
-    split = split_nondesign(part, nondesign, coincidence_tolerance(part, params), origin);
+    split =
+        split_nondesign(part, nondesign, coincidence_tolerance(part, params), origin, params.imprint_seconds, progress);
     TopTools_IndexedMapOfShape solids;
     TopExp::MapShapes(split, TopAbs_SOLID, solids);
     for (int i = 1; i <= nondesign.num_solids() && !changed; ++i)

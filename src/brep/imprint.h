@@ -10,6 +10,7 @@
 
 #include "brep/classify.h"
 #include "brep/topology_index.h"
+#include "common/progress.h"
 
 namespace topopt::brep {
 
@@ -29,10 +30,12 @@ struct MeshedNonDesign {
 /// (check_containment passed). `fuzzy`: the distance below which two entities coincide (model
 /// units). Returns a compound of N solids in input order, each with faces of its own (a face
 /// where two solids touch is copied into each), and in `face_origin` (resized to the result's
-/// face count, TopExp numbering) the input face each face comes from. Throws
-/// Error(InvalidShape) when the split fails or cuts a solid into pieces, naming the solid.
+/// face count, TopExp numbering) the input face each face comes from. `seconds`: the CPU time
+/// (of the calling thread) the split may take; OCCT is asked to stop past it, or when
+/// `progress` says cancelled. Throws Error(InvalidShape) when the split fails or cuts a solid
+/// into pieces, naming the solid; Error(Timeout) past `seconds`, Error(Cancelled) on a cancel.
 TopoDS_Shape split_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign, double fuzzy,
-                             std::vector<int>& face_origin);
+                             std::vector<int>& face_origin, double seconds = 120, const Progress& progress = {});
 
 /// `nondesign` as it is, with its classification and relations (no imprint; face_origin the
 /// identity).
@@ -43,9 +46,10 @@ MeshedNonDesign without_imprint(const TopologyIndex& nondesign, const Classifica
 /// of it lies partly on Ω's boundary or on another non-design solid, else its imprint
 /// (split_nondesign) classified afresh. The test is the imprint itself: a split that leaves
 /// every solid's face and edge counts unchanged changes nothing, and the input is kept (so
-/// meshes of parts without partial contact do not change).
+/// meshes of parts without partial contact do not change). The split runs within
+/// params.imprint_seconds of CPU time: past it, Error(Timeout) naming the stage and what to do.
 MeshedNonDesign meshed_nondesign(const TopologyIndex& part, const TopologyIndex& nondesign,
                                  const Classification& on_part, const ContainmentReport& relations,
-                                 const ClassifyParams& params = {});
+                                 const ClassifyParams& params = {}, const Progress& progress = {});
 
 }  // namespace topopt::brep

@@ -31,8 +31,9 @@ TwoBReps load_two_breps(const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
   m.nd_on_part = guard_occt("classifying the non-design solids against the part",
                             [&] { return classify(m.part, m.nondesign, params); });
   progress.say("brep", 0.85, "imprinting the part's boundary on the non-design solids");
-  m.meshed = guard_occt("imprinting the part's boundary on the non-design solids",
-                        [&] { return meshed_nondesign(m.part, m.nondesign, m.nd_on_part, m.relations, params); });
+  m.meshed = guard_occt("imprinting the part's boundary on the non-design solids", [&] {
+    return meshed_nondesign(m.part, m.nondesign, m.nd_on_part, m.relations, params, progress);
+  });
   progress.say("brep", 1.0, "inputs ready");
   return m;
 }

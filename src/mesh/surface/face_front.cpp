@@ -249,13 +249,14 @@ class FaceFill {
   /// Advances until the front is closed. Throws Error(MeshingFailed) where it cannot close,
   /// Error(TooLarge) past params.max_triangles.
   void run(const Progress& progress) {
-    long since_progress = 0;
+    long since_progress = 0, steps = 0;
     while (front_.alive_count() > 0) {
       if (queue_.empty()) throw Error(ErrorCode::Internal, "face front: the queue ran dry with an open front");
       const int e = queue_.top().second;
       queue_.pop();
       if (!front_.alive(e)) continue;
-      if (tris_.size() % 4096 == 0) progress.check_cancel("face meshing");
+      // by steps, not triangles: a front retrying its edges without adding any is checked too
+      if (++steps % 1024 == 0) progress.check_cancel("face meshing");
       if (static_cast<long>(tris_.size()) >= params_.max_triangles)
         throw Error(ErrorCode::TooLarge, "face front: more than the allowed number of triangles; raise the mesh size");
       const Reach g = reach(e);

@@ -92,5 +92,34 @@ TEST(Imprint, ModelsWithoutPartialContactAreKeptAsTheyAre) {
   }
 }
 
+TEST(Imprint, PastItsBudgetTheImprintStopsWithATimeoutNamingTheStage) {
+  const auto fx = testing::plate_with_bosses_on_one_side();
+  ClassifyParams params;
+  params.imprint_seconds = 1e-6;  // spent before OCCT's first check
+  try {
+    load_two_breps(fx.part, fx.nondesign, params);
+    FAIL() << "the imprint ran past its budget without stopping";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Timeout) << e.what();
+    EXPECT_NE(std::string(e.what()).find("imprinting the part's boundary"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--mesher gmsh"), std::string::npos) << e.what();
+  }
+  params.imprint_seconds = 120;  // the default: the same fixture imprints
+  EXPECT_TRUE(load_two_breps(fx.part, fx.nondesign, params).meshed.imprinted);
+}
+
+TEST(Imprint, ACancelStopsTheImprint) {
+  const auto fx = testing::plate_with_bosses_on_one_side();
+  const TwoBReps m = load_two_breps(fx.part, fx.nondesign);
+  Progress cancel;
+  cancel.cancelled = [] { return true; };
+  try {
+    meshed_nondesign(m.part, m.nondesign, m.nd_on_part, m.relations, {}, cancel);
+    FAIL() << "a cancel did not stop the imprint";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Cancelled) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace topopt::brep

@@ -142,6 +142,24 @@ TEST(FaceFront, SquareAndSquareWithHole) {
   }
 }
 
+TEST(FaceFront, ACancelStopsTheFront) {
+  // the front checks for a cancel (and so the native mesher's time budget) every 1024 steps,
+  // counted whether or not a step made a triangle, so a front retrying edges is stopped too
+  Builder b;
+  b.loop({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, 0.01);  // about 20 000 triangles to make
+  const FaceFrontInput in = b.input();
+  long asked = 0;
+  Progress cancel;
+  cancel.cancelled = [&asked] { return ++asked > 0; };
+  try {
+    fill_face(in, {}, cancel);
+    FAIL() << "the front ran to its end through a cancel";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Cancelled) << e.what();
+  }
+  EXPECT_EQ(asked, 1) << "asked once and stopped";
+}
+
 TEST(FaceFront, PrePlacedTrianglesAreKept) {
   // A strip of triangles along the bottom of a 2 x 2 square, and a lone triangle touching the
   // top side at a single node: the front starts from their free edges.
