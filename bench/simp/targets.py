@@ -17,7 +17,7 @@ Single core = pinned to CPU 0 (taskset) with OpenMP and OpenBLAS at one thread (
 CPU = user + sys of the child. Every study reports iterations, final compliance and the grey share
 of the last design (elements with 0.1 < rho < 0.9) so that speed is never bought with a worse design.
 
-Status (2026-12-02): the cantilever and rocker parts have run (BENCHMARKS.md); the solve, memory
+Status (2026-12-02): the cantilever, rocker and solve parts have run (BENCHMARKS.md); the memory
 and threads parts were written but have not run yet.
 
 usage: bench/simp/targets.py [--build build] [--skip-memory] [--memory-sizes 0.67,0.53] [--skip-threads]
