@@ -93,14 +93,16 @@ the workbench's threshold slider, so a re-extraction warns as the optimisation d
 }
 
 /// One iteration as Python sees it: {"iteration", "compliance", "volume", "change", "seconds",
-/// "displacements", "stress", "frequency", "frequency_repeated"} (per displacement limit, the
-/// largest |u| over the load cases, mm; with a stress limit the largest relaxed von Mises stress,
-/// MPa, else 0; with the frequency objective the first eigenfrequency in Hz, else 0).
+/// "displacements", "stress_relaxed", "stress_crisp", "frequency", "frequency_repeated"} (per
+/// displacement limit, the largest |u| over the load cases, mm; with a stress limit the largest
+/// relaxed von Mises stress and the crisp design's largest, MPa, else 0; with the frequency objective the first
+/// eigenfrequency in Hz, else 0).
 pyb::dict record_dict(const simp::IterationRecord& rec) {
   pyb::dict d;
   d["iteration"] = rec.iteration, d["compliance"] = rec.compliance, d["volume"] = rec.volume_fraction,
   d["change"] = rec.change, d["seconds"] = rec.seconds, d["displacements"] = rec.displacements,
-  d["stress"] = rec.stress, d["frequency"] = rec.frequency, d["frequency_repeated"] = rec.repeated;
+  d["stress_relaxed"] = rec.stress_relaxed, d["stress_crisp"] = rec.stress_crisp, d["frequency"] = rec.frequency,
+  d["frequency_repeated"] = rec.repeated;
   return d;
 }
 
@@ -176,10 +178,10 @@ void bind_simp(pyb::module_& m) {
 job_json: job file text (docs/job-format.md; faces by FreeCAD name). part_brep, nondesign_brep:
 BREP strings (Shape.exportBrepToString()), unless the job names a mesh file. callback(dict) is
 called with {"stage", "fraction", "message"} while meshing and {"iteration", "compliance",
-"volume", "change", "seconds", "displacements", "stress", "frequency", "frequency_repeated"}
-after each iteration (displacements: per displacement limit of the job, the largest |u| over
-the load cases in mm; stress: with a stress limit, the largest relaxed von Mises stress in MPa,
-else 0; frequency: with "objective": "frequency", the first eigenfrequency in Hz, else 0); returning True cancels (TopOptError with
+"volume", "change", "seconds", "displacements", "stress_relaxed", "stress_crisp", "frequency",
+"frequency_repeated"} after each iteration (displacements: per displacement limit of the job, the
+largest |u| over the load cases in mm; stress_relaxed and stress_crisp: with a stress limit, the
+largest relaxed von Mises stress and the crisp design's largest in MPa, else 0; frequency: with "objective": "frequency", the first eigenfrequency in Hz, else 0); returning True cancels (TopOptError with
 .code "Cancelled"). Returns a dict: nodes #V x 3, tets #T x 4, domain #T, boundary_triangles,
 boundary_faces, boundary_nondesign_faces, densities #T, history (list of dicts), threshold,
 surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, seconds (simp,

@@ -75,7 +75,8 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
                             {"grey", h.grey},
                             {"seconds", h.seconds},
                             {"displacements", h.displacements},
-                            {"stress", h.stress},
+                            {"stress_relaxed", h.stress_relaxed},
+                            {"stress_crisp", h.stress_crisp},
                             {"frequency", h.frequency},
                             {"frequency_repeated", h.repeated}});
   std::ofstream f(path);

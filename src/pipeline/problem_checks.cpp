@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "simp/optimizer.h"
+#include "simp/responses/responses.h"
 
 namespace topopt::pipeline {
 namespace {
@@ -148,13 +149,14 @@ double physical_memory_bytes() {
 std::string not_crisp_warning(const simp::SimpResult& result, const simp::SimpParams& params) {
   if (result.converged || result.history.empty()) return {};
   const simp::IterationRecord& last = result.history.back();
-  const bool short_of_beta = params.projection.enabled && last.beta < params.projection.beta_max;
+  const double beta_max = simp::update_settings(params).projection.beta_max;  // lower under a stress limit
+  const bool short_of_beta = params.projection.enabled && last.beta < beta_max;
   const double grey_limit = 0.03;  // issue 19: a crisp design has at most 3 % grey volume
   if (!short_of_beta && last.grey <= grey_limit) return {};
   std::ostringstream m;
   m << std::setprecision(3) << "the optimisation stopped at its iteration cap (" << params.max_iterations
     << ") before the design was crisp: ";
-  if (short_of_beta) m << "the projection reached β = " << last.beta << " of " << params.projection.beta_max << ", ";
+  if (short_of_beta) m << "the projection reached β = " << last.beta << " of " << beta_max << ", ";
   m << 100 * last.grey << " % of the design volume is grey (0.1 < ρ < 0.9); the result surface cuts through "
     << "material the optimiser had not decided on. Raise 'optimization.max_iterations' (MaxIterations in the "
     << "study) and run again";

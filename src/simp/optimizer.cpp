@@ -234,7 +234,8 @@ void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult
   msg << "iteration " << rec.iteration << ": compliance " << rec.compliance << ", volume " << rec.volume_fraction
       << ", change " << rec.change;
   for (double u : rec.displacements) msg << ", displacement " << u << " mm";
-  if (rec.stress > 0) msg << ", stress " << rec.stress << " MPa";
+  if (rec.stress_relaxed > 0)
+    msg << ", stress " << rec.stress_relaxed << " MPa relaxed, " << rec.stress_crisp << " MPa crisp";
   if (rec.frequency > 0)
     msg << ", first eigenfrequency " << rec.frequency << " Hz" << (rec.repeated ? " (repeated)" : "");
   if (rec.beta != 1) msg << ", beta " << rec.beta << ", grey " << 100 * rec.grey << " %";
@@ -260,10 +261,11 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   res.design = problem.design();
   const int num_design = static_cast<int>(res.design.size());
   check_responses(params, 3 * mesh.V.rows());
-  Responses responses(params, material.density);
+  Responses responses(params, material, supports, loads);
   const int num_variables = problem.num_variables();
-  DesignUpdate update(params, num_variables, responses.constraints(static_cast<int>(loads.cols())));
-  Continuation schedule(params.projection, params.tol_change, params.tol_objective);
+  const SimpParams stepping = update_settings(params);  // smaller steps under a stress limit
+  DesignUpdate update(stepping, num_variables, responses.constraints(static_cast<int>(loads.cols())));
+  Continuation schedule(stepping.projection, params.tol_change, params.tol_objective);
   VecXd x = VecXd::Constant(num_variables, params.volume_fraction);
   for (int it = 1; it <= params.max_iterations; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -286,7 +288,8 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
                         problem.grey_share(x),
                         0,
                         mma.displacements,
-                        mma.stress,
+                        mma.stress_relaxed,
+                        mma.stress_crisp,
                         mma.frequency,
                         mma.repeated};
     x = xnew;

@@ -47,8 +47,12 @@ struct IterationRecord {
   double seconds = 0;          ///< wall time of this iteration
   /// Per DisplacementLimit, the largest |u_d| over the load cases (mm); empty without limits.
   std::vector<double> displacements;
-  /// With a stress limit: the largest relaxed von Mises stress ρ̄^q σ0 of the elements (MPa).
-  double stress = 0;
+  /// With a stress limit: the largest relaxed von Mises stress ρ̄^q σ0 of the elements (MPa),
+  /// what the constraint holds ...
+  double stress_relaxed = 0;
+  /// ... and the largest von Mises stress of this iteration's crisp design (ρ̄ >= 0.5 solid, the
+  /// rest void, analysed anew; over its solid tets), what the part will see (MPa).
+  double stress_crisp = 0;
   /// Frequency objective: the first eigenfrequency (Hz), and whether the second equals it
   /// (within 0.1 %: the eigenvalue's gradient is then not defined).
   double frequency = 0;

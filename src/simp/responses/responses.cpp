@@ -1,6 +1,7 @@
 // Displacement responses and the MMA terms of each objective (see responses.h).
 #include "simp/responses/responses.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/error.h"
@@ -67,7 +68,7 @@ void Responses::add_objective(ComplianceProblem& problem, MmaTerms& t, int& row,
     return;
   }
   VecXd grad;
-  const fem::ModalResult modes = first_eigenvalue(problem, density_, r, modes_, &grad);
+  const fem::ModalResult modes = first_eigenvalue(problem, material_.density, r, modes_, &grad);
   const double lambda = modes.eigenvalues[0];
   if (first_eigenvalue_ <= 0) first_eigenvalue_ = std::max(1e-300, std::abs(lambda));
   t.f0 = -lambda / first_eigenvalue_, t.df0 = -grad / first_eigenvalue_, t.objective = lambda;
@@ -84,7 +85,21 @@ void Responses::add_stress(ComplianceProblem& problem, MmaTerms& t, int& row) {
     t.f[row] = stress_scale_[k] * pn[k] - 1;
     t.df.row(row++) = stress_scale_[k] * grad.col(k).transpose();
   }
-  t.stress = largest.maxCoeff() * params_.responses.stress_limit;
+  t.stress_relaxed = largest.maxCoeff() * params_.responses.stress_limit;
+  const TetMesh& mesh = problem.elasticity().mesh();
+  VecXd density = VecXd::Ones(mesh.T.rows());
+  const VecXd& rho = problem.physical_densities();
+  for (size_t i = 0; i < problem.design().size(); ++i) density[problem.design()[i]] = rho[i];
+  t.stress_crisp = crisp_max_von_mises(mesh, material_, supports_, loads_, density);
+}
+
+SimpParams update_settings(const SimpParams& params) {
+  SimpParams s = params;
+  if (params.responses.stress_limit > 0) {
+    s.move = std::min(s.move, 0.05);
+    s.projection.beta_max = std::min(s.projection.beta_max, std::max(8.0, s.projection.beta_start));
+  }
+  return s;
 }
 
 void check_responses(const SimpParams& params, long num_dofs) {

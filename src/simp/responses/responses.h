@@ -24,7 +24,8 @@ struct MmaTerms {
   VecXd f;                            ///< #m constraint values
   Eigen::MatrixXd df;                 ///< m by #D
   std::vector<double> displacements;  ///< per DisplacementLimit, the largest |u_d| over the cases (mm)
-  double stress = 0;                  ///< with a stress limit: the largest relaxed von Mises (MPa)
+  double stress_relaxed = 0;          ///< with a stress limit: the largest relaxed von Mises ρ̄^q σ0 (MPa)
+  double stress_crisp = 0;            ///< ... and the crisp design's largest (crisp_max_von_mises, MPa)
   double frequency = 0;               ///< Frequency objective: the first eigenfrequency (Hz)
   bool repeated = false;              ///< ... and whether it is repeated (the second within 0.1 %)
   double objective = 0;               ///< the objective's own value: c, the volume fraction or λ1
@@ -34,8 +35,12 @@ struct MmaTerms {
 /// adaptive normalisation needs from the earlier iterations.
 class Responses {
  public:
-  /// density: the material's mass density (t/mm³), for the Frequency objective.
-  Responses(const SimpParams& params, double density) : params_(params), density_(density) {}
+  /// material: its mass density (t/mm³) is the Frequency objective's; material, supports and
+  /// loads ((3*#V) by #cases, as optimize() is given them) are the crisp design's analysis
+  /// under a stress limit. All are kept by reference and must outlive this object.
+  Responses(const SimpParams& params, const fem::Material& material, const fem::Supports& supports,
+            const Eigen::MatrixXd& loads)
+      : params_(params), material_(material), supports_(supports), loads_(loads) {}
   /// The number of constraints terms() gives with `num_cases` load cases.
   int constraints(int num_cases) const;
   /// The terms at the design of the last problem.compliance() call, given its compliance c,
@@ -50,7 +55,9 @@ class Responses {
 
  private:
   const SimpParams& params_;
-  double density_;
+  const fem::Material& material_;
+  const fem::Supports& supports_;
+  const Eigen::MatrixXd& loads_;
   VecXd stress_scale_;           // #cases: c_k of the last iteration (empty before the first)
   double first_eigenvalue_ = 0;  // λ1 of the first iteration (the objective's scale)
   Eigen::MatrixXd modes_;        // the last eigen subspace (the next one's start)
@@ -58,6 +65,15 @@ class Responses {
                      const VecXd& dv);
   void add_stress(ComplianceProblem& problem, MmaTerms& t, int& row);
 };
+
+/// The settings the design update and the β continuation run with: `params`, except that under
+/// a stress limit the move limit is at most 0.05 and β stops at 8. The p-norm's linearisation
+/// does not see that thinning every member at once raises the stress of all of them: with the
+/// move limit 0.2, MMA emptied the cantilever in six iterations. At high β only the grey
+/// surface layer can still move (the projection is flat elsewhere) and removing it lowers its
+/// own relaxed stress: the cantilever eroded to nothing after β was raised to 32, and in
+/// another run to 16, at the move limit 0.05 (docs/optimization.md).
+SimpParams update_settings(const SimpParams& params);
 
 /// Throws Error(InvalidParameter) for responses that cannot run: a mass objective without any
 /// limit, a compliance or displacement limit that is not positive, a gauge of the wrong size

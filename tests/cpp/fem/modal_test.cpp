@@ -6,14 +6,11 @@
 #include <unistd.h>
 
 #include <Eigen/Eigenvalues>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <regex>
-#include <sstream>
 
 #include "fem/boundary_conditions.h"
 #include "mesh/core/structured_box.h"
+#include "testing/ccx_modes.h"
 
 namespace topopt::fem {
 namespace {
@@ -99,45 +96,8 @@ TEST(Modal, RepeatedFirstEigenvalueIsReported) {
   EXPECT_FALSE(lowest_modes(fe, mat.density, {}, mp).first_repeated);
 }
 
-/// The lowest `modes` eigenfrequencies (Hz) of the mesh fixed at the given dofs, by ccx.
-std::vector<double> ccx_frequencies(const TetMesh& m, const Material& mat, const Supports& s, int modes,
-                                    const fs::path& dir) {
-  std::ofstream f(dir / "modes.inp");
-  f.precision(17);
-  f << "*NODE\n";
-  for (long i = 0; i < m.V.rows(); ++i)
-    f << i + 1 << ", " << m.V(i, 0) << ", " << m.V(i, 1) << ", " << m.V(i, 2) << "\n";
-  f << "*ELEMENT, TYPE=C3D4, ELSET=ALL\n";
-  for (long t = 0; t < m.T.rows(); ++t)
-    f << t + 1 << ", " << m.T(t, 0) + 1 << ", " << m.T(t, 1) + 1 << ", " << m.T(t, 2) + 1 << ", " << m.T(t, 3) + 1
-      << "\n";
-  f.precision(10);  // ccx reads a material card's numbers in fields of 20 characters
-  f << "*MATERIAL, NAME=M\n*ELASTIC\n" << mat.young << ", " << mat.poisson << "\n*DENSITY\n" << mat.density << "\n";
-  f << "*SOLID SECTION, ELSET=ALL, MATERIAL=M\n*BOUNDARY\n";
-  for (int d : s.dofs) f << d / 3 + 1 << ", " << d % 3 + 1 << ", " << d % 3 + 1 << ", 0\n";
-  f << "*STEP\n*FREQUENCY, SOLVER=SPOOLES\n" << modes << "\n*END STEP\n";
-  f.close();
-  const std::string cmd = "cd '" + dir.string() + "' && OMP_NUM_THREADS=1 ccx modes > ccx.log 2>&1";
-  if (std::system(cmd.c_str()) != 0) return {};
-  // the .dat's eigenvalue table: MODE NO, EIGENVALUE, (RAD/TIME), (CYCLES/TIME), ...
-  std::ifstream dat(dir / "modes.dat");
-  std::string line;
-  std::vector<double> hz;
-  bool table = false;
-  while (std::getline(dat, line)) {
-    if (line.find("E I G E N V A L U E   O U T P U T") != std::string::npos) table = true;
-    std::istringstream in(line);
-    int mode;
-    double lambda, omega, cycles;
-    if (table && (in >> mode >> lambda >> omega >> cycles) && mode == static_cast<int>(hz.size()) + 1)
-      hz.push_back(cycles);
-    if (static_cast<int>(hz.size()) == modes) break;
-  }
-  return hz;
-}
-
 TEST(CalculixAgreement, FirstEigenfrequenciesAgreeWithCcx) {
-  if (std::system("command -v ccx > /dev/null 2>&1") != 0) GTEST_SKIP() << "ccx is not installed";
+  if (!testing::have_ccx()) GTEST_SKIP() << "ccx is not installed";
   const TetMesh m = plate({12, 3, 2});
   const Material mat{70000, 0.33, 2.7e-9};
   const Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
@@ -147,7 +107,7 @@ TEST(CalculixAgreement, FirstEigenfrequenciesAgreeWithCcx) {
   const ModalResult ours = lowest_modes(fe, mat.density, {}, mp);
   const fs::path dir = fs::temp_directory_path() / ("topopt_ccx_modes_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const std::vector<double> theirs = ccx_frequencies(m, mat, s, 3, dir);
+  const std::vector<double> theirs = testing::ccx_frequencies(m, mat, s, 3, dir);
   ASSERT_EQ(theirs.size(), 3u) << "no eigenvalue table from ccx; see " << dir;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(ours.frequencies[k], theirs[k], 0.01 * theirs[k]) << "mode " << k + 1;
   EXPECT_GT(ours.frequencies[0], 0);

@@ -4,12 +4,20 @@
 #include "simp/responses/responses.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <map>
 #include <random>
+#include <set>
 
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "mesh/core/structured_box.h"
+#include "testing/ccx_modes.h"
 
 namespace topopt::simp {
 namespace {
@@ -41,6 +49,125 @@ Beam beam(std::array<int, 3> cells) {
 DisplacementLimit tip_limit(const Beam& b, const std::array<double, 3>& direction, double limit) {
   const fem::LoadSpec unit{fem::LoadSpec::Kind::Force, {2}, direction, 0, {}};
   return {"Face2", fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"gauge", {unit}, 1}}).col(0), limit};
+}
+
+/// The tets of `m` with keep[t], their nodes renumbered (unused ones dropped), the boundary
+/// triangles of `m` whose tet is kept with their face numbers; the faces the cut opens are free
+/// surface and get no triangles (nothing acts on them). domain as in `m`.
+TetMesh keep_tets(const TetMesh& m, const std::vector<bool>& keep) {
+  std::map<std::array<int, 3>, long> tet_of;  // a triangle of m's boundary -> its tet
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<int, 3> f;
+      for (int a = 0, k = 0; a < 4; ++a)
+        if (a != skip) f[k++] = m.T(t, a);
+      std::sort(f.begin(), f.end());
+      tet_of[f] = t;
+    }
+  std::vector<int> node(m.V.rows(), -1);
+  std::vector<long> tets, tris;
+  for (long t = 0; t < m.T.rows(); ++t)
+    if (keep[t]) tets.push_back(t);
+  for (long f = 0; f < m.F.rows(); ++f) {
+    std::array<int, 3> k{m.F(f, 0), m.F(f, 1), m.F(f, 2)};
+    std::sort(k.begin(), k.end());
+    if (keep[tet_of.at(k)]) tris.push_back(f);
+  }
+  TetMesh out;
+  int nv = 0;
+  out.T.resize(static_cast<long>(tets.size()), 4);
+  out.domain.resize(out.T.rows());
+  for (long i = 0; i < out.T.rows(); ++i) {
+    for (int a = 0; a < 4; ++a) {
+      int& n = node[m.T(tets[i], a)];
+      if (n < 0) n = nv++;
+      out.T(i, a) = n;
+    }
+    out.domain[i] = m.domain[tets[i]];
+  }
+  out.V.resize(nv, 3);
+  for (long v = 0; v < m.V.rows(); ++v)
+    if (node[v] >= 0) out.V.row(node[v]) = m.V.row(v);
+  out.F.resize(static_cast<long>(tris.size()), 3);
+  out.face.resize(out.F.rows());
+  out.nd_face = VecXi::Zero(out.F.rows());
+  for (long i = 0; i < out.F.rows(); ++i) {
+    for (int a = 0; a < 3; ++a) out.F(i, a) = node[m.F(tris[i], a)];
+    out.face[i] = m.face[tris[i]];
+  }
+  return out;
+}
+
+/// A 20 × 20 × 2 mm L (the square with its corner x > 8, y > 8 cut away), held at the top of
+/// its upright (Face4, y = 20) and pulled down (−y, 200 N) at the end of its arm (Face2,
+/// x = 20), which is a non-design load pad (x >= 18): the classic stress test, whose re-entrant
+/// corner at (8, 8) concentrates the stress of a design that keeps it sharp.
+Beam l_bracket() {
+  mesh::StructuredBoxParams p;
+  p.size = {20, 20, 2};
+  p.cells = {20, 20, 2};
+  p.nondesign = {{18, 0, 0, 20, 8, 2}};
+  const TetMesh box = mesh::structured_box_mesh(p);
+  std::vector<bool> keep(box.T.rows());
+  for (long t = 0; t < box.T.rows(); ++t) {
+    Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+    for (int a = 0; a < 4; ++a) c += box.V.row(box.T(t, a)) / 4;
+    keep[t] = !(c.x() > 8 && c.y() > 8);
+  }
+  Beam b;
+  b.mesh = keep_tets(box, keep);
+  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {4}}});
+  const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -200, 0}, 0, {}};
+  b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"down", {pull}, 1}});
+  return b;
+}
+
+/// True when the crisp design (tets with density >= 0.5, #T) has one face-connected piece that
+/// holds a tet of every non-design solid 1..num_pads and a tet on each of `supported` faces.
+bool one_piece_holds(const TetMesh& mesh, const VecXd& density, int num_pads, const std::vector<int>& supported) {
+  const long nt = mesh.T.rows();
+  std::vector<long> parent(nt);
+  for (long t = 0; t < nt; ++t) parent[t] = t;
+  std::function<long(long)> root = [&](long t) { return parent[t] == t ? t : parent[t] = root(parent[t]); };
+  std::map<std::array<int, 3>, long> seen;  // a face of a kept tet -> the tet
+  std::map<std::array<int, 3>, long> face_tet;
+  for (long t = 0; t < nt; ++t) {
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<int, 3> f;
+      for (int a = 0, k = 0; a < 4; ++a)
+        if (a != skip) f[k++] = mesh.T(t, a);
+      std::sort(f.begin(), f.end());
+      face_tet[f] = t;
+      if (density[t] < 0.5) continue;
+      auto [it, fresh] = seen.emplace(f, t);
+      if (!fresh) parent[root(t)] = root(it->second);
+    }
+  }
+  std::vector<std::set<long>> pieces_of;
+  for (int pad = 1; pad <= num_pads; ++pad) {
+    std::set<long> s;
+    for (long t = 0; t < nt; ++t)
+      if (mesh.domain[t] == pad) s.insert(root(t));
+    pieces_of.push_back(s);
+  }
+  for (int face : supported) {
+    std::set<long> s;
+    for (long f = 0; f < mesh.F.rows(); ++f) {
+      if (mesh.face[f] != face) continue;
+      std::array<int, 3> k{mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
+      std::sort(k.begin(), k.end());
+      const long t = face_tet.at(k);
+      if (density[t] >= 0.5) s.insert(root(t));
+    }
+    pieces_of.push_back(s);
+  }
+  // some piece is in every requirement's set
+  for (long piece : pieces_of.front()) {
+    bool all = true;
+    for (const std::set<long>& s : pieces_of) all = all && s.count(piece);
+    if (all) return true;
+  }
+  return false;
 }
 
 /// Central differences of face_displacement against its adjoint gradient at a random design.
@@ -222,7 +349,44 @@ TEST(Responses, MassUnderAStressLimitKeepsTheCrispDesignsStressWithinIt) {
   const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, r.density);
   EXPECT_LE(crisp, 1.05 * p.responses.stress_limit) << "solid block " << solid << " MPa";
   EXPECT_LT(r.history.back().volume_fraction, 0.7);
-  EXPECT_GT(r.history.back().stress, 0);
+  EXPECT_GT(r.history.back().stress_relaxed, 0);
+  // the history's crisp stress is this one's, up to the last update (the history's last record
+  // is the design before it; r.density after it)
+  EXPECT_NEAR(r.history.back().stress_crisp, crisp, 1e-3 * crisp);
+  // not asserted: its crisp cut at 0.5 is one piece holding the pad and Face1. On this coarse
+  // beam (filter radius 4 over 2 mm cells, β stopped at 8) it is not; the L bracket's is.
+}
+
+TEST(Responses, StressLimitRoundsTheReentrantCornerOfAnLBracket) {
+  // the lightest L under a stress limit, and the stiffest L of the same volume: the first must
+  // keep the limit on its crisp design and carry less stress than the second, whose re-entrant
+  // corner stays sharp
+  const Beam b = l_bracket();
+  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, VecXd::Ones(b.mesh.T.rows()));
+  SimpParams p;
+  p.filter.radius = 1.5;
+  p.update = UpdateKind::MMA;
+  p.max_iterations = 250;
+  p.volume_fraction = 0.8;
+  p.responses.objective = Objective::Mass;
+  p.responses.stress_limit = 1.2 * solid;
+  const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, r.density);
+  const double volume = r.history.back().volume_fraction;
+  EXPECT_LE(crisp, 1.1 * p.responses.stress_limit) << "solid L " << solid << " MPa";
+  EXPECT_GT(volume, 0.2);
+  EXPECT_LT(volume, 0.75);
+  EXPECT_TRUE(one_piece_holds(b.mesh, r.density, 1, {4}));
+  SimpParams stiff;
+  stiff.filter.radius = 1.5;
+  stiff.volume_fraction = volume;
+  stiff.max_iterations = 250;
+  const SimpResult c = optimize(b.mesh, b.mat, b.supports, b.loads, {}, stiff);
+  const double corner = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, c.density);
+  EXPECT_LT(crisp, corner) << "the compliance design of volume " << c.history.back().volume_fraction;
+  std::cout << "L bracket: solid " << solid << " MPa, limit " << p.responses.stress_limit << " MPa, stress design "
+            << crisp << " MPa at volume " << volume << " (" << r.history.size() << " iterations), compliance design "
+            << corner << " MPa at volume " << c.history.back().volume_fraction << "\n";
 }
 
 TEST(Responses, EigenvalueGradientMatchesFiniteDifferences) {
@@ -257,22 +421,44 @@ TEST(Responses, EigenvalueGradientMatchesFiniteDifferences) {
   }
 }
 
-TEST(Responses, FrequencyObjectiveRaisesTheFirstEigenfrequency) {
-  // the cantilever with its load pad as a tip mass: the uniform start at 40 % against the
-  // design that maximises the first eigenfrequency at the same volume
-  Beam b = beam({12, 4, 2});
+TEST(Responses, FrequencyDesignIsOnePieceWithTheLoadPadAndAgreesWithCcx) {
+  // the cantilever with its load pad as a tip mass: the design of 40 % that maximises the first
+  // eigenfrequency, carried through the β continuation to a crisp design, must hold the pad;
+  // its crisp design's (kept tets only) first eigenfrequency beats the uniform start's and
+  // agrees with CalculiX's on the same tets
+  Beam b = beam({24, 8, 4});
   SimpParams p;
   p.volume_fraction = 0.4;
-  p.filter.radius = 5;
+  p.filter.radius = 2.5;
   p.update = UpdateKind::MMA;
-  p.max_iterations = 40;
-  p.projection.enabled = false;
+  p.move = 0.1;
+  p.max_iterations = 300;
   p.responses.objective = Objective::Frequency;
   const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   ASSERT_GE(r.history.size(), 5u);
-  EXPECT_GT(r.history.front().frequency, 0);
-  EXPECT_GT(r.history.back().frequency, 1.1 * r.history.front().frequency);
+  EXPECT_EQ(r.history.back().beta, p.projection.beta_max);
   EXPECT_NEAR(r.history.back().volume_fraction, 0.4, 0.01);
+  EXPECT_TRUE(one_piece_holds(b.mesh, r.density, 1, {1}));
+  std::vector<bool> keep(b.mesh.T.rows());
+  for (long t = 0; t < b.mesh.T.rows(); ++t) keep[t] = r.density[t] >= 0.5;
+  const TetMesh crisp = keep_tets(b.mesh, keep);
+  const fem::Supports held = fem::make_supports(crisp, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  fem::Elasticity fe(crisp, b.mat, held);
+  const double ours = fem::lowest_modes(fe, b.mat.density, {}).frequencies[0];
+  const double uniform = r.history.front().frequency;
+  EXPECT_GT(ours, 1.2 * uniform);
+  // SIMP's last, nearly crisp iterate against the crisp design (grey tets and the void's e_min)
+  EXPECT_NEAR(r.history.back().frequency, ours, 0.05 * ours);
+  std::cout << "frequency design: uniform start " << uniform << " Hz, SIMP's last " << r.history.back().frequency
+            << " Hz, crisp " << ours << " Hz (" << r.history.size() << " iterations)\n";
+  if (!testing::have_ccx()) GTEST_SKIP() << "ccx is not installed";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("topopt_ccx_freq_design_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::vector<double> theirs = testing::ccx_frequencies(crisp, b.mat, held, 1, dir);
+  ASSERT_EQ(theirs.size(), 1u) << "no eigenvalue table from ccx; see " << dir;
+  EXPECT_NEAR(ours, theirs[0], 0.02 * theirs[0]);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Responses, RefusesWhatCannotRun) {
