@@ -7,6 +7,7 @@ time, all with OMP_NUM_THREADS=1 and one run after another in this one script; a
 the result surface (result.stl, rendered with matplotlib) in the work folder.
 
 usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
+                             [--controls free,draw]  (labels containing one of these words)
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, re, subprocess, sys, time
@@ -33,6 +34,8 @@ def controls_for(name, box):
            "extrusion along y": {"extrusion": [0, 1, 0]}}
     if name == "cantilever":
         out["pattern x (3 x 18 mm)"] = {"patterns": [{"direction": [1, 0, 0], "pitch": 18, "count": 3}]}
+    out["draw z one-sided"] = {"draw_direction": {"direction": [0, 0, 1]}}
+    out["draw z split at mid-height"] = {"draw_direction": {"direction": [0, 0, 1], "parting_point": mid}}
     return out
 
 
@@ -57,6 +60,7 @@ def main():
     ap.add_argument("--work", default="/tmp/controls_bench")
     ap.add_argument("--only", default="")
     ap.add_argument("--iterations", type=int, default=60)
+    ap.add_argument("--controls", default="", help="comma-separated words: run only the controls whose label has one")
     ap.add_argument("--pictures-only", action="store_true", help="render the result.stl files of an earlier run")
     a = ap.parse_args()
     if a.pictures_only:
@@ -77,6 +81,8 @@ def main():
         box = step_box(part)
         free_c = None
         for label, controls in controls_for(name, box).items():
+            if a.controls and not any(w in label for w in a.controls.split(",")):
+                continue
             slug = re.sub(r"[^a-z0-9]+", "_", label.lower()).strip("_")
             out = os.path.join(a.work, name + "_" + slug)
             opt = {"volume_fraction": 0.3, "max_iterations": a.iterations}

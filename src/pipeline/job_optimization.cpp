@@ -154,13 +154,31 @@ void each_item(const Fields& f, const std::string& key, const std::function<void
     one(Fields(f.at(key)[i], f.name(key) + "[" + std::to_string(i) + "]", keys, example));
 }
 
+/// "controls"."draw_direction": {"direction": [x, y, z], "parting_point": [x, y, z] (split
+/// casting when given), "cell": mm, "smoothness"} (docs/optimization.md).
+void parse_draw_direction(const Fields& controls, simp::DrawDirection& d) {
+  if (!controls.has("draw_direction")) return;
+  const Fields f(controls.at("draw_direction"), controls.name("draw_direction"),
+                 {"direction", "parting_point", "cell", "smoothness"},
+                 "{\"direction\": [0, 0, 1], \"parting_point\": [0, 0, 10]}");
+  d.enabled = true;
+  d.direction = vector3(f, "direction");
+  d.split = f.has("parting_point");
+  if (d.split) d.parting_point = Eigen::Vector3d(f.vec3("parting_point").data());
+  d.cell = f.number("cell", 0);
+  if (d.cell < 0) f.bad("cell", "must be positive (mm, the side of the draw grid's cells), or 0 for the tolerance");
+  d.smoothness = f.number("smoothness", d.smoothness);
+  if (!(d.smoothness > 0 && d.smoothness <= 0.01))
+    f.bad("smoothness", "must lie in (0, 0.01] (the ε of the smooth maximum along the columns; 1e-4 is usual)");
+}
+
 /// "controls": {"symmetry_planes": [{"point", "normal"}], "cyclic": [{"point", "axis",
 /// "sectors"}], "patterns": [{"direction", "pitch", "count"}], "extrusion": [x, y, z],
-/// "tolerance"} (docs/optimization.md).
+/// "draw_direction": {...}, "tolerance"} (docs/optimization.md).
 void parse_controls(const Fields& opt, simp::ControlsParams& c) {
   if (!opt.has("controls")) return;
   const Fields f(opt.at("controls"), opt.name("controls"),
-                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "tolerance"},
+                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "draw_direction", "tolerance"},
                  "{\"symmetry_planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0]}]}");
   each_item(
       f, "symmetry_planes",
@@ -184,6 +202,7 @@ void parse_controls(const Fields& opt, simp::ControlsParams& c) {
       },
       {"direction", "pitch", "count"}, "{\"direction\": [1, 0, 0], \"pitch\": 20, \"count\": 3}");
   if (f.has("extrusion")) c.extrude = true, c.extrusion = vector3(f, "extrusion");
+  parse_draw_direction(f, c.draw);
   c.tolerance = f.number("tolerance", 0);
   if (c.tolerance < 0) f.bad("tolerance", "must be positive (mm), or 0 for the mean edge length");
 }

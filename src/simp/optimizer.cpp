@@ -8,6 +8,7 @@
 #include "common/blas_threads.h"
 #include "common/error.h"
 #include "simp/controls/design_map.h"
+#include "simp/controls/draw_filter.h"
 #include "simp/density_filter.h"
 #include "simp/responses/responses.h"
 #include "simp/update.h"
@@ -37,8 +38,8 @@ void check_params(const SimpParams& params) {
                 "beta and a threshold eta in (0, 1)");
   if (params.sensitivity_filter && params.controls.any())
     throw Error(ErrorCode::InvalidParameter,
-                "the geometry controls (symmetry, cyclic, pattern, extrusion) work with the density filter: "
-                "turn the sensitivity filter off");
+                "the geometry controls (symmetry, cyclic, pattern, extrusion, draw direction) work with the density "
+                "filter: turn the sensitivity filter off");
 }
 
 void check_volume_fraction(double volume_fraction, const std::string& name) {
@@ -73,7 +74,12 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   progress.info("filter: " + filter_->describe());
   const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
   controls_ = std::make_unique<DesignMap>(mesh, design_, params.controls, tolerance);
-  if (params.controls.any()) progress.info("controls: " + controls_->describe());
+  if (params.controls.ties()) progress.info("controls: " + controls_->describe());
+  if (params.controls.draw.enabled) {
+    const double cell = params.controls.draw.cell > 0 ? params.controls.draw.cell : tolerance;
+    draw_ = std::make_unique<DrawFilter>(design_centroids(mesh, design_), vd_, params.controls.draw, cell);
+    progress.info("controls: " + draw_->describe());
+  }
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())
@@ -84,16 +90,17 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   }
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
-  if (!params.projection.enabled)
+  if (!params.projection.enabled && !draw_)
     volume_weights_ =
         controls_->apply_transpose(params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
 }
 
 ComplianceProblem::~ComplianceProblem() = default;
 
-void ComplianceProblem::forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
+void ComplianceProblem::forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde, VecXd& rho_bar) const {
   const VecXd z = controls_->apply(x);
-  rho_tilde = params_.sensitivity_filter ? z : filter_->apply(z);
+  rho_filtered = params_.sensitivity_filter ? z : filter_->apply(z);
+  rho_tilde = draw_ ? draw_->apply(rho_filtered) : rho_filtered;
   rho_bar = rho_tilde;
   if (params_.projection.enabled)
     for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
@@ -104,14 +111,14 @@ int ComplianceProblem::num_variables() const { return controls_->num_variables()
 VecXd ComplianceProblem::design_field(const VecXd& x) const { return controls_->apply(x); }
 
 VecXd ComplianceProblem::physical(const VecXd& x) const {
-  VecXd rt, rb;
-  forward(x, rt, rb);
+  VecXd rf, rt, rb;
+  forward(x, rf, rt, rb);
   return rb;
 }
 
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   const int num_design = static_cast<int>(design_.size());
-  forward(x, rho_tilde_, rho_bar_);
+  forward(x, rho_filtered_, rho_tilde_, rho_bar_);
   // ---- FE analysis
   for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar_[i]);
   fe_->set_scale(scale_);
@@ -131,13 +138,14 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
     c += weights_[k] * F.col(k).dot(U_.col(k));
     if (dc) dc_bar += weights_[k] * (load_derivative(2 * U_.col(k), k) - stiffness_derivative(U_.col(k), U_.col(k)));
   }
-  if (dc) *dc = chain(rho_tilde_, dc_bar);
+  if (dc) *dc = chain(rho_filtered_, rho_tilde_, dc_bar);
   return c;
 }
 
-VecXd ComplianceProblem::chain(const VecXd& rho_tilde, VecXd d_bar) const {
+VecXd ComplianceProblem::chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const {
   if (params_.projection.enabled)
     for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= proj_.derivative(rho_tilde[i]);
+  if (draw_) d_bar = draw_->apply_transpose(rho_filtered, d_bar);
   return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
 }
 
@@ -167,10 +175,10 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
     if (dv) *dv = volume_weights_;
     return volume_weights_.dot(x);
   }
-  VecXd rho_tilde, rho_bar;
-  forward(x, rho_tilde, rho_bar);
+  VecXd rho_filtered, rho_tilde, rho_bar;
+  forward(x, rho_filtered, rho_tilde, rho_bar);
   if (dv) {
-    *dv = chain(rho_tilde, vd_ / design_volume_);
+    *dv = chain(rho_filtered, rho_tilde, vd_ / design_volume_);
   }
   return vd_.dot(rho_bar) / design_volume_;
 }

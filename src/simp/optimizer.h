@@ -33,7 +33,7 @@ struct SimpParams {
   double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
   ResponseParams responses;  ///< objective and limits beyond the volume fraction (responses/)
-  ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion); none
+  ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion, draw direction); none
 };
 
 /// One iteration, as reported to the caller and kept in the history.
@@ -71,6 +71,7 @@ struct SimpResult {
 /// The objective and constraint of SIMP as functions of the design variables x (#D): the
 /// filter, projection and FE model are built once; evaluate() runs one FE analysis.
 class DesignMap;
+class DrawFilter;
 
 class ComplianceProblem {
  public:
@@ -106,7 +107,7 @@ class ComplianceProblem {
   fem::Elasticity& elasticity() { return *fe_; }
   /// Chain rule: a sensitivity w.r.t. the physical densities ρ̄ (#D) of the last compliance()
   /// call's x turned into one w.r.t. the design variables x (#D), through projection and filter.
-  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_tilde_, d_bar); }
+  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_filtered_, rho_tilde_, d_bar); }
   /// #D: E'(ρ̄_i) a_iᵀ K0_i b_i for the densities of the last compliance() call; a, b: 3*#V
   /// (the stiffness term of an adjoint sensitivity, −this for λ = a, u = b).
   VecXd stiffness_derivative(const VecXd& a, const VecXd& b) const;
@@ -123,6 +124,7 @@ class ComplianceProblem {
   double design_volume_ = 0;
   std::unique_ptr<DesignMap> controls_;  // x → z, before the filter
   std::unique_ptr<Filter> filter_;
+  std::unique_ptr<DrawFilter> draw_;  // draw direction: after the filter, before the projection
   std::unique_ptr<fem::Elasticity> fe_;
   Eigen::MatrixXd loads_;     // as given: with every tet's full weight
   Eigen::Matrix3Xd gravity_;  // 3 x #cases, empty without self-weight
@@ -131,11 +133,12 @@ class ComplianceProblem {
   Heaviside proj_;
   Progress progress_;
   VecXd scale_;
-  Eigen::MatrixXd U_;  // displacements of the last compliance() call
-  VecXd rho_tilde_;    // #D: its filtered densities
-  VecXd rho_bar_;      // #D: its physical densities
-  VecXd chain(const VecXd& rho_tilde, VecXd d_bar) const;
-  void forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const;
+  Eigen::MatrixXd U_;   // displacements of the last compliance() call
+  VecXd rho_filtered_;  // #D: its filtered densities
+  VecXd rho_tilde_;     // #D: the same through the draw direction (rho_filtered_ without it)
+  VecXd rho_bar_;       // #D: its physical densities
+  VecXd chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const;
+  void forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde, VecXd& rho_bar) const;
 };
 
 /// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1),

@@ -230,12 +230,16 @@ def _whole(value, name, low, high):
     return int(x)
 
 
-def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=None, tolerance=0.0):
+def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=None, tolerance=0.0,
+                 draw_direction=None, parting_point=None, draw_cell=0.0):
     """Sets the study's geometry controls (docs/optimization.md, "controls"); called without
     arguments it clears them. symmetry_planes: [(point, normal), ...]; cyclic: [(point, axis,
     sectors), ...]; patterns: [(direction, pitch mm, count), ...]; extrusion: a direction or
-    None; tolerance: mm, 0 = the mesh's mean edge length. Vectors are [x, y, z] in model axes.
-    Returns the controls as the job's dict. Raises TopOptError naming the argument."""
+    None; tolerance: mm, 0 = the mesh's mean edge length. draw_direction: the direction a
+    casting die is drawn in, or None; parting_point: with it, a point of the parting plane
+    (split casting: two dies drawn apart along ±draw_direction), None for one-sided casting;
+    draw_cell: mm, the draw grid's cell side (0: the tolerance). Vectors are [x, y, z] in model
+    axes. Returns the controls as the job's dict. Raises TopOptError naming the argument."""
     c = {}
     if symmetry_planes:
         c["symmetry_planes"] = [{"point": _vector(p, "symmetry plane %d point" % (i + 1)),
@@ -252,6 +256,16 @@ def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=No
                          for i, (d, p, n) in enumerate(patterns)]
     if extrusion is not None:
         c["extrusion"] = _vector(extrusion, "extrusion")
+    if draw_direction is not None:
+        draw = {"direction": _vector(draw_direction, "draw_direction")}
+        if parting_point is not None:
+            draw["parting_point"] = _vector(parting_point, "parting_point")
+        if checks.in_range(draw_cell, "draw_cell", 0, None) > 0:
+            draw["cell"] = float(draw_cell)
+        c["draw_direction"] = draw
+    elif parting_point is not None:
+        raise TopOptError("parting_point needs draw_direction: give the direction the dies are drawn in",
+                          "InvalidParameter")
     if checks.in_range(tolerance, "tolerance", 0, None) > 0:
         c["tolerance"] = float(tolerance)
     check_optimization(study, controls=c)

@@ -1,5 +1,6 @@
 // The geometry controls of SIMP (issue 22): symmetry planes, cyclic and linear-pattern
-// repetition and extrusion, as options for DesignMap (design_map.h).
+// repetition and extrusion, as options for DesignMap (design_map.h), and the draw direction
+// (draw_filter.h).
 #pragma once
 #include <Eigen/Core>
 #include <vector>
@@ -30,6 +31,23 @@ struct LinearPattern {
   int count = 0;     ///< >= 2
 };
 
+/// Draw direction for casting, forging or milling: every line along `direction` meets the
+/// material in one stretch that the die can release. One-sided: the die is drawn along
+/// `direction`, so the design is visible from that side (the density never rises along
+/// `direction`). Split: a parting plane through `parting_point` normal to `direction`; above it
+/// the upper die is drawn along `direction`, below it the lower die against it.
+struct DrawDirection {
+  bool enabled = false;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< need not be unit length, not zero
+  bool split = false;                                    ///< two dies and a parting plane
+  /// a point of the parting plane (split); in both cases a corner of the grid's cells
+  Eigen::Vector3d parting_point = Eigen::Vector3d::Zero();
+  /// mm: the side of the intermediate grid's cells; <= 0: ControlsParams::tolerance resolved
+  double cell = 0;
+  /// ε of the smooth maximum (a + b + √((a−b)² + ε) − √ε)/2 along each column; in (0, 0.01]
+  double smoothness = 1e-4;
+};
+
 /// Geometry controls, combinable. Defaults: none.
 struct ControlsParams {
   std::vector<MirrorPlane> mirrors;      ///< several planes allowed
@@ -40,9 +58,12 @@ struct ControlsParams {
   /// mm: how far a mirrored/rotated/shifted centroid may lie from the design element that
   /// takes it, and the width of the extrusion's columns; <= 0: the mesh's mean edge length.
   double tolerance = 0;
+  DrawDirection draw;  ///< after the density filter, before the projection (draw_filter.h)
 
+  /// True when a control ties design elements (symmetry, repetition, extrusion: DesignMap).
+  bool ties() const { return !mirrors.empty() || !cyclic.empty() || !patterns.empty() || extrude; }
   /// True when any control is set.
-  bool any() const { return !mirrors.empty() || !cyclic.empty() || !patterns.empty() || extrude; }
+  bool any() const { return ties() || draw.enabled; }
 };
 
 }  // namespace topopt::simp

@@ -7,8 +7,6 @@
 
 namespace topopt::simp {
 
-namespace {
-
 Eigen::MatrixX3d design_centroids(const TetMesh& mesh, const std::vector<int>& design) {
   Eigen::MatrixX3d c(design.size(), 3);
   for (size_t i = 0; i < design.size(); ++i) {
@@ -18,11 +16,9 @@ Eigen::MatrixX3d design_centroids(const TetMesh& mesh, const std::vector<int>& d
   return c;
 }
 
-}  // namespace
-
 DesignMap::DesignMap(const TetMesh& mesh, const std::vector<int>& design, const ControlsParams& params,
                      double tolerance) {
-  if (params.any()) {
+  if (params.ties()) {
     Tying t = tie_design(design_centroids(mesh, design), params, tolerance);
     variable_of_ = std::move(t.variable_of);
     num_variables_ = t.num_variables;

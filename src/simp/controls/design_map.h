@@ -11,6 +11,9 @@
 
 namespace topopt::simp {
 
+/// #D by 3: the centroids of the tets design (#D indices into mesh.T).
+Eigen::MatrixX3d design_centroids(const TetMesh& mesh, const std::vector<int>& design);
+
 class DesignMap {
  public:
   /// mesh: the tagged mesh; design: #D indices of the design tets in mesh.T (the order of z);

@@ -1,6 +1,7 @@
 // Geometry controls of SIMP (src/simp/controls): each measured on the optimised design —
 // mirrored, rotated and shifted designs match themselves to the mesh size, extruded sections
-// are equal — and every map's sensitivities against finite differences.
+// are equal, rays along a draw direction cross the design's boundary at most once (one-sided)
+// or twice (split) — and every map's sensitivities against finite differences.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -14,6 +15,7 @@
 #include "fem/elasticity.h"
 #include "mesh/core/structured_box.h"
 #include "simp/controls/design_map.h"
+#include "simp/controls/draw_filter.h"
 #include "simp/optimizer.h"
 
 namespace topopt::simp {
@@ -141,6 +143,112 @@ TEST(Controls, GradientsMatchFiniteDifferences) {
   check_gradient(p, 4);
   p.controls.mirrors = {MirrorPlane{{0, 0, 0}, {0, 0, 1}}};  // combined with a plane
   check_gradient(p, 5);
+}
+
+TEST(Controls, DrawDirectionGradientsMatchFiniteDifferences) {
+  SimpParams p;
+  p.projection.enabled = true;
+  p.projection.beta_start = 4;
+  p.controls.draw.enabled = true;
+  p.controls.draw.direction = {0, 0.3, 1};  // inclined: columns cut across the mesh's cells
+  p.controls.draw.cell = 1.5;
+  check_gradient(p, 6);
+  p.controls.draw.split = true;
+  p.controls.draw.parting_point = {0, 0, 0.5};
+  check_gradient(p, 7);
+  p.controls.mirrors = {MirrorPlane{{0, 0, 0}, {0, 1, 0}}};  // combined with a plane
+  p.projection.enabled = false;                              // and without the projection
+  check_gradient(p, 8);
+}
+
+/// Rays along z through (x, y) on a grid of 56 × 18 over x in (0, 28), y in (-5, 5), the crisp
+/// design sampled every 0.05 mm inside the box. Returns the share of rays that cross the
+/// design's boundary more than `allowed` times and, in *undercut, the share that a die could
+/// not release: going up, a void → solid change above the parting height z_part (the upper die,
+/// drawn along +z) or a solid → void change below it (the lower die, drawn along -z); a change
+/// at the parting plane itself is released by either die.
+double share_of_rays_crossing_more(const Beam& b, const VecXd& rho, int allowed, double z_part, double* undercut) {
+  int bad = 0, cut = 0, n = 0;
+  for (int i = 0; i < 56; ++i)
+    for (int j = 0; j < 18; ++j, ++n) {
+      const double x = (i + 0.5) * 0.5, y = -5 + (j + 0.5) * 10.0 / 18;
+      int crossings = 0;
+      bool last = b.solid(rho, {x, y, -4.999}), released = true;
+      for (double z = -4.95; z < 5; z += 0.05) {
+        const bool now = b.solid(rho, {x, y, z});
+        crossings += now != last;
+        if (now != last && now == (z > z_part) && std::abs(z - z_part) > 0.1) released = false;  // not at the plane
+        last = now;
+      }
+      bad += crossings > allowed;
+      cut += !released;
+    }
+  *undercut = static_cast<double>(cut) / n;
+  return static_cast<double>(bad) / n;
+}
+
+TEST(Controls, DrawDirectionRaysCrossTheBoundaryOnceOrTwice) {
+  Beam b({18, 6, 6});
+  SimpParams p = run_params();
+  const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  p.controls.draw.enabled = true;
+  p.controls.draw.direction = {0, 0, 1};
+  p.controls.draw.cell = 10.0 / 6;  // the grid's cells on the mesh's cells (origin 0: a cell corner)
+  const SimpResult one = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  p.controls.draw.split = true;
+  // one cell below the middle: the free design happens to be castable split at z = 0 (2 % of
+  // the rays not released there, 25 % at z = -5/3)
+  p.controls.draw.parting_point = {0, 0, -5.0 / 3};
+  const SimpResult split = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  double one_cut, split_cut, free_cut1, free_cut2;
+  const double one_bad = share_of_rays_crossing_more(b, one.density, 1, -5, &one_cut);
+  const double split_bad = share_of_rays_crossing_more(b, split.density, 2, -5.0 / 3, &split_cut);
+  const double free_bad1 = share_of_rays_crossing_more(b, free_run.density, 1, -5, &free_cut1);
+  const double free_bad2 = share_of_rays_crossing_more(b, free_run.density, 2, -5.0 / 3, &free_cut2);
+  std::cout << "rays crossing more than allowed / not released: one-sided " << one_bad << " / " << one_cut << " (free "
+            << free_bad1 << " / " << free_cut1 << "), split " << split_bad << " / " << split_cut << " (free "
+            << free_bad2 << " / " << free_cut2 << "); compliance free " << free_run.history.back().compliance
+            << ", one-sided " << one.history.back().compliance << ", split " << split.history.back().compliance << "\n";
+  EXPECT_LE(one_bad, 0.02);
+  EXPECT_LE(one_cut, 0.02);
+  EXPECT_LE(split_bad, 0.02);
+  EXPECT_LE(split_cut, 0.02);
+  EXPECT_GE(free_cut1, 0.1) << "the free design should not be castable from one side by chance";
+  EXPECT_GE(free_cut2, 0.1) << "the free design should not be castable with this parting plane by chance";
+  EXPECT_NEAR(one.history.back().volume_fraction, 0.3, 0.01);
+  EXPECT_NEAR(split.history.back().volume_fraction, 0.3, 0.01);
+}
+
+TEST(Controls, DrawFilterIsMonotoneAlongTheDirection) {
+  // a 1-D column of 10 elements 1 mm apart along z: the cast field never rises along +z
+  // (one-sided) and, split at z = 5, rises below and falls above; it never exceeds the input's
+  // largest value and keeps a field that is already castable
+  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(10, 3);
+  for (int k = 0; k < 10; ++k) c(k, 2) = k + 0.5;
+  const VecXd vol = VecXd::Ones(10);
+  VecXd r(10);
+  r << 0.1, 0.9, 0.2, 0.0, 1.0, 0.0, 0.3, 0.8, 0.0, 0.1;
+  DrawDirection d;
+  d.enabled = true;
+  d.smoothness = 1e-6;
+  const VecXd one = DrawFilter(c, vol, d, 1.0).apply(r);
+  const double slack = 0.5 * std::sqrt(d.smoothness) + 1e-12;  // smax(a, b) >= max(a, b) - √ε/2
+  for (int k = 0; k + 1 < 10; ++k) EXPECT_GE(one[k], one[k + 1] - slack) << k;
+  EXPECT_NEAR(one[0], 1.0, 0.01);
+  EXPECT_LE(one.maxCoeff(), 1.0 + 1e-12);
+  d.split = true;
+  d.parting_point = {0, 0, 5};
+  const VecXd two = DrawFilter(c, vol, d, 1.0).apply(r);
+  for (int k = 0; k + 1 < 5; ++k) EXPECT_LE(two[k], two[k + 1] + slack) << k;
+  for (int k = 5; k + 1 < 10; ++k) EXPECT_GE(two[k], two[k + 1] - slack) << k;
+  EXPECT_NEAR(two[4], 1.0, 0.01);
+  EXPECT_NEAR(two[5], 0.8, 0.01);
+  VecXd castable(10);
+  castable << 1, 1, 1, 0.7, 0.2, 0, 0, 0, 0, 0;
+  d.split = false;
+  EXPECT_LE((DrawFilter(c, vol, d, 1.0).apply(castable) - castable).cwiseAbs().maxCoeff(), 1e-3);
+  d.direction = {0, 0, 0};
+  EXPECT_THROW(DrawFilter(c, vol, d, 1.0), Error);
 }
 
 TEST(Controls, MirroredDesignMatchesItselfOnAnInclinedPlane) {

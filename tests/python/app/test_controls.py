@@ -28,6 +28,12 @@ class Controls(unittest.TestCase):
         self.assertEqual(c["patterns"], [{"direction": [1, 0, 0], "pitch": 20, "count": 3}])
         self.assertEqual(c["extrusion"], [0, 0, 1])
         self.assertEqual(c["tolerance"], 2)
+        api.set_controls(self.study, draw_direction=(0, 0, 1), parting_point=(0, 0, 5), draw_cell=1.5)
+        c = api.job_of(self.study)["optimization"]["controls"]
+        self.assertEqual(c["draw_direction"], {"direction": [0, 0, 1], "parting_point": [0, 0, 5], "cell": 1.5})
+        api.set_controls(self.study, draw_direction=(0, 1, 0))  # one-sided: no parting plane
+        c = api.job_of(self.study)["optimization"]["controls"]
+        self.assertEqual(c["draw_direction"], {"direction": [0, 1, 0]})
         api.set_controls(self.study)  # cleared
         self.assertEqual(self.study.GeometryControls, "")
         self.assertNotIn("controls", api.job_of(self.study)["optimization"])
@@ -36,7 +42,10 @@ class Controls(unittest.TestCase):
         for kwargs, words in [(dict(symmetry_planes=[((0, 5, 5), (0, 0, 0))]), "symmetry plane 1 normal"),
                               (dict(cyclic=[((0, 0, 0), (1, 0, 0), 2.5)]), "cyclic 1 sectors"),
                               (dict(patterns=[((1, 0, 0), -3, 2)]), "pattern 1 pitch"),
-                              (dict(extrusion=(1, 2)), "extrusion")]:
+                              (dict(extrusion=(1, 2)), "extrusion"),
+                              (dict(draw_direction=(0, 0, 0)), "draw_direction"),
+                              (dict(parting_point=(0, 0, 1)), "parting_point"),
+                              (dict(draw_direction=(0, 0, 1), draw_cell=-1), "draw_cell")]:
             with self.assertRaises(api.TopOptError) as ctx:
                 api.set_controls(self.study, **kwargs)
             self.assertIn(words, str(ctx.exception))
@@ -51,6 +60,9 @@ class Controls(unittest.TestCase):
             api.run(self.study, verbose=False)
         self.assertIn("symmetry plane 1", str(ctx.exception))
         api.set_controls(self.study, symmetry_planes=[((0, 5, 5), (0, 1, 0))], extrusion=(0, 0, 1))
+        result = api.run(self.study, verbose=False)
+        self.assertGreater(result.Mesh.CountFacets, 0)
+        api.set_controls(self.study, draw_direction=(0, 0, 1), parting_point=(0, 0, 5))
         result = api.run(self.study, verbose=False)
         self.assertGreater(result.Mesh.CountFacets, 0)
 
