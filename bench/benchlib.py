@@ -68,8 +68,9 @@ def read_stl(path):
     return a["v"].astype(float)
 
 
-def picture(stl, png, title):
-    """An isometric, shaded picture of the surface in stl (equal axes), written to png."""
+def picture(stl, png, title, elev=25, azim=-60):
+    """A shaded picture of the surface in stl (equal axes), written to png, seen from elevation
+    elev and azimuth azim (degrees; the defaults give the isometric view)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -88,7 +89,7 @@ def picture(stl, png, title):
     lo, hi = tris.reshape(-1, 3).min(0), tris.reshape(-1, 3).max(0)
     c, r = (lo + hi) / 2, (hi - lo).max() / 2
     ax.set_xlim(c[0] - r, c[0] + r), ax.set_ylim(c[1] - r, c[1] + r), ax.set_zlim(c[2] - r, c[2] + r)
-    ax.view_init(elev=25, azim=-60)
+    ax.view_init(elev=elev, azim=azim)
     ax.set_title(title, fontsize=9)
     ax.set_axis_off()
     fig.savefig(png, dpi=110, bbox_inches="tight")

@@ -12,6 +12,10 @@ namespace {
 
 using Tri = std::array<int, 3>;
 
+/// Two triangles count as one plane when their unit normals' dot product is at least 1 − this
+/// (about 1.4e-6 rad apart): the pieces of one mesh triangle cut at level crossings, rounding aside.
+constexpr double kCoplanar = 1e-12;
+
 Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
   const Eigen::Vector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]);
   return (b - a).cross(c - a);
@@ -34,8 +38,7 @@ class Remesher {
     for (int pass = 0; pass < p_.passes; ++pass) {
       long changes = 0;
       for (size_t t = 0; t < tris_.size(); ++t)
-        if (alive_[t] && workable(static_cast<int>(t)) && angle(static_cast<int>(t)) < p_.target_angle)
-          changes += improve(static_cast<int>(t));
+        if (alive_[t] && angle(static_cast<int>(t)) < p_.target_angle) changes += improve(static_cast<int>(t));
       if (changes == 0) break;
     }
   }
@@ -113,21 +116,81 @@ class Remesher {
     return 0;
   }
 
-  /// Moves a free point v towards the mean of its neighbours, within the plane of its star
-  /// (area-weighted normal), by the full step or half of it, when that raises the smallest
-  /// angle of its triangles and turns none by more than max_normal_turn.
-  bool relocate(int v) {
-    if (s_.lock[v] != 0) return false;
-    Eigen::Vector3d n = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
-    const std::vector<int> nb = neighbours(v);
-    if (nb.size() < 3) return false;
+  /// The planar Ω face whose interior point v is (on Ω's boundary, not on the cut line, and
+  /// every triangle around it on that one planar face), or 0. Such a point may move and go
+  /// within the face's plane: the face stays where it was, its edges and the cut line too.
+  int face_interior(int v) const {
+    if (s_.lock[v] != 1 || !p_.planar_faces || (s_.point_face.size() && s_.point_face[v] != 0)) return 0;
+    int f = 0;
+    for (int t : star_[v])
+      if (alive_[t]) {
+        if (f != 0 && tags_[t] != f) return 0;
+        f = tags_[t];
+      }
+    return planar(f) ? f : 0;
+  }
+
+  /// The planar Ω face whose cut line v lies on (on the line of that one face, every triangle
+  /// around it on the face or the free-form region), or 0.
+  int cut_line_face(int v) const {
+    if (s_.lock[v] != 1 || !p_.planar_faces || s_.point_face.size() == 0) return 0;
+    const int f = s_.point_face[v];
+    if (!planar(f)) return 0;
+    for (int t : star_[v])
+      if (alive_[t] && tags_[t] != 0 && tags_[t] != f) return 0;
+    return f;
+  }
+
+  /// v's neighbours along the cut line of face f: edges with a triangle of f and one free-form.
+  std::vector<int> line_neighbours(int v, int f) const {
+    std::vector<int> out;
+    for (int w : neighbours(v)) {
+      const std::vector<int> e = edge_triangles(v, w);
+      if (e.size() == 2 && ((tags_[e[0]] == 0 && tags_[e[1]] == f) || (tags_[e[0]] == f && tags_[e[1]] == 0)))
+        out.push_back(w);
+    }
+    return out;
+  }
+
+  /// Where relocate moves v towards and the normal of the plane the move stays in: a free point,
+  /// the mean of its neighbours in the plane of its star (area-weighted normal); a point inside a
+  /// planar Ω face, the mean of its neighbours in the face's plane; a point of a planar face's cut
+  /// line, the mean of its two neighbours on that line, in the face's plane (as the smoothing moves
+  /// it). face: the planar face (0 for a free point). False when v may not move.
+  bool relocation_target(int v, Eigen::Vector3d& mean, Eigen::Vector3d& n, int& face) const {
+    face = face_interior(v);
+    std::vector<int> nb;
+    if (s_.lock[v] == 0 || face != 0) {
+      nb = neighbours(v);
+      if (nb.size() < 3) return false;
+    } else {
+      face = cut_line_face(v);
+      if (face == 0) return false;
+      nb = line_neighbours(v, face);
+      if (nb.size() != 2) return false;
+    }
+    mean.setZero();
     for (int w : nb) mean += s_.V.row(w).transpose();
     mean /= static_cast<double>(nb.size());
-    double worst_before = 180;
+    n.setZero();
+    if (face != 0) n = s_.face_plane[face].head<3>();
     for (int t : star_[v])
-      if (alive_[t]) n += normal_of(s_.V, tris_[t]), worst_before = std::min(worst_before, angle(t));
+      if (face == 0 && alive_[t]) n += normal_of(s_.V, tris_[t]);
     if (n.norm() == 0) return false;
     n.normalize();
+    return true;
+  }
+
+  /// Moves point v towards its relocation_target, within the target's plane, by the full step or
+  /// half of it, when that raises the smallest angle of its triangles and turns none by more than
+  /// max_normal_turn (a point of a planar Ω face ends on the face's plane to rounding).
+  bool relocate(int v) {
+    Eigen::Vector3d mean, n;
+    int face = 0;
+    if (!relocation_target(v, mean, n, face)) return false;
+    double worst_before = 180;
+    for (int t : star_[v])
+      if (alive_[t]) worst_before = std::min(worst_before, angle(t));
     const Eigen::Vector3d p0 = s_.V.row(v).transpose();
     Eigen::Vector3d step = mean - p0;
     step -= step.dot(n) * n;
@@ -136,7 +199,9 @@ class Remesher {
       std::vector<Eigen::Vector3d> normals;
       for (int t : star_[v])
         if (alive_[t]) normals.push_back(normal_of(s_.V, tris_[t]));
-      s_.V.row(v) = (p0 + share * step).transpose();
+      Eigen::Vector3d p = p0 + share * step;
+      if (face != 0) p -= (n.dot(p) - s_.face_plane[face][3]) * n;  // on the plane to rounding
+      s_.V.row(v) = p.transpose();
       double worst_after = 180;
       bool turned = false;
       size_t k = 0;
@@ -155,11 +220,12 @@ class Remesher {
     return false;
   }
 
-  /// Flips edge ab when its two triangles share a tag the remesher may change, lie nearly in
-  /// one plane (exactly, on a planar face), and the flip raises their smallest angle.
+  /// Flips edge ab when its two triangles share a tag and lie nearly in one plane (on the
+  /// free-form region: bent less than flat_dihedral; on a planar Ω face: its plane; on any other
+  /// face: one plane to kCoplanar), and the flip raises their smallest angle. Flips move no point.
   bool flip(int a, int b) {
     const std::vector<int> e = edge_triangles(a, b);
-    if (e.size() != 2 || tags_[e[0]] != tags_[e[1]] || !workable(e[0])) return false;
+    if (e.size() != 2 || tags_[e[0]] != tags_[e[1]]) return false;
     int t1 = e[0], t2 = e[1];
     // t1 holds the directed edge a -> b
     auto has_ab = [&](int t) {
@@ -173,6 +239,8 @@ class Remesher {
     if (c == d || edge_triangles(c, d).size() > 0) return false;
     const Eigen::Vector3d n1 = normal_of(s_.V, tris_[t1]), n2 = normal_of(s_.V, tris_[t2]);
     if (n1.norm() == 0 || n2.norm() == 0) return false;
+    // elsewhere (non-design faces, curved Ω faces) only within one plane: the surface stays put
+    if (!workable(t1) && n1.normalized().dot(n2.normalized()) < 1 - kCoplanar) return false;
     if (tags_[t1] == 0 && n1.normalized().dot(n2.normalized()) < std::cos(p_.flat_dihedral * M_PI / 180)) return false;
     const Tri u = {a, d, c}, w = {d, b, c};
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
@@ -192,10 +260,11 @@ class Remesher {
   }
   void drop(int v, int t) { star_[v].erase(std::remove(star_[v].begin(), star_[v].end(), t), star_[v].end()); }
 
-  /// Whether point v may go into its neighbour u: v free, or v on the cut line of a planar Ω
-  /// face with uv along that line (one triangle of the face and one of the free-form on it).
+  /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, or on the cut
+  /// line of a planar Ω face with uv along that line (one triangle of the face and one of the
+  /// free-form on it).
   bool may_go(int v, int u) const {
-    if (s_.lock[v] == 0) return true;
+    if (s_.lock[v] == 0 || face_interior(v) != 0) return true;
     if (s_.lock[v] != 1 || !p_.planar_faces) return false;
     const int f = s_.point_face.size() ? s_.point_face[v] : 0;
     if (!planar(f)) return false;

@@ -1,7 +1,8 @@
 // Well-shaped triangles on the result surface: marching tetrahedra leaves needles and caps
 // where the level passes close to a mesh node. Edge collapses and edge flips on the
-// free-form region (and on Ω's planar faces, within their plane) remove them; nothing on a
-// non-design solid and no point of Ω's faces leaves its place.
+// free-form region (and on Ω's planar faces, within their plane; flips within one plane on the
+// other faces) remove them; no point of a non-design solid moves and no point of Ω's faces
+// leaves its face's plane.
 #pragma once
 #include <vector>
 
@@ -24,13 +25,18 @@ struct RemeshReport {
 };
 
 /// Removes the badly shaped triangles of s where it can: flips an edge when that raises the
-/// smallest angle of its two triangles; collapses a short edge into one of its points when
-/// the point that goes is free (lock 0) or slides on the cut line of a planar Ω face, the
-/// surface stays manifold (link condition), and no remaining triangle turns by more than
-/// max_normal_turn or ends with a smaller smallest angle than the worst one it replaces;
-/// else moves a free point of the triangle within the plane of its triangles towards the
-/// mean of its neighbours when that raises their smallest angle. Locked points keep their
-/// positions; tags keep their meaning. Returns the counts and which points stayed.
+/// smallest angle of its two triangles (on the free-form region across edges bent less than
+/// flat_dihedral; on Ω's planar faces within the plane; on the non-design solids' and Ω's other
+/// faces only between triangles in one plane, so no point moves); collapses a short edge into one
+/// of its points when the point that goes is free (lock 0), lies inside a planar Ω face (every
+/// triangle around it on that face), or slides on the cut line of a planar Ω face, the surface
+/// stays manifold (link condition), and no remaining triangle turns by more than max_normal_turn
+/// or ends with a smaller smallest angle than the worst one it replaces; else moves a point of the
+/// triangle towards the mean of its neighbours when that raises their smallest angle: a free point
+/// within the plane of its triangles, a point inside a planar Ω face within the face's plane, a
+/// cut-line point towards its two neighbours on the line, within the face's plane. Non-design
+/// points and points on Ω's edges keep their positions; tags keep their meaning. Returns the
+/// counts and which points stayed.
 RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {});
 
 }  // namespace topopt::result

@@ -2,7 +2,8 @@
 // ../shared/data/README.md) on coarse meshes, each at two settings (the threshold that keeps
 // the volume fraction with the default smoothing; threshold 0.4 with 60 smoothing pairs): a
 // valid solid (closed, outward, no self-intersection by the exact check), no triangle below 10°
-// on the free-form surface, the volume of the kept design (smoothing does not shrink it), Ω's
+// on the free-form surface (the mount at 0.4: 7°), the smallest angles on Ω's faces and the
+// non-design faces at their measured floors, the volume of the kept design (smoothing does not shrink it), Ω's
 // planar faces' points in their planes and the non-design points where marching tetrahedra put
 // them.
 #include <gtest/gtest.h>
@@ -23,11 +24,20 @@ struct Example {
   std::string name;
   double size;          // mesh size (mm)
   std::string problem;  // supports and load cases
+  /// The smallest angle asserted on Ω's kept faces (issue 19 asks 10°; not reached yet). Measured
+  /// at the two settings: rocker 7.11° / 6.95°, cantilever 8.93° (triangles of the FE mesh's own
+  /// boundary on a non-design solid, whose points may not move) / 12.0°, bracket 9.67° / 12.2°,
+  /// mount 5.45° / 12.1°: asserted just under what is measured so it cannot get worse unseen.
+  double min_angle_faces;
   /// The smallest free-form angle asserted (issue 19 asks 10°). The mount at threshold 0.4 with
-  /// 60 smoothing pairs measures 7.3° (its default setting and the other three examples reach
+  /// 60 smoothing pairs measures 7.9° (its default setting and the other three examples reach
   /// 10°): left open in issue 19, asserted at what is measured so it cannot get worse unseen.
   double min_angle = 10.0;
 };
+
+/// The smallest angle asserted on the non-design solids' faces (issue 19 asks 10°): measured
+/// 9.99° (bracket) to 14.3°; their points never move, flips within one plane only.
+constexpr double kMinAngleNondesign = 9.5;
 
 pipeline::Job example_job(const Example& e) {
   const std::string dir = std::string(TOPOPT_SHARED_DATA) + "/examples/";
@@ -54,12 +64,14 @@ double nondesign_volume(const TetMesh& mesh) {
 /// The properties every design surface must have; `design` (#T) and `threshold` are what it
 /// was cut from.
 void check_design_surface(const TetMesh& mesh, const TriSurface& s, const VecXd& design, double threshold,
-                          double min_angle) {
+                          const Example& e) {
   const ResultCheck c = check_result(s);
   EXPECT_TRUE(c.closed.closed_manifold()) << c.closed.unpaired_edges << " unpaired edges";
   EXPECT_GT(c.closed.volume, 0);
   EXPECT_EQ(c.crossings.size(), 0u);
-  EXPECT_GE(c.min_angle_free, min_angle);
+  EXPECT_GE(c.min_angle_free, e.min_angle);
+  EXPECT_GE(c.min_angle_faces, e.min_angle_faces);
+  EXPECT_GE(c.min_angle_nondesign, kMinAngleNondesign);
   // the volume: the kept design (exact for the linear field) plus the non-design solids
   const VecXd nd = node_densities(mesh, design);
   const double kept = kept_design_volume(mesh, nd, threshold) + nondesign_volume(mesh);
@@ -93,7 +105,7 @@ void check_example(const Example& e) {
   const pipeline::OptimizeResult& r = run.optimization;
   {
     SCOPED_TRACE(e.name + ": the volume's threshold, 20 smoothing pairs");
-    check_design_surface(run.mesh, r.surface, r.design, r.threshold, e.min_angle);
+    check_design_surface(run.mesh, r.surface, r.design, r.threshold, e);
   }
   SCOPED_TRACE(e.name + ": threshold 0.4, 60 smoothing pairs");
   SmoothParams smooth;
@@ -101,27 +113,30 @@ void check_example(const Example& e) {
   VecXd design;
   const TriSurface s = pipeline::result_surface(run.mesh, r.simp.density, 0.4, 0.3, smooth, nullptr,
                                                 pipeline::anchor_nodes(run.mesh, job), {}, nullptr, &design);
-  check_design_surface(run.mesh, s, design, 0.4, e.min_angle);
+  check_design_surface(run.mesh, s, design, 0.4, e);
 }
 
 TEST(SurfaceExamples, Rocker) {
   check_example({"rocker", 3.0,
                  R"("supports": [{"type": "fixed", "faces": ["Face10"]}], "load_cases": [{"name": "rocker", "loads":
                   [{"type": "force", "faces": ["Face9"], "vector": [0, -1000, 0]},
-                   {"type": "force", "faces": ["Face11"], "vector": [600, 0, 0]}]}])"});
+                   {"type": "force", "faces": ["Face11"], "vector": [600, 0, 0]}]}])",
+                 6.5});
 }
 
 TEST(SurfaceExamples, Cantilever) {
   check_example({"cantilever", 3.0,
                  R"("supports": [{"type": "fixed", "faces": ["Face1"]}], "load_cases": [{"name": "tip", "loads":
-                  [{"type": "force", "faces": ["NonDesign:Face12"], "vector": [0, 0, -1000]}]}])"});
+                  [{"type": "force", "faces": ["NonDesign:Face12"], "vector": [0, 0, -1000]}]}])",
+                 8.5});
 }
 
 TEST(SurfaceExamples, Bracket) {
   check_example({"bracket", 5.0,
                  R"("supports": [{"type": "fixed", "faces": ["Face10", "Face11", "Face12", "Face13"]}], "load_cases":
                   [{"name": "x", "loads": [{"type": "force", "faces": ["Face7"], "vector": [5000, 0, 0]}]},
-                   {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}])"});
+                   {"name": "z", "loads": [{"type": "force", "faces": ["Face7"], "vector": [0, 0, -5000]}]}])",
+                 9.5});
 }
 
 TEST(SurfaceExamples, Mount) {
@@ -130,7 +145,7 @@ TEST(SurfaceExamples, Mount) {
                  R"("supports": [{"type": "fixed", "faces": ["Face28", "Face29", "Face30", "Face31"]}], "load_cases":
                   [{"name": "down", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 0, -10000]}]},
                    {"name": "side", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 5000, 0]}]}])",
-                 7.0});
+                 5.0, 7.0});
 }
 
 }  // namespace
