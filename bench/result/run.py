@@ -23,7 +23,7 @@ run; triangles, smallest angle (free-form and Ω's faces), crossing triangle pai
 the smoothing and in the returned surface (exact check), volume, surface stage time.
 
 usage: bench/result/run.py [--build build] [--work /tmp/topopt-bench-result] [--only cantilever,...]
-                           [--surface [--size MM] [--max-iterations N]]
+                           [--settings before,after] [--surface [--size MM] [--max-iterations N]]
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, sys
@@ -132,6 +132,9 @@ def cad_columns(out):
     v = json.load(open(os.path.join(out, "verification.json")))
     step, crisp_v = v.get("step", {}), v.get("crisp", {})
     return {"step_mb": step.get("bytes", 0) / 1e6 if step else None, "step_s": step.get("seconds"),
+            "step_cpu_s": step.get("cpu_seconds"), "step_valid": step.get("valid"), "step_solids": step.get("solids"),
+            "step_volume": step.get("volume"), "as_built_cpu_s": v.get("as_built", {}).get("cpu_seconds"),
+            "unheld": v.get("unheld_volumes"),
             "step_faces": step.get("faces"), "step_planar": step.get("planar_faces"),
             "as_built": v.get("compliance_as_built"), "as_built_tets": v.get("tets"),
             "crisp_ours": crisp_v.get("compliance"),
@@ -144,16 +147,24 @@ def cad_table(rows):
     def f(x, fmt):
         return fmt % x if x is not None else "failed"
     print("\n## Result: back in CAD and verified (bench/result/run.py)\n")
-    print("| example | setting | STEP (MB) | STEP faces (planar) | STEP time (s) | as-built compliance (N·mm) | "
-          "as-built tets | crisp, our FEM (N·mm) | as built / crisp, CalculiX | verification time (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    # as built / crisp: both from verification.json (our FEM, every load case with its weight);
+    # CalculiX's crisp figure solves the first load case only (crisp.py)
+    print("| example | setting | STEP (MB) | STEP valid, solids | STEP volume / STL | STEP faces (planar) | "
+          "STEP time (s, CPU s) | as-built compliance (N·mm) | as-built tets | crisp, our FEM (N·mm) | "
+          "as built / crisp | verification time (s, CPU s) | left out (mm³) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (name, setting), r in rows.items():
-        ratio = r["as_built"] / r["crisp"] if r["as_built"] is not None and r["crisp"] else None
-        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |"
+        ratio = r["as_built"] / r["crisp_ours"] if r["as_built"] is not None and r["crisp_ours"] else None
+        vol = r["step_volume"] / r["volume"] if r.get("step_volume") and r.get("volume") else None
+        print("| %s | %s | %s | %s | %s | %s | %s, %s | %s | %s | %s | %s | %s, %s | %s |"
               % (name, setting, f(r["step_mb"], "%.2f"),
+                 "%s, %s" % (r["step_valid"], r["step_solids"]) if r["step_faces"] is not None else "failed",
+                 f(vol, "%.5f"),
                  "%s (%s)" % (r["step_faces"], r["step_planar"]) if r["step_faces"] is not None else "failed",
-                 f(r["step_s"], "%.1f"), f(r["as_built"], "%.2f"), f(r["as_built_tets"], "%d"),
-                 f(r["crisp_ours"], "%.2f"), f(ratio, "%.3f"), f(r["verification_s"], "%.1f")))
+                 f(r["step_s"], "%.1f"), f(r["step_cpu_s"], "%.1f"), f(r["as_built"], "%.2f"),
+                 f(r["as_built_tets"], "%d"), f(r["crisp_ours"], "%.2f"), f(ratio, "%.3f"),
+                 f(r["verification_s"], "%.1f"), f(r["as_built_cpu_s"], "%.1f"),
+                 ", ".join("%.0f" % x for x in r["unheld"]) if r.get("unheld") else "–"))
 
 
 def main():
@@ -161,6 +172,8 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--work", default="/tmp/topopt-bench-result")
     ap.add_argument("--only", default=",".join(EXAMPLES))
+    ap.add_argument("--settings", default=",".join(SETTINGS),
+                    help="which of %s to run (default: both; 'after' alone is today's defaults)" % ", ".join(SETTINGS))
     ap.add_argument("--surface", action="store_true", help="only the surface table (before/after issue 19 B)")
     ap.add_argument("--size", type=float, default=None, help="mesh size for --surface (default: each example's)")
     ap.add_argument("--max-iterations", type=int, default=None, help="SIMP's cap for --surface (default: the job default)")
@@ -172,14 +185,15 @@ def main():
         return
     rows = {}
     for name in a.only.split(","):
-        for setting in SETTINGS:
+        for setting in a.settings.split(","):
             rows[name, setting] = r = one(a.build, a.work, name, setting)
             print("%s %s: %s" % (name, setting, json.dumps(r)), file=sys.stderr, flush=True)
     json.dump({"%s/%s" % k: v for k, v in rows.items()}, open(os.path.join(a.work, "rows.json"), "w"), indent=1)
     print("## Result: crisp designs (bench/result/run.py)\n")
     print("| example | tets | setting | iterations | status | grey share | SIMP compliance (N·mm) | crisp compliance, "
-          "CalculiX (N·mm) | SIMP wall (s) | optimize CPU (s) | CPU after / before |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "CalculiX, first load case (N·mm) | SIMP wall (s) | optimize CPU (s) | CPU after / before | triangles | "
+          "smallest angle, free-form (°) | self-intersections | surface time (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (name, setting), r in rows.items():
         ratio = r["cpu_s"] / rows[name, "before"]["cpu_s"] if (name, "before") in rows else float("nan")
         print("| %s | %d | %s | %d | %s | %.1f %% | %.2f | %.2f | %.1f | %.1f | %.2f | %d | %.2f | %d | %.2f |"

@@ -97,12 +97,14 @@ int cmd_optimize(const Args& args, const dist::MpiSession* session) {
             << check.closed.volume << " mm^3 (" << r.seconds_surface << " s)\n";
   if (run.files.step)
     std::cout << "step: " << run.files.step->faces << " faces (" << run.files.step->planar_faces << " planar), "
-              << run.files.step->bytes / 1e6 << " MB (" << run.files.step->seconds << " s)\n";
+              << run.files.step->bytes / 1e6 << " MB (" << run.files.step->seconds << " s, "
+              << run.files.step->cpu_seconds << " s CPU)\n";
   if (const auto& v = run.files.verification)
     std::cout << "verification: compliance as built " << v->as_built.compliance << " N*mm on " << v->as_built.tets
               << " tets, crisp design " << v->crisp.compliance << " N*mm (ratio " << v->ratio()
               << "), max displacement " << v->as_built.max_displacement << " mm, max von Mises "
-              << v->as_built.max_von_mises << " MPa (" << v->as_built.seconds << " s)\n";
+              << v->as_built.max_von_mises << " MPa (" << v->as_built.seconds << " s, " << v->as_built.cpu_seconds
+              << " s CPU)\n";
   for (const auto& p : run.written) std::cout << "wrote " << p << "\n";
   if (stats_text.empty()) stats_text = serial_stats_json(run.mesh.T.rows(), r.seconds_simp);
   write_stats_file(stats, stats_text);

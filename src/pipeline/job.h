@@ -36,13 +36,13 @@ struct OptimizeSettings {
 
 /// The "output" section.
 struct OutputSettings {
-  std::string directory;     ///< absolute; default "<job folder>/out"
-  bool vtu = true;           ///< solve: DIR/result.vtu
-  bool inp = false;          ///< solve: DIR/result.inp, the problem as a CalculiX deck
-  bool step = true;          ///< optimize: DIR/result.step, the result as one CAD solid
-  /// optimize: DIR/verification.json and .vtu, the result solid analysed. Off by default until the
-  /// volume mesher fills result surfaces reliably (it timed out on the examples, issue 19).
-  bool verification = false;
+  std::string directory;  ///< absolute; default "<job folder>/out"
+  bool vtu = true;        ///< solve: DIR/result.vtu
+  bool inp = false;       ///< solve: DIR/result.inp, the problem as a CalculiX deck
+  bool step = true;       ///< optimize: DIR/result.step, the result as one CAD solid
+  /// optimize: DIR/verification.json and .vtu, the result solid meshed by the native volume mesher
+  /// and analysed (result/verification.h).
+  bool verification = true;
 };
 
 /// A parsed, validated job. Paths are absolute (resolved against the job file's folder).

@@ -21,12 +21,13 @@ json figures_json(const result::AnalysisFigures& a) {
           {"max_von_mises", a.max_von_mises},
           {"tets", a.tets},
           {"nodes", a.nodes},
-          {"seconds", a.seconds}};
+          {"seconds", a.seconds},
+          {"cpu_seconds", a.cpu_seconds}};
 }
 
 json step_json(const result::StepExportReport& s) {
-  return {{"valid", s.valid},   {"solids", s.solids}, {"faces", s.faces},    {"planar_faces", s.planar_faces},
-          {"volume", s.volume}, {"bytes", s.bytes},   {"seconds", s.seconds}};
+  return {{"valid", s.valid},   {"solids", s.solids}, {"faces", s.faces},     {"planar_faces", s.planar_faces},
+          {"volume", s.volume}, {"bytes", s.bytes},   {"seconds", s.seconds}, {"cpu_seconds", s.cpu_seconds}};
 }
 
 json verification_json(const result::Verification& v) {
@@ -36,7 +37,8 @@ json verification_json(const result::Verification& v) {
           {"tets", v.as_built.tets},
           {"as_built", figures_json(v.as_built)},
           {"crisp", figures_json(v.crisp)},
-          {"ratio", v.ratio()}};
+          {"ratio", v.ratio()},
+          {"unheld_volumes", v.unheld_volumes}};
 }
 
 void write_verification_vtu(const std::string& path, const Job& job, const result::Verification& v) {

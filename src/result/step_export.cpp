@@ -2,10 +2,12 @@
 #include "result/step_export.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -18,6 +20,7 @@
 #include <ShapeUpgrade_UnifySameDomain.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shell.hxx>
@@ -25,6 +28,7 @@
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <gp_Pln.hxx>
@@ -128,7 +132,80 @@ void write_step_file(const TopoDS_Shape& shape, const std::string& path) {
     throw Error(ErrorCode::Io, "cannot write '" + path + "' (folder missing, not writable, or disk full)");
 }
 
+/// The surface's triangles by piece (triangles sharing a point belong together), each piece
+/// with its signed volume (> 0: a body, its triangles outward; < 0: a closed void inside one).
+struct SurfacePieces {
+  std::vector<std::vector<long>> triangles;
+  std::vector<double> volume;
+};
+
+SurfacePieces surface_pieces(const TriSurface& s) {
+  std::vector<int> parent(s.V.rows());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto root = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (long q = 0; q < s.F.rows(); ++q)
+    for (int k = 1; k < 3; ++k) parent[root(s.F(q, k))] = root(s.F(q, 0));
+  SurfacePieces out;
+  std::map<int, size_t> index;
+  for (long q = 0; q < s.F.rows(); ++q) {
+    const auto it = index.emplace(root(s.F(q, 0)), out.triangles.size()).first;
+    if (it->second == out.triangles.size()) out.triangles.emplace_back(), out.volume.push_back(0);
+    out.triangles[it->second].push_back(q);
+    const Eigen::Vector3d a = s.V.row(s.F(q, 0)), b = s.V.row(s.F(q, 1)), c = s.V.row(s.F(q, 2));
+    out.volume[it->second] += a.dot(b.cross(c)) / 6;
+  }
+  return out;
+}
+
+/// One solid per body of the surface, each void's shell added to the body that holds it (by
+/// OCCT's classifier, at one of the void's points); a compound when there are several bodies.
+TopoDS_Shape solids_of(const TriSurface& s, const SurfacePieces& pieces) {
+  SharedTopology topo(s);
+  BRep_Builder builder;
+  std::vector<TopoDS_Solid> bodies;
+  std::vector<std::pair<TopoDS_Shell, long>> voids;  // (shell, one of its triangles)
+  for (size_t k = 0; k < pieces.triangles.size(); ++k) {
+    TopoDS_Shell shell;
+    builder.MakeShell(shell);
+    for (long q : pieces.triangles[k]) builder.Add(shell, triangle_face(s, topo, q));
+    shell.Closed(true);
+    if (pieces.volume[k] < 0) {
+      voids.emplace_back(shell, pieces.triangles[k][0]);
+      continue;
+    }
+    TopoDS_Solid solid;
+    builder.MakeSolid(solid);
+    builder.Add(solid, shell);
+    bodies.push_back(solid);
+  }
+  for (const auto& [shell, q] : voids) {
+    const gp_Pnt p = point(s, s.F(q, 0));
+    auto holder = std::find_if(bodies.begin(), bodies.end(), [&](const TopoDS_Solid& b) {
+      return BRepClass3d_SolidClassifier(b, p, 1e-7).State() == TopAbs_IN;
+    });
+    if (holder == bodies.end())
+      throw Error(ErrorCode::InvalidShape, "the result surface has a closed void near (" + std::to_string(p.X()) +
+                                               ", " + std::to_string(p.Y()) + ", " + std::to_string(p.Z()) +
+                                               ") that lies in no body; try other smoothing settings "
+                                               "(\"optimization.smooth\")");
+    builder.Add(*holder, shell);
+  }
+  if (bodies.size() == 1) return bodies[0];
+  TopoDS_Compound all;
+  builder.MakeCompound(all);
+  for (const TopoDS_Solid& b : bodies) builder.Add(all, b);
+  return all;
+}
+
 }  // namespace
+
+int result_bodies(const TriSurface& s) {
+  const SurfacePieces pieces = surface_pieces(s);
+  return static_cast<int>(std::count_if(pieces.volume.begin(), pieces.volume.end(), [](double v) { return v > 0; }));
+}
 
 TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params) {
   const SurfaceCheck check = check_surface(s.V, s.F);
@@ -137,15 +214,9 @@ TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params) {
         ErrorCode::InvalidShape,
         "the result surface is not closed and outward (" + std::to_string(check.unpaired_edges) +
             " unpaired edges): it cannot become a solid; try other smoothing settings (\"optimization.smooth\")");
-  SharedTopology topo(s);
-  BRep_Builder builder;
-  TopoDS_Shell shell;
-  builder.MakeShell(shell);
-  for (long q = 0; q < s.F.rows(); ++q) builder.Add(shell, triangle_face(s, topo, q));
-  shell.Closed(true);
-  TopoDS_Solid solid;
-  builder.MakeSolid(solid);
-  builder.Add(solid, shell);
+  // the bodies of the result (a detached non-design solid is one more) with their voids
+  // inside, not a single shell of several pieces (BRepCheck: not connected)
+  const TopoDS_Shape solid = solids_of(s, surface_pieces(s));
   if (!params.unify) return solid;
   ShapeUpgrade_UnifySameDomain unify(solid, true, true, false);
   unify.SetAngularTolerance(params.angular_tolerance);
@@ -171,6 +242,8 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
                                    const Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
+  rusage before{};
+  ::getrusage(RUSAGE_CHILDREN, &before);
   const pid_t caller = getpid();
   const std::string answer = run_isolated(
       "writing the result as STEP", params.seconds,
@@ -184,10 +257,11 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
         return brep::guard_occt("building the result solid", [&]() {
           const TopoDS_Shape solid = result_solid(s, params);
           const StepExportReport r = describe_solid(solid);
-          if (!r.valid || r.solids != 1)
+          const int bodies = result_bodies(s);
+          if (!r.valid || r.solids != bodies)
             throw Error(ErrorCode::InvalidShape,
-                        "the result solid is not one valid solid (" + std::to_string(r.solids) +
-                            " solids, OCCT's check " + (r.valid ? "passed" : "failed") +
+                        "the result solid is not " + std::to_string(bodies) + " valid solid(s) (" +
+                            std::to_string(r.solids) + " solids, OCCT's check " + (r.valid ? "passed" : "failed") +
                             "); the STL is written: try other smoothing settings (\"optimization.smooth\")");
           write_step_file(solid, path);
           return report_text(r);
@@ -196,6 +270,13 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
       progress);
   StepExportReport r = report_of(answer);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rusage after{};
+  ::getrusage(RUSAGE_CHILDREN, &after);
+  auto cpu = [](const rusage& u) {
+    return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  };
+  r.cpu_seconds = cpu(after) - cpu(before);  // the child, waited for by run_isolated
   std::error_code ec;
   r.bytes = static_cast<long>(std::filesystem::file_size(path, ec));
   return r;

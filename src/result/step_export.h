@@ -16,8 +16,11 @@ class TopoDS_Shape;
 namespace topopt::result {
 
 struct StepExportParams {
-  double seconds = 120;  ///< time budget of the child process that builds and writes the solid (<= 0: none)
-  bool unify = true;     ///< merge coplanar faces and collinear edges (ShapeUpgrade_UnifySameDomain)
+  /// Wall-time budget of the child process that builds and writes the solid (<= 0: none): a
+  /// backstop for a fault inside OCCT, large enough for a machine whose wall clock runs 20 to
+  /// 30 times the CPU time (the rocker needs a few CPU seconds).
+  double seconds = 900;
+  bool unify = true;  ///< merge coplanar faces and collinear edges (ShapeUpgrade_UnifySameDomain)
   /// Angle (radians) within which two facets count as coplanar when merging. Ω's planar faces
   /// are exactly planar; a small value keeps the free-form region's facets apart.
   double angular_tolerance = 1e-6;
@@ -25,21 +28,28 @@ struct StepExportParams {
 
 /// What the solid written holds, as OCCT's checks found it after building.
 struct StepExportReport {
-  bool valid = false;    ///< BRepCheck_Analyzer found no fault
-  int solids = 0;        ///< solids in the shape (1 when all went well)
-  int faces = 0;         ///< B-Rep faces after merging
-  int planar_faces = 0;  ///< faces on a Geom_Plane
-  double volume = 0;     ///< mm³, by OCCT's GProp
-  double seconds = 0;    ///< building, checking and writing
-  long bytes = 0;        ///< size of the STEP file
+  bool valid = false;      ///< BRepCheck_Analyzer found no fault
+  int solids = 0;          ///< solids in the shape (1 when all went well)
+  int faces = 0;           ///< B-Rep faces after merging
+  int planar_faces = 0;    ///< faces on a Geom_Plane
+  double volume = 0;       ///< mm³, by OCCT's GProp
+  double seconds = 0;      ///< building, checking and writing (wall time)
+  double cpu_seconds = 0;  ///< the same in CPU time of the child that did it
+  long bytes = 0;          ///< size of the STEP file
 };
 
 /// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): a planar
 /// face per triangle sharing its edges with the neighbours, then, with params.unify, coplanar
-/// faces merged. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
+/// faces merged. One solid per body of the surface (result_bodies; a compound of them when
+/// there are several, e.g. a detached non-design solid), closed voids as inner shells of the
+/// body holding them. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
 /// first triangle without area or an open surface (what to change: the smoothing settings).
 /// Runs OCCT in this process: callers with foreign or untrusted surfaces use write_result_step.
 TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {});
+
+/// The bodies of the result surface `s`: its pieces (triangles sharing points) that enclose a
+/// positive volume (a piece of negative volume is a closed void inside a body).
+int result_bodies(const TriSurface& s);
 
 /// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer) and
 /// measures its volume; seconds and bytes are left 0.
@@ -49,7 +59,7 @@ StepExportReport describe_solid(const TopoDS_Shape& shape);
 /// with the time budget params.seconds, so that a fault or a hang inside OCCT costs the
 /// export, never the caller. Returns the report of the solid written. Throws Error(Timeout)
 /// past the budget, Error(Crashed) when OCCT ends the child, Error(InvalidShape) when the
-/// solid is not one valid solid, Error(Io) when the file cannot be written.
+/// shape is not valid or not one solid per body (result_bodies), Error(Io) when the file cannot be written.
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params = {},
                                    const Progress& progress = {});
 

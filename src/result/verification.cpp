@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+
+#include <sys/resource.h>
 #include <unordered_map>
 
 #include "common/error.h"
@@ -17,6 +19,15 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// CPU seconds (user + system) of this process (RUSAGE_SELF, all threads) or of its ended
+/// children (RUSAGE_CHILDREN: the meshing child once run_isolated has waited for it).
+double cpu_seconds(int who) {
+  rusage u{};
+  ::getrusage(who, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 Eigen::Vector3d corner(const MatX3d& V, const MatX3i& F, long q, int k) { return V.row(F(q, k)).transpose(); }
@@ -126,6 +137,71 @@ mesh::VolumeFillResult unpack(const std::string& b) {
   return r;
 }
 
+/// Keeps in `m` only the pieces (tets sharing nodes) that hold a fixed dof of `problem`'s
+/// supports; returns the volumes of those left out. Throws Error(NoSupport) naming a piece
+/// left out on which a load acts.
+std::vector<double> drop_unheld_pieces(TetMesh& m, const VerificationProblem& problem) {
+  int count = 0;
+  const VecXi piece = node_components(m, std::vector<char>(m.T.rows(), 1), count);
+  if (count <= 1) return {};
+  std::vector<char> held(count, 0), loaded(count, 0);
+  std::vector<int> piece_of_node(m.V.rows(), -1);
+  for (long t = 0; t < m.T.rows(); ++t)
+    for (int k = 0; k < 4; ++k) piece_of_node[m.T(t, k)] = piece[t];
+  for (int d : fem::make_supports(m, problem.supports).dofs)
+    if (piece_of_node[d / 3] >= 0) held[piece_of_node[d / 3]] = 1;
+  const Eigen::MatrixXd loads = fem::make_loads(m, problem.material, problem.load_cases);
+  for (long i = 0; i < m.V.rows(); ++i)
+    if (piece_of_node[i] >= 0 && loads.middleRows(3 * i, 3).cwiseAbs().maxCoeff() > 0) loaded[piece_of_node[i]] = 1;
+  std::vector<double> volume(count, 0.0);
+  std::vector<Eigen::Vector3d> centre(count, Eigen::Vector3d::Zero());
+  for (long t = 0; t < m.T.rows(); ++t) {
+    const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                          d = m.V.row(m.T(t, 3));
+    const double v = (b - a).dot((c - a).cross(d - a)) / 6;
+    volume[piece[t]] += v, centre[piece[t]] += v * (a + b + c + d) / 4;
+  }
+  std::vector<double> dropped;
+  for (int k = 0; k < count; ++k) {
+    if (held[k]) continue;
+    const Eigen::Vector3d c = centre[k] / std::max(volume[k], 1e-300);
+    if (loaded[k])
+      throw Error(ErrorCode::NoSupport, "a load acts on a piece of the result (" +
+                                            std::to_string(static_cast<long>(volume[k])) + " mm³ around (" +
+                                            std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " +
+                                            std::to_string(c.z()) +
+                                            ")) that no support holds: the design does not carry it; give more volume "
+                                            "(\"optimization.volume_fraction\") or a lower threshold");
+    dropped.push_back(volume[k]);
+  }
+  if (dropped.empty()) return {};
+  MatX4i T(m.T.rows(), 4);
+  long n = 0;
+  for (long t = 0; t < m.T.rows(); ++t)
+    if (held[piece[t]]) T.row(n++) = m.T.row(t);
+  T.conservativeResize(n, 4);
+  std::vector<int> renum(m.V.rows(), -1);  // the kept pieces' nodes, in their order
+  int nv = 0;
+  for (long t = 0; t < n; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (renum[T(t, k)] < 0) renum[T(t, k)] = nv++;
+  MatX3d V(nv, 3);
+  for (long i = 0; i < m.V.rows(); ++i)
+    if (renum[i] >= 0) V.row(renum[i]) = m.V.row(i);
+  for (long t = 0; t < n; ++t)
+    for (int k = 0; k < 4; ++k) T(t, k) = renum[T(t, k)];
+  long nf = 0;
+  for (long q = 0; q < m.F.rows(); ++q)
+    if (renum[m.F(q, 0)] >= 0) {
+      m.F.row(nf) << renum[m.F(q, 0)], renum[m.F(q, 1)], renum[m.F(q, 2)];
+      m.face[nf] = m.face[q], m.nd_face[nf] = m.nd_face[q], ++nf;
+    }
+  m.F.conservativeResize(nf, 3), m.face.conservativeResize(nf), m.nd_face.conservativeResize(nf);
+  m.V = V, m.T = T;
+  m.domain = VecXi::Zero(n);
+  return dropped;
+}
+
 }  // namespace
 
 TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
@@ -164,6 +240,7 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
                         const VecXd& scale, const fem::SolverParams& solver, const Progress& progress,
                         Eigen::MatrixXd* U, std::vector<VecXd>* von_mises) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds(RUSAGE_SELF);
   const fem::Supports supports = fem::make_supports(mesh, problem.supports);
   const Eigen::MatrixXd loads = fem::make_loads(loaded, problem.material, problem.load_cases);
   fem::Elasticity fe(mesh, problem.material, supports, solver);
@@ -186,6 +263,7 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
   a.nodes = std::count(node_used.begin(), node_used.end(), 1);
   a.tets = scale.size() ? (scale.array() >= 1).count() : mesh.T.rows();
   a.seconds = seconds_since(t0);
+  a.cpu_seconds = cpu_seconds(RUSAGE_SELF) - cpu0;
   if (U) *U = u;
   return a;
 }
@@ -204,13 +282,19 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
                                         " s; the result files are written, only the verification is missing");
   };
   Verification v;
+  const double child_cpu0 = cpu_seconds(RUSAGE_CHILDREN), cpu0 = cpu_seconds(RUSAGE_SELF);
   try {
     v.mesh = verification_mesh(s, fe, params.fill, params.seconds, timed);
   } catch (const Error& e) {
     if (e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Timeout) out_of_time("meshing the result solid");
     throw;
   }
+  v.unheld_volumes = drop_unheld_pieces(v.mesh, problem);
+  for (double vol : v.unheld_volumes)
+    progress.warn("verification: a piece of the result of " + std::to_string(static_cast<long>(vol)) +
+                  " mm³ that no support holds and no load acts on (a detached non-design solid?) is left out");
   const double seconds_mesh = seconds_since(t0);
+  const double cpu_mesh = cpu_seconds(RUSAGE_CHILDREN) - child_cpu0 + cpu_seconds(RUSAGE_SELF) - cpu0;
   // the crisp design on the FE mesh: removed tets keep void_stiffness, only kept tets weigh
   const std::vector<char> kept = crisp_tets(fe, node_densities(fe, design), threshold);
   VecXd scale(fe.T.rows());
@@ -226,6 +310,7 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   try {
     v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
     v.as_built.seconds += seconds_mesh;
+    v.as_built.cpu_seconds += cpu_mesh;
     v.crisp = analyse(fe, loaded, problem, scale, params.solver, timed);
   } catch (const Error& e) {
     if (e.code() == ErrorCode::Cancelled) out_of_time("solving the verification");

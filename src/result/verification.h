@@ -16,7 +16,11 @@
 namespace topopt::result {
 
 struct VerificationParams {
-  double seconds = 300;          ///< wall-time budget of meshing the result and solving (<= 0: none)
+  /// Wall-time backstop of meshing the result and solving (<= 0: none). The fill itself stops
+  /// by name within its CPU budget (VolumeFillParams::cpu_seconds, proportional to its tets);
+  /// this only catches what that cannot (a machine so loaded that the wall clock runs 20 to
+  /// 30 times the CPU time, as measured on the shared 2-core machine, must not lose the result).
+  double seconds = 1800;
   mesh::VolumeFillParams fill;   ///< the volume mesher's settings (default: size graded from the surface)
   fem::SolverParams solver;      ///< the linear solver (default: chosen by size)
   double void_stiffness = 1e-9;  ///< the crisp design's removed tets keep this share of E (as SIMP's void)
@@ -37,7 +41,8 @@ struct AnalysisFigures {
   double max_von_mises = 0;
   long tets = 0;
   long nodes = 0;
-  double seconds = 0;  ///< meshing (as built only) and solving
+  double seconds = 0;      ///< meshing (as built only) and solving, wall time
+  double cpu_seconds = 0;  ///< the same in CPU time (the meshing child's and this process's, all threads)
 };
 
 struct Verification {
@@ -46,6 +51,10 @@ struct Verification {
   TetMesh mesh;              ///< the verification mesh: tets of the result, F the result surface with Ω's face tags
   Eigen::MatrixXd U;         ///< (3 #V) by #cases displacements on `mesh`
   std::vector<VecXd> von_mises;  ///< per case, #T of `mesh` (MPa)
+  /// Pieces of the result solid that no support holds and no load acts on (a detached
+  /// non-design solid the design does not reach): left out of `mesh` and the as-built
+  /// analysis (they carry nothing and would make it singular), their volumes here (mm³).
+  std::vector<double> unheld_volumes;
   double ratio() const { return crisp.compliance > 0 ? as_built.compliance / crisp.compliance : 0; }
 };
 
@@ -67,9 +76,11 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
 
 /// The verification: `s` meshed and solved (as built) and the crisp design of `design` (#T
 /// element densities after hygiene, cut at `threshold` as the surface was) solved on `fe`.
-/// The whole runs within params.seconds: past it, Error(Timeout) naming the step. Throws
-/// what fill_volume and fem throw (MeshingFailed, FaceNotFound when a support's face is gone,
-/// NoSupport).
+/// The whole runs within params.seconds: past it, Error(Timeout) naming the step. Pieces of
+/// the result that no support holds are left out (Verification::unheld_volumes, a warning through
+/// progress) when no load acts on them; Error(NoSupport) naming the piece when one does (the
+/// design does not carry that load). Throws what fill_volume and fem throw (MeshingFailed,
+/// FaceNotFound when a support's face is gone).
 Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& design, double threshold,
                            const VerificationProblem& problem, const VerificationParams& params = {},
                            const Progress& progress = {});

@@ -42,7 +42,11 @@ class SpatialGrid {
     Level& L = levels_[k];
     for_cells(L.cell(lo, origin_), L.cell(hi, origin_), [&](const Cell& c) {
       std::vector<int>& ids = L.buckets[key(c)];
-      if (ids.empty()) ++L.blocks[key(block_of(c))];
+      if (ids.empty()) {
+        Block& bl = L.blocks[key(block_of(c))];
+        bl.at = block_of(c);
+        ++bl.cells;
+      }
       ids.push_back(id);
     });
     max_id_ = std::max(max_id_, id);
@@ -71,7 +75,7 @@ class SpatialGrid {
       if (w == 0) {  // the cell emptied: its block counts one occupied cell less
         L.buckets.erase(it);
         auto bl = L.blocks.find(key(block_of(c)));
-        if (bl != L.blocks.end() && --bl->second <= 0) L.blocks.erase(bl);
+        if (bl != L.blocks.end() && --bl->second.cells <= 0) L.blocks.erase(bl);
       }
     });
   }
@@ -90,11 +94,15 @@ class SpatialGrid {
 
  private:
   using Cell = std::array<long, Dim>;
+  struct Block {
+    Cell at{};      ///< the block's coordinates (its cells' >> 4)
+    int cells = 0;  ///< its non-empty cells
+  };
   struct Level {
     explicit Level(double inv_cell) : inv(inv_cell) {}
     double inv;                                              ///< 1 / the cell's edge
     std::unordered_map<uint64_t, std::vector<int>> buckets;  ///< ids per non-empty cell
-    std::unordered_map<uint64_t, int> blocks;                ///< non-empty cells per block of 16^Dim
+    std::unordered_map<uint64_t, Block> blocks;              ///< the occupied blocks of 16^Dim cells
     Cell cell(const double* p, const std::array<double, Dim>& o) const {
       Cell c;
       for (int d = 0; d < Dim; ++d) c[d] = static_cast<long>(std::floor((p[d] - o[d]) * inv));
@@ -130,25 +138,51 @@ class SpatialGrid {
     }
   }
 
+  /// The occupied blocks of level L overlapping blocks [ba, bb], in the order of for_cells:
+  /// found by walking the box's blocks or, when the box holds more blocks than the level has
+  /// occupied ones (a wide query over a fine level: a surface with a few tiny triangles puts
+  /// their nodes on a level whose cells are 10^-4 of the others, and a query box of the usual
+  /// size then spans ~10^9 of its blocks), by filtering the occupied ones and sorting them.
+  static void blocks_in(const Level& L, const Cell& ba, const Cell& bb, std::vector<Cell>& out) {
+    out.clear();
+    double in_box = 1;
+    for (int d = 0; d < Dim; ++d) in_box *= static_cast<double>(bb[d] - ba[d] + 1);
+    if (in_box <= static_cast<double>(L.blocks.size())) {
+      for_cells(ba, bb, [&](const Cell& blk) {
+        if (L.blocks.count(key(blk))) out.push_back(blk);
+      });
+      return;
+    }
+    for (const auto& kv : L.blocks) {
+      const Cell& blk = kv.second.at;
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) inside = inside && blk[d] >= ba[d] && blk[d] <= bb[d];
+      if (inside) out.push_back(blk);
+    }
+    std::sort(out.begin(), out.end());
+  }
+
   /// Calls on_cell(level, cell) for the cells overlapping [lo, hi] on every level holding
-  /// items: all of them when they are few, else those inside the level's occupied blocks.
+  /// items: all of them when they are few, else those inside the level's occupied blocks
+  /// (blocks_in: at most as many blocks looked at as the level has occupied).
   template <class Self, class OnCell>
   static void scan(Self& self, const double* lo, const double* hi, OnCell&& on_cell) {
+    std::vector<Cell> blocks;
     for (auto& L : self.levels_) {
       if (L.blocks.empty()) continue;
       const Cell a = L.cell(lo, self.origin_), b = L.cell(hi, self.origin_);
-      long cells = 1;
-      for (int d = 0; d < Dim; ++d) cells *= b[d] - a[d] + 1;
+      double cells = 1;
+      for (int d = 0; d < Dim; ++d) cells *= static_cast<double>(b[d] - a[d] + 1);
       if (cells <= 64) {
         for_cells(a, b, [&](const Cell& c) { on_cell(L, c); });
         continue;
       }
-      for_cells(block_of(a), block_of(b), [&](const Cell& blk) {
-        if (!L.blocks.count(key(blk))) return;
+      blocks_in(L, block_of(a), block_of(b), blocks);
+      for (const Cell& blk : blocks) {
         Cell ca, cb;
         for (int d = 0; d < Dim; ++d) ca[d] = std::max(a[d], blk[d] << 4), cb[d] = std::min(b[d], (blk[d] << 4) + 15);
         for_cells(ca, cb, [&](const Cell& c) { on_cell(L, c); });
-      });
+      }
     }
   }
 

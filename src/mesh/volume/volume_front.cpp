@@ -1,6 +1,8 @@
 // 3D advancing front: the driver of named steps (see volume_front.h).
 #include "mesh/volume/volume_front.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -287,7 +289,8 @@ class FrontFill {
         << "); a coarser or smoother surface mesh there may help";
       throw Error(ErrorCode::MeshingFailed, s.str());
     }
-    if (tets_.size() % 20000 == 0) progress_.check_cancel("volume meshing");
+    // by faces taken, not tets made: a front whose faces keep failing makes none
+    if (++taken_ % 256 == 0) progress_.check_cancel("volume meshing (advancing front)");
   }
 
   [[noreturn]] void throw_too_large() const {
@@ -323,12 +326,35 @@ class FrontFill {
   TetFront front_;
   std::vector<Tet> tets_;
   long bulk_tets_ = 0;
+  long taken_ = 0;  ///< faces taken from the queue (cancellation checks)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue_;
   std::vector<int> near_nodes_;
   std::vector<std::pair<double, int>> candidates_;        ///< (score, node; -1 - k = new_points_[k])
   std::vector<std::pair<double, int>> near_by_distance_;  ///< (distance to the ideal point, node)
   std::vector<Vec3> new_points_;
 };
+
+/// CPU seconds the calling thread has used (the fill runs on one thread; a machine shared
+/// with other work slows its clock, not its budget).
+double thread_cpu_seconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// `progress` whose cancelled() also answers yes once this thread has used `seconds` of CPU
+/// from now (<= 0: never); `expired` is set when that is why.
+Progress within_cpu_budget(const Progress& progress, double seconds, std::shared_ptr<bool> expired) {
+  if (seconds <= 0) return progress;
+  Progress timed = progress;
+  const double end = thread_cpu_seconds() + seconds;
+  timed.cancelled = [progress, end, expired] {
+    if (progress.cancelled && progress.cancelled()) return true;
+    if (thread_cpu_seconds() > end) *expired = true;
+    return *expired;
+  };
+  return timed;
+}
 
 /// The fill itself on nodes P (the input nodes, to which it appends): fill_volume retries
 /// without the bulk when this fails with it. `budget`: the front stops with a named error
@@ -397,23 +423,10 @@ VolumeFillResult compact(long inputs, const std::vector<Vec3>& P, const std::vec
   return out;
 }
 
-}  // namespace
-
-VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& given,
-                             const Progress& progress) {
-  VolumeFillParams params = given;
-  if (!params.size && F.rows() > 0) params.size = default_size(V, F, T0);
-  // the front's budget: many times the tets its size asks for, and room for a fine boundary
-  // (the grid resolves the region about as finely as its boundary: 8 cells per triangle, at
-  // least 100 k, at most 1 M)
-  const long cells = std::clamp(8 * static_cast<long>(F.rows()), 100'000L, 1'000'000L);
-  const double expected = params.size ? expected_tets(V, F, params.size, cells) : 0.0;
-  const long budget = expected > 0 ? static_cast<long>(kBudgetFactor * expected) + 30 * F.rows() + 100'000 : 0;
-  progress.info("volume: the size asks for about " + std::to_string(static_cast<long>(expected)) + " tets");
-  // one copy of the nodes in, one out: a fill only appends to them, so a retry starts from
-  // the input nodes by dropping what the failed attempt appended
-  std::vector<Vec3> P(V.rows());
-  for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
+/// The fill's steps within the budget of `timed` (within_cpu_budget): the front (retried
+/// without the bulk when that fails), the improvement, the flat-tet removal. Returns the tets.
+std::vector<Tet> fill_and_improve(std::vector<Vec3>& P, const MatX3d& V, const MatX3i& F, const MatX4i& T0,
+                                  VolumeFillParams& params, long budget, const Progress& progress) {
   std::vector<Tet> tets;
   try {
     tets = fill_tets(P, F, T0, params, budget, progress);
@@ -435,7 +448,46 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   ip.sliver_floor = params.sliver_floor;
   improve_tets(P, tets, static_cast<int>(V.rows()), ip, progress);
   remove_flat_tets(P, tets, progress);
-  return compact(V.rows(), P, tets);
+  return tets;
+}
+
+}  // namespace
+
+double volume_fill_seconds(long tet_budget) { return 10.0 + static_cast<double>(tet_budget) / 4000.0; }
+
+VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& given,
+                             const Progress& progress) {
+  VolumeFillParams params = given;
+  if (!params.size && F.rows() > 0) params.size = default_size(V, F, T0);
+  // the front's budget: many times the tets its size asks for, and room for a fine boundary
+  // (the grid resolves the region about as finely as its boundary: 8 cells per triangle, at
+  // least 100 k, at most 1 M)
+  const long cells = std::clamp(8 * static_cast<long>(F.rows()), 100'000L, 1'000'000L);
+  const double expected = params.size ? expected_tets(V, F, params.size, cells) : 0.0;
+  const long budget = expected > 0 ? static_cast<long>(kBudgetFactor * expected) + 30 * F.rows() + 100'000 : 0;
+  progress.info("volume: the size asks for about " + std::to_string(static_cast<long>(expected)) + " tets");
+  // one copy of the nodes in, one out: a fill only appends to them, so a retry starts from
+  // the input nodes by dropping what the failed attempt appended
+  std::vector<Vec3> P(V.rows());
+  for (long i = 0; i < V.rows(); ++i) P[i] = V.row(i).transpose();
+  const double seconds =
+      params.cpu_seconds != 0 ? params.cpu_seconds : volume_fill_seconds(budget > 0 ? budget : 30 * F.rows() + 100'000);
+  auto expired = std::make_shared<bool>(false);
+  const Progress timed = within_cpu_budget(progress, seconds, expired);
+  try {
+    const std::vector<Tet> tets = fill_and_improve(P, V, F, T0, params, budget, timed);
+    return compact(V.rows(), P, tets);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::Cancelled || !*expired) throw;
+    const std::string what = e.what();  // "cancelled during <stage>" (Progress::check_cancel)
+    const size_t at = what.find("during ");
+    std::ostringstream s;
+    s << "the volume mesh did not finish within its budget of " << static_cast<long>(std::ceil(seconds))
+      << " s of computing (for about " << static_cast<long>(expected) << " tets); it was stopped while "
+      << (at == std::string::npos ? what : what.substr(at + 7))
+      << "; a coarser or smoother surface mesh, or a larger size, may help";
+    throw Error(ErrorCode::Timeout, s.str());
+  }
 }
 
 }  // namespace topopt::mesh

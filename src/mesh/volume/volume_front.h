@@ -35,7 +35,17 @@ struct VolumeFillParams {
   double sliver_below = 0.4;     ///< new tets below this get a compass search on their nodes each round, then sliver
                                  ///< removal by point insertion, worst first, up to 3 times (0: none)
   double sliver_floor = 0.1;     ///< then tets below this get wider cavities re-filled (tet_improve.h; 0: none)
+  /// CPU seconds of the calling thread the whole fill (retry and improvement included) may
+  /// take before it stops with Error(Timeout); 0: volume_fill_seconds of the tets the front may
+  /// make (its budget, proportional to what the size asks for); < 0: no limit.
+  double cpu_seconds = 0;
 };
+
+/// The automatic time budget of a fill allowed to make up to `tet_budget` tets (fill_volume's:
+/// ten times what the size asks for, plus room for a fine boundary): 10 s plus one CPU
+/// second per 4 000 tets. The fill makes about 8 000 tets per CPU second with its improvement
+/// (result surfaces of the examples, 2026), so a fill that ends normally uses a few per cent of it.
+double volume_fill_seconds(long tet_budget);
 
 struct VolumeFillResult {
   MatX3d V;  ///< #V' by 3: the input nodes (unchanged, same indices) then the new ones the tets use
@@ -48,7 +58,9 @@ struct VolumeFillResult {
 /// kFlatRadiusRatio): such a tet is taken out and its cavity re-filled. Throws
 /// Error(MeshingFailed) naming where the front could not be closed, where it went on making
 /// tets past ten times what its size asks for (expected_tets) without closing, or where a flat
-/// tet could not be removed; Error(Cancelled) when progress says so (checked in every loop).
+/// tet could not be removed; Error(Timeout) naming the stage past params.cpu_seconds (the
+/// shared rule: every mesh ends or fails by name within a budget proportional to its expected
+/// tets); Error(Cancelled) when progress says so (both checked in every loop).
 VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0, const VolumeFillParams& params = {},
                              const Progress& progress = {});
 

@@ -18,6 +18,7 @@
 #include "common/error.h"
 #include "simp/density_filter.h"
 #include "testing/bar_field.h"
+#include "testing/cube_piece.h"
 
 namespace topopt::result {
 namespace {
@@ -60,6 +61,26 @@ TEST(StepExport, OneValidSolidWithTheSurfacesVolumeAndMergedPlanarFaces) {
   EXPECT_LE(r.faces, free_form + r.planar_faces);
   // without merging every triangle is a face
   EXPECT_EQ(describe_solid(result_solid(s, {.unify = false})).faces, s.F.rows());
+}
+
+TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
+  // a detached piece (the bracket's and the mount's results hold detached non-design solids)
+  // made one shell of several pieces, which BRepCheck refuses: one solid per body now
+  const TriSurface bar = bar_surface();
+  const double volume = check_surface(bar.V, bar.F).volume;
+  const TriSurface two = testing::with_cube(bar, {20, 16, 1}, 3);  // clear of the bar
+  EXPECT_EQ(result_bodies(two), 2);
+  StepExportReport r = describe_solid(result_solid(two));
+  EXPECT_TRUE(r.valid);
+  EXPECT_EQ(r.solids, 2);
+  EXPECT_NEAR(r.volume, volume + 27, 1e-6 * volume);
+  // a closed void inside the first end block (x in [0, 6], y in [6, 14], z in [2, 8])
+  const TriSurface hollow = testing::with_cube(bar, {2, 9, 4}, 2, true);
+  EXPECT_EQ(result_bodies(hollow), 1);
+  r = describe_solid(result_solid(hollow));
+  EXPECT_TRUE(r.valid);
+  EXPECT_EQ(r.solids, 1);
+  EXPECT_NEAR(r.volume, volume - 8, 1e-6 * volume);
 }
 
 TEST(StepExport, TheStepFileReadsBackAsOneValidSolidOfTheSameVolume) {

@@ -5,12 +5,17 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "common/error.h"
 #include "fem/elasticity.h"
+#include "mesh/core/conformity.h"
 #include "simp/density_filter.h"
 #include "testing/bar_field.h"
+#include "testing/cube_piece.h"
 
 namespace topopt::result {
 namespace {
@@ -79,6 +84,109 @@ TEST(Verification, AsBuiltComplianceMatchesAnIndependentSolveAndTheCrispDesign) 
   EXPECT_GT(v.as_built.max_displacement, 0.5 * beam);
   EXPECT_LT(v.as_built.max_displacement, 3 * beam);
   EXPECT_GT(v.as_built.max_von_mises, 0);
+}
+
+/// The bar's result surface with one tiny triangle (edges about 1e-4 of the others) at a
+/// corner of triangle q: two points inserted next to it, each splitting a triangle in three,
+/// in the triangle's plane (the surface stays closed and does not cross itself), as a cut
+/// point landing next to a node leaves on a result surface. The tiny triangle comes first.
+TriSurface with_tiny_triangle(const TriSurface& s, long q) {
+  const int a = s.F(q, 0), b = s.F(q, 1), c = s.F(q, 2);
+  const Eigen::RowVector3d A = s.V.row(a), B = s.V.row(b), C = s.V.row(c);
+  const Eigen::RowVector3d Q1 = A + 1e-4 * ((B - A) + (C - A));       // inside (a, b, c)
+  const Eigen::RowVector3d Q2 = A + 1e-4 * (C - A) + 0.5 * (Q1 - A);  // inside (c, a, q1)
+  TriSurface t = s;
+  const int q1 = static_cast<int>(s.V.rows()), q2 = q1 + 1;
+  t.V.conservativeResize(q1 + 2, 3);
+  t.V.row(q1) = Q1, t.V.row(q2) = Q2;
+  const std::vector<std::array<int, 3>> split = {{a, q1, q2}, {a, b, q1}, {b, c, q1}, {c, a, q2}, {q1, c, q2}};
+  t.F.resize(s.F.rows() + 4, 3);
+  t.tag.resize(t.F.rows());
+  for (size_t k = 0; k < split.size(); ++k) t.F.row(k) << split[k][0], split[k][1], split[k][2], t.tag[k] = s.tag[q];
+  for (long r = 0, w = 5; r < s.F.rows(); ++r)
+    if (r != q) t.F.row(w) = s.F.row(r), t.tag[w++] = s.tag[r];
+  return t;
+}
+
+TEST(Verification, MeshesAResultSurfaceWithATinyTriangleWithinItsBudget) {
+  // a tiny triangle put the volume front's spatial grid on a level of 1e-4 mm cells, and every
+  // search for nearby front nodes then walked billions of empty blocks: the verification hung
+  // (last seen in TetFront::nodes_near). The fill must end, conformal and of the surface's
+  // volume, well within its CPU budget (it takes about a second)
+  const Fixture f = bar_fixture();
+  const TriSurface s = with_tiny_triangle(f.surface, f.surface.F.rows() / 2);
+  double volume = 0, shortest = 1e300;
+  for (long q = 0; q < s.F.rows(); ++q) {
+    volume += s.V.row(s.F(q, 0)).dot(s.V.row(s.F(q, 1)).cross(s.V.row(s.F(q, 2)))) / 6;
+    for (int k = 0; k < 3; ++k)
+      shortest = std::min(shortest, (s.V.row(s.F(q, k)) - s.V.row(s.F(q, (k + 1) % 3))).norm());
+  }
+  ASSERT_LT(shortest, 1e-3);  // the tiny triangle is there
+  mesh::VolumeFillParams fill;
+  fill.cpu_seconds = 60;
+  const mesh::VolumeFillResult r = mesh::fill_volume(s.V, s.F, MatX4i(0, 4), fill);
+  TetMesh m;
+  m.V = r.V, m.T = r.T, m.F = s.F;
+  m.domain = VecXi::Zero(m.T.rows());
+  m.face = VecXi::Ones(s.F.rows());
+  const mesh::ConformityReport c = mesh::check_conformity(m);
+  EXPECT_TRUE(c.ok()) << c.describe();
+  double filled = 0;
+  for (long t = 0; t < m.T.rows(); ++t) {
+    const Eigen::RowVector3d p = m.V.row(m.T(t, 0));
+    filled += (m.V.row(m.T(t, 1)) - p).dot((m.V.row(m.T(t, 2)) - p).cross(m.V.row(m.T(t, 3)) - p)) / 6;
+  }
+  EXPECT_NEAR(filled, volume, 1e-9 * volume);
+}
+
+TEST(Verification, AVolumeFillStopsByNameAtItsBudget) {
+  // the shared rule (issue 20): a fill ends or fails with a named error within a budget; a
+  // budget far too small for the bar must stop it with Timeout naming the budget
+  const Fixture f = bar_fixture();
+  mesh::VolumeFillParams fill;
+  fill.cpu_seconds = 1e-4;
+  try {
+    mesh::fill_volume(f.surface.V, f.surface.F, MatX4i(0, 4), fill);
+    FAIL() << "a fill with no time finished";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Timeout);
+    EXPECT_NE(std::string(e.what()).find("did not finish within its budget"), std::string::npos) << e.what();
+  }
+  EXPECT_GT(mesh::volume_fill_seconds(1'000'000), mesh::volume_fill_seconds(10'000));
+}
+
+TEST(Verification, LeavesOutAnUnloadedPieceNoSupportHoldsAndRefusesALoadedOne) {
+  // a detached non-design solid (the bracket's result has one) made the as-built stiffness
+  // singular: left out and reported with its volume; the compliance is the bar's alone
+  const Fixture f = bar_fixture();
+  // a cube [20, 23] x [16, 19] x [1, 4] (27 mm³), clear of the bar
+  const TriSurface s = testing::with_cube(f.surface, {20, 16, 1}, 3);
+  std::vector<std::string> warnings;
+  Progress p;
+  p.log = [&](LogLevel level, const std::string& m) {
+    if (level == LogLevel::Warning) warnings.push_back(m);
+  };
+  const Verification v = verify_result(s, f.mesh, f.density, 0.5, f.problem, {}, p);
+  ASSERT_EQ(v.unheld_volumes.size(), 1u);
+  EXPECT_NEAR(v.unheld_volumes[0], 27, 1e-9);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("27 mm³"), std::string::npos) << warnings[0];
+  const Verification bar = verify_result(f.surface, f.mesh, f.density, 0.5, f.problem);
+  EXPECT_EQ(v.mesh.T.rows(), bar.mesh.T.rows());
+  EXPECT_NEAR(v.as_built.compliance, bar.as_built.compliance, 1e-9 * bar.as_built.compliance);
+  // gravity loads every piece: the cube then carries a load no support takes
+  VerificationProblem heavy = f.problem;
+  fem::LoadSpec g;
+  g.kind = fem::LoadSpec::Kind::Gravity;
+  g.vector = {0, 0, -9810};
+  heavy.load_cases[0].items.push_back(g);
+  try {
+    verify_result(s, f.mesh, f.density, 0.5, heavy);
+    FAIL() << "a loaded piece without support was verified";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NoSupport);
+    EXPECT_NE(std::string(e.what()).find("27 mm³ around (21.5"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Verification, RunsWithinItsBudgetOrSaysWhichStepRanOut) {

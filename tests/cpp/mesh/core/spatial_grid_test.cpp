@@ -95,6 +95,29 @@ TEST(SpatialGrid, CandidatesStayNearTheQueryBox) {
   EXPECT_EQ(out, std::vector<int>{id});
 }
 
+TEST(SpatialGrid, AWideQueryOverATinyLevelLooksOnlyAtItsOccupiedBlocks) {
+  // the volume front's grid starts at the shortest boundary edge: a result surface with one
+  // tiny triangle (1e-6 of the part) put its nodes on a level whose blocks a query of the
+  // usual size spans ~10^17 of; walking them all hung the verification (TetFront::nodes_near).
+  // Only the level's few occupied blocks may be looked at: this query must return at once.
+  const double origin[3] = {0, 0, 0};
+  SpatialGrid<3> grid(origin, 1e-6);
+  const double tiny_lo[3] = {5, 5, 5}, tiny_hi[3] = {5 + 5e-7, 5 + 5e-7, 5 + 5e-7};
+  grid.insert(0, tiny_lo, tiny_hi);  // level 0
+  const double p1[3] = {1, 2, 3}, p2[3] = {9, 9, 9};
+  grid.insert(1, p1, p1), grid.insert(2, p2, p2);  // level 0 too, far apart
+  const double mid_lo[3] = {4, 4, 4}, mid_hi[3] = {4.5, 4.5, 4.5};
+  grid.insert(3, mid_lo, mid_hi);                     // a coarse level
+  const double lo[3] = {0, 0, 0}, hi[3] = {8, 8, 8};  // 8e6 cells of level 0 a side
+  std::vector<int> out;
+  grid.query(lo, hi, out, [](int) { return true; });
+  std::sort(out.begin(), out.end());
+  EXPECT_EQ(out, (std::vector<int>{0, 1, 3}));
+  int visited = 0;
+  grid.for_each(lo, hi, [&](int) { ++visited; });
+  EXPECT_EQ(visited, 3);
+}
+
 TEST(SpatialGrid, PointsInThePlaneByTheConstVisit) {
   // a size field as the surface mesher builds one: min over points of s_i + g·distance, where
   // only points within the reach (h − min s) / g can win; the grid's answer equals brute force
