@@ -124,9 +124,23 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
   EXPECT_TRUE(c1.valid()) << c1.crossings.size() << " crossings";
   EXPECT_GT(c1.min_angle_free, c0.min_angle_free);
   EXPECT_NEAR(c1.closed.volume, kept, 0.01 * kept);
-  // locked points keep their places (free points may move within their triangles' plane)
+  // non-design points keep their places; points on Ω's boundary may move only within the plane
+  // of every planar Ω face they touch (free points within their triangles' plane)
   for (size_t i = 0; i < r.kept_points.size(); ++i)
-    if (s.lock[i] != 0) EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
+    if (s.lock[i] == 2) {
+      EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
+    }
+  long on_planes = 0;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    const int f = s.tag[t];
+    if (f <= 0 || f >= static_cast<int>(s.face_plane.size()) || s.face_plane[f].head<3>().norm() == 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d x = s.V.row(s.F(t, k)).transpose();
+      EXPECT_NEAR(s.face_plane[f].head<3>().dot(x), s.face_plane[f][3], 1e-9) << "face " << f;
+      ++on_planes;
+    }
+  }
+  EXPECT_GT(on_planes, 0);
   long locked_before = (lock0.array() == 2).count(), locked_after = (s.lock.array() == 2).count();
   EXPECT_EQ(locked_after, locked_before);
 }

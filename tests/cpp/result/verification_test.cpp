@@ -172,8 +172,14 @@ TEST(Verification, LeavesOutAnUnloadedPieceNoSupportHoldsAndRefusesALoadedOne) {
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("27 mm³"), std::string::npos) << warnings[0];
   const Verification bar = verify_result(f.surface, f.mesh, f.density, 0.5, f.problem);
-  EXPECT_EQ(v.mesh.T.rows(), bar.mesh.T.rows());
-  EXPECT_NEAR(v.as_built.compliance, bar.as_built.compliance, 1e-9 * bar.as_built.compliance);
+  // no tet of the cube is left in the analysed mesh
+  for (long i = 0; i < v.mesh.V.rows(); ++i) {
+    const bool in_cube = v.mesh.V(i, 0) > 19.9 && v.mesh.V(i, 1) > 15.9 && v.mesh.V(i, 2) > 0.9;
+    ASSERT_FALSE(in_cube) << "node " << i << " of the left-out cube";
+  }
+  // the bar's compliance: not to the digit, since the fill's sizes depend on the whole surface
+  // (the bar's tets differ with the cube beside it: 14 459 against 15 483)
+  EXPECT_NEAR(v.as_built.compliance, bar.as_built.compliance, 0.02 * bar.as_built.compliance);
   // gravity loads every piece: the cube then carries a load no support takes
   VerificationProblem heavy = f.problem;
   fem::LoadSpec g;
