@@ -8,8 +8,10 @@
 
 #include <sys/resource.h>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "common/error.h"
+#include "common/face_key.h"
 #include "common/isolate.h"
 #include "fem/elasticity.h"
 #include "result/design_hygiene.h"
@@ -202,6 +204,38 @@ std::vector<double> drop_unheld_pieces(TetMesh& m, const VerificationProblem& pr
   return dropped;
 }
 
+/// The crisp design's part of `fe` that takes loads: its kept tets (body loads) and only the
+/// boundary triangles that are faces of kept tets (face loads), so a load face the design keeps
+/// only in part is loaded where material is, as on the result solid, and no force lands on
+/// nodes held by removed tets alone (their void stiffness made the compliance ~10^7 times the
+/// as-built one on a top-loaded box).
+TetMesh crisp_loaded_mesh(const TetMesh& fe, const std::vector<char>& kept) {
+  TetMesh loaded = fe;
+  if (loaded.domain.size() != fe.T.rows()) loaded.domain = VecXi::Zero(fe.T.rows());
+  std::unordered_set<FaceKey, FaceKeyHash> kept_faces;
+  long n = 0;
+  for (long t = 0; t < fe.T.rows(); ++t) {
+    if (!kept[t]) continue;
+    for (int k = 0; k < 4; ++k)
+      kept_faces.insert(face_key(fe.T(t, kTetFace[k][0]), fe.T(t, kTetFace[k][1]), fe.T(t, kTetFace[k][2])));
+    loaded.T.row(n) = fe.T.row(t), loaded.domain[n] = loaded.domain[t], ++n;
+  }
+  loaded.T.conservativeResize(n, 4);
+  loaded.domain.conservativeResize(n);
+  long nf = 0;
+  for (long q = 0; q < fe.F.rows(); ++q) {
+    if (!kept_faces.count(face_key(fe.F(q, 0), fe.F(q, 1), fe.F(q, 2)))) continue;
+    loaded.F.row(nf) = fe.F.row(q);
+    if (fe.face.size()) loaded.face[nf] = fe.face[q];
+    if (fe.nd_face.size()) loaded.nd_face[nf] = fe.nd_face[q];
+    ++nf;
+  }
+  loaded.F.conservativeResize(nf, 3);
+  if (fe.face.size()) loaded.face.conservativeResize(nf);
+  if (fe.nd_face.size()) loaded.nd_face.conservativeResize(nf);
+  return loaded;
+}
+
 }  // namespace
 
 TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
@@ -298,15 +332,8 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   // the crisp design on the FE mesh: removed tets keep void_stiffness, only kept tets weigh
   const std::vector<char> kept = crisp_tets(fe, node_densities(fe, design), threshold);
   VecXd scale(fe.T.rows());
-  TetMesh loaded = fe;
-  if (loaded.domain.size() != fe.T.rows()) loaded.domain = VecXi::Zero(fe.T.rows());
-  long n = 0;
-  for (long t = 0; t < fe.T.rows(); ++t) {
-    scale[t] = kept[t] ? 1.0 : params.void_stiffness;
-    if (kept[t]) loaded.T.row(n) = fe.T.row(t), loaded.domain[n] = loaded.domain[t], ++n;
-  }
-  loaded.T.conservativeResize(n, 4);
-  loaded.domain.conservativeResize(n);
+  for (long t = 0; t < fe.T.rows(); ++t) scale[t] = kept[t] ? 1.0 : params.void_stiffness;
+  const TetMesh loaded = crisp_loaded_mesh(fe, kept);
   try {
     v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
     v.as_built.seconds += seconds_mesh;
