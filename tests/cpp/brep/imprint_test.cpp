@@ -25,8 +25,9 @@ TEST(Imprint, BossOuterCylinderSplitsIntoAPieceOnThePartAndAPieceInside) {
   ASSERT_EQ(static_cast<int>(m.meshed.face_origin.size()), m.meshed.topo.num_faces());
   // The input's outer cylinders are interior as a whole (they lie on no one face of Ω).
   for (int f = 0; f < m.nondesign.num_faces(); ++f)
-    if (m.nondesign.face_surface[f] == "Cylinder" && m.nondesign.face_area[f] > 2 * 3.1416 * 6 * 14 - 1)
+    if (m.nondesign.face_surface[f] == "Cylinder" && m.nondesign.face_area[f] > 2 * 3.1416 * 6 * 14 - 1) {
       EXPECT_EQ(m.nd_on_part.face[f].on, On::Interior) << "input Face" << f + 1;
+    }
   // After the imprint each outer cylinder is two faces: z in [0, 8] inside (area 2 pi 6 8),
   // z in [8, 14] on the part's boss face (2 pi 6 6); both come from the input's cylinder.
   const double inside = 2 * M_PI * 6 * 8, outside = 2 * M_PI * 6 * 6;

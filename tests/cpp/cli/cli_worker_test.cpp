@@ -187,7 +187,9 @@ TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
   double tip = 0;
   int at_tip = 0;
   for (long i = 0; i < V.rows(); ++i) {
-    if (V(i, 0) < 1e-9) EXPECT_EQ(U.row(i).norm(), 0.0);
+    if (V(i, 0) < 1e-9) {
+      EXPECT_EQ(U.row(i).norm(), 0.0);
+    }
     if (V(i, 0) > 60 - 1e-9) tip += U(i, 2), ++at_tip;
   }
   ASSERT_GT(at_tip, 0);

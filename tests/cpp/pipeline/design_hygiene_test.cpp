@@ -82,8 +82,12 @@ TEST(DesignHygiene, ALoosePieceIsRemovedWithItsVolumeAndTheRestIsOnePiece) {
   EXPECT_NE(rep.warnings[0].find("removed a loose piece"), std::string::npos) << rep.warnings[0];
   EXPECT_NE(rep.warnings[0].find("mm³"), std::string::npos) << rep.warnings[0];
   for (long t = 0; t < m.T.rows(); ++t) {
-    if (inside(centre(m, t), {6, 3, 3, 8, 7, 7})) EXPECT_EQ(clean[t], 0) << t;
-    if (inside(centre(m, t), {0, 0, 0, 3, 10, 10})) EXPECT_EQ(clean[t], 1) << t;
+    if (inside(centre(m, t), {6, 3, 3, 8, 7, 7})) {
+      EXPECT_EQ(clean[t], 0) << t;
+    }
+    if (inside(centre(m, t), {0, 0, 0, 3, 10, 10})) {
+      EXPECT_EQ(clean[t], 1) << t;
+    }
   }
   // cleaned once, clean for good
   HygieneReport again;
@@ -150,8 +154,12 @@ TEST(DesignHygiene, ClosedVoidsAreFilledUnlessAllowedAndOpenOnesStay) {
   EXPECT_GT(rep.void_volume_filled, 20);
   EXPECT_LT(rep.void_volume_filled, 64);
   for (long t = 0; t < m.T.rows(); ++t) {
-    if (inside(centre(m, t), {3, 3, 3, 7, 7, 7})) EXPECT_EQ(clean[t], 1);
-    if (inside(centre(m, t), {0, 0, 8, 2, 2, 10})) EXPECT_EQ(clean[t], 0);
+    if (inside(centre(m, t), {3, 3, 3, 7, 7, 7})) {
+      EXPECT_EQ(clean[t], 1);
+    }
+    if (inside(centre(m, t), {0, 0, 8, 2, 2, 10})) {
+      EXPECT_EQ(clean[t], 0);
+    }
   }
   ASSERT_EQ(rep.warnings.size(), 1u);
   EXPECT_NE(rep.warnings[0].find("filled 1 closed internal void"), std::string::npos) << rep.warnings[0];

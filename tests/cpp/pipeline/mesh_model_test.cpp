@@ -201,7 +201,9 @@ TEST(MeshModel, NativeTetsWithinOneAndAHalfOfGmshsAtTheSameSettings) {
       EXPECT_GT(curvature, 0);
       EXPECT_GT(neighbour, 0);
     }
-    if (name == "cantilever") EXPECT_GT(nondesign, 0);
+    if (name == "cantilever") {
+      EXPECT_GT(nondesign, 0);
+    }
   }
 }
 

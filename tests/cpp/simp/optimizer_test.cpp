@@ -135,7 +135,9 @@ TEST(Simp, OcUnderSelfWeightAloneMeetsTheVolumeAndLowersTheCompliance) {
   EXPECT_NEAR(r.history.back().volume_fraction, 0.4, 0.005);
   EXPECT_LT(r.history.back().compliance, 0.8 * r.history.front().compliance);
   for (long t = 0; t < c.mesh.T.rows(); ++t)
-    if (c.mesh.domain[t] != 0) EXPECT_EQ(r.density[t], 1.0);
+    if (c.mesh.domain[t] != 0) {
+      EXPECT_EQ(r.density[t], 1.0);
+    }
 }
 
 TEST(Simp, GradientThroughHeavisideProjection) {

@@ -394,7 +394,9 @@ TEST(SurfaceMesher, EachFaceSaysWhichRuleSetsItsSize) {
   for (const FaceSize& f : face_sizes_of(slotted, 4, topo)) {
     proximity += f.reason == SizeReason::Proximity;
     max_size += f.reason == SizeReason::MaxSize;
-    if (f.reason == SizeReason::MaxSize) EXPECT_NEAR(f.size, 4, 1e-12);
+    if (f.reason == SizeReason::MaxSize) {
+      EXPECT_NEAR(f.size, 4, 1e-12);
+    }
   }
   EXPECT_GE(proximity, 2);
   EXPECT_GE(max_size, 1);
