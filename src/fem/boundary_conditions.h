@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fem/elasticity.h"
@@ -22,6 +23,15 @@ struct SupportSpec {
   /// TetMesh::nd_face where they form part of Ω's boundary (load pads).
   std::vector<int> nd_faces;
 };
+
+/// A support of `kind` on Ω's faces `faces` (1-based; Fixed: every component), the other
+/// fields at their defaults: the short form tests and callers use instead of a brace list.
+inline SupportSpec support_on(SupportSpec::Kind kind, std::vector<int> faces) {
+  SupportSpec s;
+  s.kind = kind;
+  s.faces = std::move(faces);
+  return s;
+}
 
 /// One load item; a load case is a list of them.
 struct LoadSpec {

@@ -36,7 +36,7 @@ TEST(CliSolve, SolvesAJobWithAMeshFile) {
   double printed = std::stod(sm[1]);
   using namespace topopt::fem;
   Material mat{200000, 0.3};
-  Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   Eigen::MatrixXd F =
       make_loads(m, mat, {LoadCase{"tip", {LoadSpec{LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}}}, 1}});
   Elasticity fe(m, mat, s);

@@ -42,7 +42,7 @@ Beam make_beam() {
   p.cells = {12, 3, 3};
   p.nondesign = {{22, 0, 0, 24, 6, 6}};
   b.mesh = mesh::structured_box_mesh(p);
-  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   b.loads =
       fem::make_loads(b.mesh, b.material,
                       {fem::LoadCase{"tip", {fem::LoadSpec{fem::LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}}}, 1}});

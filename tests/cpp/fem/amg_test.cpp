@@ -73,7 +73,7 @@ TEST(Amg, MultigridSolveEqualsCholeskyWithVoidContrast) {
     const bool solid = c[2] > 5.5 || c[2] < 2.5 || std::abs(c[2] - (4 + 3 * std::sin(c[0] / 6))) < 1.2;
     scale[t] = solid ? 1.0 : 1e-9;
   }
-  Supports sup = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}, {}}});
+  Supports sup = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   LoadSpec load{LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}};
   Eigen::MatrixXd F = make_loads(m, Material{}, {LoadCase{"c", {load}, 1}});
   Eigen::MatrixXd U[2];

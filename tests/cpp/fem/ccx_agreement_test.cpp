@@ -26,7 +26,7 @@ TEST(CalculixAgreement, DisplacementsAgreeWithCcx) {
   for (long i = 0; i < m.V.rows(); ++i)
     if (m.V(i, 0) > 1e-9 && m.V(i, 0) < 30 - 1e-9) m.V(i, 1) += 0.05 * std::sin(m.V(i, 0));
   Material mat{70000, 0.33, 2.7e-9};
-  Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}},
+  Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1}),
                                  SupportSpec{SupportSpec::Kind::Components, {3}, {false, true, false}, {}}});
   LoadCase lc{"mixed",
               {LoadSpec{LoadSpec::Kind::Force, {2}, {10, -20, -150}, 0, {}},

@@ -97,7 +97,7 @@ TEST(Elasticity, RigidBodyModesCarryNoEnergy) {
 double cantilever_tip(std::array<int, 3> cells, double L, double a, double P, const Material& mat,
                       SolverKind kind = SolverKind::Auto) {
   TetMesh m = box({L, a, a}, cells);
-  Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   LoadSpec load;
   load.kind = LoadSpec::Kind::Force;
   load.faces = {2};
@@ -167,7 +167,7 @@ TEST(Elasticity, IterativeSolverAgreesWithDirectAndWarmStarts) {
 TEST(Elasticity, ScaleRefillsTheMatrix) {
   // Scaling every element by s divides the displacements by s exactly.
   TetMesh m = box({10, 2, 2}, {5, 1, 1});
-  Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   LoadSpec load{LoadSpec::Kind::Force, {2}, {0, 10, 0}, 0, {}};
   Eigen::MatrixXd F = make_loads(m, Material{}, {LoadCase{"c", {load}, 1}});
   Elasticity fe(m, Material{}, s);
@@ -222,10 +222,10 @@ TEST(Elasticity, SymmetricHalfEqualsFullModel) {
   half_load.vector = {0, 0, -50};
   Eigen::MatrixXd Ff = make_loads(full, mat, {LoadCase{"f", {load}, 1}});
   Eigen::MatrixXd Fh = make_loads(half, mat, {LoadCase{"h", {half_load}, 1}});
-  Elasticity ff(full, mat, make_supports(full, {SupportSpec{SupportSpec::Kind::Fixed, {1}}}));
+  Elasticity ff(full, mat, make_supports(full, {support_on(SupportSpec::Kind::Fixed, {1})}));
   Elasticity fh(
       half, mat,
-      make_supports(half, {SupportSpec{SupportSpec::Kind::Fixed, {1}}, SupportSpec{SupportSpec::Kind::Symmetry, {4}}}));
+      make_supports(half, {support_on(SupportSpec::Kind::Fixed, {1}), support_on(SupportSpec::Kind::Symmetry, {4})}));
   Eigen::MatrixXd Uf = ff.solve(Ff), Uh = fh.solve(Fh);
   double err = (Uf.topRows(3 * nv) - Uh).cwiseAbs().maxCoeff();
   EXPECT_LT(err, 1e-9 * Uh.cwiseAbs().maxCoeff());
@@ -290,7 +290,7 @@ TEST(Elasticity, SingularSystemsAreReportedNotSolved) {
   two.T.conservativeResize(2 * m.T.rows(), 4);
   two.T.bottomRows(m.T.rows()) = m.T.array() + static_cast<int>(m.V.rows());
   two.domain = VecXi::Zero(two.T.rows());
-  Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   Elasticity f2(two, mat, s);
   try {
     f2.solve(Eigen::MatrixXd::Zero(f2.num_dofs(), 1));
@@ -327,7 +327,7 @@ TEST(BoundaryConditions, LoadTotalsAndFaceErrors) {
   }
   // A symmetry plane that is not planar is refused.
   try {
-    make_supports(m, {SupportSpec{SupportSpec::Kind::Symmetry, {1, 3}}});
+    make_supports(m, {support_on(SupportSpec::Kind::Symmetry, {1, 3})});
     FAIL();
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);

@@ -42,7 +42,7 @@ TEST(Modal, ConsistentMassWeighsThePart) {
 TEST(Modal, SubspaceIterationMatchesADenseEigensolver) {
   const TetMesh m = plate({6, 2, 1});
   const Material mat;
-  const Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  const Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   Elasticity fe(m, mat, s);
   ModalParams mp;
   mp.modes = 3;
@@ -83,7 +83,7 @@ TEST(Modal, RepeatedFirstEigenvalueIsReported) {
   p.cells = {10, 2, 2};
   const TetMesh m = mesh::structured_box_mesh(p);
   const Material mat;
-  Elasticity fe(m, mat, make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}}));
+  Elasticity fe(m, mat, make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})}));
   ModalParams mp;
   mp.modes = 2;
   mp.repeated = 0.3;
@@ -100,7 +100,7 @@ TEST(CalculixAgreement, FirstEigenfrequenciesAgreeWithCcx) {
   if (!testing::have_ccx()) GTEST_SKIP() << "ccx is not installed";
   const TetMesh m = plate({12, 3, 2});
   const Material mat{70000, 0.33, 2.7e-9};
-  const Supports s = make_supports(m, {SupportSpec{SupportSpec::Kind::Fixed, {1}}});
+  const Supports s = make_supports(m, {support_on(SupportSpec::Kind::Fixed, {1})});
   Elasticity fe(m, mat, s);
   ModalParams mp;
   mp.modes = 3;

@@ -81,7 +81,7 @@ TEST(ProblemChecks, FilterRadiusLargerThanThePartOrThanMemory) {
 TEST(ProblemChecks, IterationCapBeforeTheDesignIsCrispIsNamed) {
   const TetMesh m = beam();
   const fem::Material mat;
-  const fem::Supports supports = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const fem::Supports supports = fem::make_supports(m, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   const Eigen::MatrixXd loads = fem::make_loads(m, mat, {force_on(2, {0, 0, -100})});
   simp::SimpParams p;
   p.max_iterations = 4;  // β starts at 1: four iterations cannot reach 32

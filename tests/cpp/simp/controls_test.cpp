@@ -37,7 +37,7 @@ struct Beam {
     box.cells = cells;
     box.nondesign = {{28, -5, -5, 30, 5, 5}};
     mesh = mesh::structured_box_mesh(box);
-    supports = fem::make_supports(mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+    supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
     fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, -30}, 0, {}};
     loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {pull}, 1}});
   }

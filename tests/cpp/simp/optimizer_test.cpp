@@ -30,7 +30,7 @@ Case cantilever(std::array<int, 3> cells = {12, 4, 2}) {
   p.cells = cells;
   p.nondesign = {{27.5, 0, 0, 30, 10, 5}};  // a load pad
   c.mesh = mesh::structured_box_mesh(p);
-  c.supports = fem::make_supports(c.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  c.supports = fem::make_supports(c.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
   fem::LoadSpec push{fem::LoadSpec::Kind::Force, {2}, {0, 0, -60}, 0, {}};
   c.loads = fem::make_loads(c.mesh, c.mat, {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}});
@@ -101,7 +101,7 @@ TEST(Simp, SelfWeightFollowsTheDensity) {
   bp.cells = {6, 2, 2};
   const TetMesh mesh = mesh::structured_box_mesh(bp);
   const fem::Material mat;
-  const fem::Supports supports = fem::make_supports(mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const fem::Supports supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {0, 0, -9810}, 0, {}};
   const std::vector<fem::LoadCase> cases{fem::LoadCase{"g", {weight}, 1}};
   const Eigen::MatrixXd F = fem::make_loads(mesh, mat, cases);  // the full weight

@@ -38,7 +38,7 @@ Beam beam(std::array<int, 3> cells) {
   p.cells = cells;
   p.nondesign = {{27.5, 0, 0, 30, 10, 5}};
   b.mesh = mesh::structured_box_mesh(p);
-  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
   const fem::LoadSpec push{fem::LoadSpec::Kind::Force, {2}, {0, 0, -60}, 0, {}};
   b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}});
@@ -116,7 +116,7 @@ Beam l_bracket() {
   }
   Beam b;
   b.mesh = keep_tets(box, keep);
-  b.supports = fem::make_supports(b.mesh, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {4}}});
+  b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {4})});
   const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -200, 0}, 0, {}};
   b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"down", {pull}, 1}});
   return b;
@@ -442,7 +442,7 @@ TEST(Responses, FrequencyDesignIsOnePieceWithTheLoadPadAndAgreesWithCcx) {
   std::vector<bool> keep(b.mesh.T.rows());
   for (long t = 0; t < b.mesh.T.rows(); ++t) keep[t] = r.density[t] >= 0.5;
   const TetMesh crisp = keep_tets(b.mesh, keep);
-  const fem::Supports held = fem::make_supports(crisp, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+  const fem::Supports held = fem::make_supports(crisp, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   fem::Elasticity fe(crisp, b.mat, held);
   const double ours = fem::lowest_modes(fe, b.mat.density, {}).frequencies[0];
   const double uniform = r.history.front().frequency;

@@ -83,7 +83,7 @@ TEST(NativeMesher, WallLayersLetAThinPlateBendLikeABeam) {
   for (int layers : {0, 2}) {
     const int k = layers ? 1 : 0;
     const TetMesh m = mesh_with(model, pipeline::Mesher::Native, layers);
-    const fem::Supports sup = fem::make_supports(m, {fem::SupportSpec{fem::SupportSpec::Kind::Fixed, {1}}});
+    const fem::Supports sup = fem::make_supports(m, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
     const fem::LoadSpec tip{fem::LoadSpec::Kind::Force, {2}, {0, 0, -1}, 0, {}};
     const Eigen::MatrixXd F = fem::make_loads(m, mat, {fem::LoadCase{"tip", {tip}, 1}});
     fem::Elasticity fe(m, mat, sup, {});
