@@ -12,20 +12,13 @@
 #include <TopTools_ListOfShape.hxx>
 #include <TopoDS_Compound.hxx>
 #include <cmath>
-#include <ctime>
 #include <string>
 
+#include "common/cpu_time.h"
 #include "common/error.h"
 
 namespace topopt::brep {
 namespace {
-
-/// CPU seconds the calling thread has used (the splitter runs on it: SetRunParallel(false)).
-double thread_cpu_seconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 /// OCCT's progress indicator for the split: it asks OCCT to stop (UserBreak) once the thread
 /// has spent its CPU budget or the caller cancels, and remembers which of the two it was.

@@ -18,6 +18,7 @@
 
 #include "brep/occt_guard.h"
 #include "cli/commands.h"
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "pipeline/output_files.h"
 #ifdef TOPOPT_WITH_PETSC
@@ -60,8 +61,7 @@ std::string serial_stats_json(long tets, double seconds_run) {
   getrusage(RUSAGE_SELF, &usage);
   nlohmann::json j;
   j["ranks"] = 1;
-  const double cpu = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                     1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  const double cpu = process_cpu_seconds();
   j["per_rank"] = {{{"rank", 0},
                     {"tets", tets},
                     {"seconds_run", seconds_run},

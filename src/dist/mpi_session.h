@@ -46,8 +46,4 @@ void check_petsc(int code, const char* what);
 /// Peak resident memory of this process (bytes), from getrusage.
 double peak_memory_bytes();
 
-/// User + system CPU time of this process so far (s), from getrusage: on a shared machine the
-/// work a rank did, where wall time also counts the waits for the others.
-double cpu_seconds();
-
 }  // namespace topopt::dist

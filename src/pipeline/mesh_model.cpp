@@ -3,7 +3,6 @@
 
 #include <sys/prctl.h>
 #include <sys/syscall.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -11,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/isolate.h"
 #include "mesh/core/conformity.h"
@@ -65,26 +65,18 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// CPU seconds this process has used (all its threads): the native mesher's budget is counted
-/// in them, so that a machine shared with other work does not stop a mesh that would finish.
-double cpu_seconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 /// The native mesher stopped after `seconds` of computing: it checks its Progress's
 /// cancelled() at safe points in every stage's loop, and here that also answers yes once the
 /// budget is spent; such a stop becomes Error(Timeout) naming the budget and the stage.
 TetMesh mesh_native_within(const brep::TwoBReps& model, const MeshSettings& settings, const MeshSizes& sizes,
                            const Progress& progress, mesh::MeshRun* run) {
   const double seconds = native_time_budget(settings, sizes);
-  const double end = cpu_seconds() + seconds;
+  const double end = process_cpu_seconds() + seconds;  // all threads
   std::atomic<bool> expired{false};
   Progress timed = progress;
   timed.cancelled = [&progress, &expired, end] {
     if (progress.cancelled && progress.cancelled()) return true;
-    if (cpu_seconds() > end) expired = true;
+    if (process_cpu_seconds() > end) expired = true;
     return expired.load();
   };
   try {

@@ -2,7 +2,6 @@
 #include "result/step_export.h"
 
 #include <fcntl.h>
-#include <sys/resource.h>
 #include <unistd.h>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
@@ -37,6 +36,7 @@
 #include <vector>
 
 #include "brep/occt_guard.h"
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/isolate.h"
 
@@ -242,8 +242,7 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
                                    const Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  rusage before{};
-  ::getrusage(RUSAGE_CHILDREN, &before);
+  const double children_cpu0 = children_cpu_seconds();
   const pid_t caller = getpid();
   const std::string answer = run_isolated(
       "writing the result as STEP", params.seconds,
@@ -270,13 +269,7 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
       progress);
   StepExportReport r = report_of(answer);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  rusage after{};
-  ::getrusage(RUSAGE_CHILDREN, &after);
-  auto cpu = [](const rusage& u) {
-    return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-           1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-  };
-  r.cpu_seconds = cpu(after) - cpu(before);  // the child, waited for by run_isolated
+  r.cpu_seconds = children_cpu_seconds() - children_cpu0;  // the child, waited for by run_isolated
   std::error_code ec;
   r.bytes = static_cast<long>(std::filesystem::file_size(path, ec));
   return r;

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstring>
 
-#include <sys/resource.h>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/face_key.h"
 #include "common/isolate.h"
@@ -21,15 +21,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// CPU seconds (user + system) of this process (RUSAGE_SELF, all threads) or of its ended
-/// children (RUSAGE_CHILDREN: the meshing child once run_isolated has waited for it).
-double cpu_seconds(int who) {
-  rusage u{};
-  ::getrusage(who, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 Eigen::Vector3d corner(const MatX3d& V, const MatX3i& F, long q, int k) { return V.row(F(q, k)).transpose(); }
@@ -274,7 +265,7 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
                         const VecXd& scale, const fem::SolverParams& solver, const Progress& progress,
                         Eigen::MatrixXd* U, std::vector<VecXd>* von_mises) {
   const auto t0 = std::chrono::steady_clock::now();
-  const double cpu0 = cpu_seconds(RUSAGE_SELF);
+  const double cpu0 = process_cpu_seconds();
   const fem::Supports supports = fem::make_supports(mesh, problem.supports);
   const Eigen::MatrixXd loads = fem::make_loads(loaded, problem.material, problem.load_cases);
   fem::Elasticity fe(mesh, problem.material, supports, solver);
@@ -297,7 +288,7 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
   a.nodes = std::count(node_used.begin(), node_used.end(), 1);
   a.tets = scale.size() ? (scale.array() >= 1).count() : mesh.T.rows();
   a.seconds = seconds_since(t0);
-  a.cpu_seconds = cpu_seconds(RUSAGE_SELF) - cpu0;
+  a.cpu_seconds = process_cpu_seconds() - cpu0;
   if (U) *U = u;
   return a;
 }
@@ -316,7 +307,7 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
                                         " s; the result files are written, only the verification is missing");
   };
   Verification v;
-  const double child_cpu0 = cpu_seconds(RUSAGE_CHILDREN), cpu0 = cpu_seconds(RUSAGE_SELF);
+  const double child_cpu0 = children_cpu_seconds(), cpu0 = process_cpu_seconds();
   try {
     v.mesh = verification_mesh(s, fe, params.fill, params.seconds, timed);
   } catch (const Error& e) {
@@ -328,7 +319,7 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
     progress.warn("verification: a piece of the result of " + std::to_string(static_cast<long>(vol)) +
                   " mm³ that no support holds and no load acts on (a detached non-design solid?) is left out");
   const double seconds_mesh = seconds_since(t0);
-  const double cpu_mesh = cpu_seconds(RUSAGE_CHILDREN) - child_cpu0 + cpu_seconds(RUSAGE_SELF) - cpu0;
+  const double cpu_mesh = children_cpu_seconds() - child_cpu0 + process_cpu_seconds() - cpu0;
   // the crisp design on the FE mesh: removed tets keep void_stiffness, only kept tets weigh
   const std::vector<char> kept = crisp_tets(fe, node_densities(fe, design), threshold);
   VecXd scale(fe.T.rows());

@@ -1,8 +1,6 @@
 // 3D advancing front: the driver of named steps (see volume_front.h).
 #include "mesh/volume/volume_front.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -11,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
@@ -333,14 +332,6 @@ class FrontFill {
   std::vector<std::pair<double, int>> near_by_distance_;  ///< (distance to the ideal point, node)
   std::vector<Vec3> new_points_;
 };
-
-/// CPU seconds the calling thread has used (the fill runs on one thread; a machine shared
-/// with other work slows its clock, not its budget).
-double thread_cpu_seconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 /// `progress` whose cancelled() also answers yes once this thread has used `seconds` of CPU
 /// from now (<= 0: never); `expired` is set when that is why.
