@@ -260,14 +260,38 @@ class Remesher {
   }
   void drop(int v, int t) { star_[v].erase(std::remove(star_[v].begin(), star_[v].end(), t), star_[v].end()); }
 
-  /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, or on the cut
-  /// line of a planar Ω face with uv along that line (one triangle of the face and one of the
-  /// free-form on it).
+  /// Whether v may be removed by a collapse into a neighbour without any point moving, the face it
+  /// lies inside staying where it is: every triangle around v has one tag f != 0, and either v is
+  /// a point of Ω's face f (lock 1, not on its cut line; a curved face keeps its points, the
+  /// triangles stay chords of it) or v is a non-design point (lock 2) whose triangles lie in one
+  /// plane and whose neighbours are all non-design points (the FE mesh's own boundary triangles
+  /// re-triangulated within their plane, the border of a non-design footprint kept).
+  bool removable_inside(int v) const {
+    if (!p_.planar_faces || s_.lock[v] == 0 || (s_.point_face.size() && s_.point_face[v] != 0)) return false;
+    int f = 0;
+    Eigen::Vector3d n0 = Eigen::Vector3d::Zero();
+    for (int t : star_[v]) {
+      if (!alive_[t]) continue;
+      const Eigen::Vector3d n = normal_of(s_.V, tris_[t]);
+      if (f == 0) f = tags_[t], n0 = n.normalized();
+      if (tags_[t] != f || f == 0 || n.norm() == 0) return false;
+      if (s_.lock[v] == 2 && n.normalized().dot(n0) < 1 - kCoplanar) return false;
+    }
+    if (s_.lock[v] == 2)  // not on the border of a non-design solid's footprint on an Ω face
+      for (int w : neighbours(v))
+        if (s_.lock[w] != 2) return false;
+    return f != 0 && (s_.lock[v] == 2 || f > 0);
+  }
+
+  /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, removable from
+  /// inside a face (removable_inside), or on the cut line of an Ω face with uv along that line
+  /// (one triangle of the face and one of the free-form on it; on a curved face no point moves,
+  /// the line keeps its other points).
   bool may_go(int v, int u) const {
-    if (s_.lock[v] == 0 || face_interior(v) != 0) return true;
+    if (s_.lock[v] == 0 || face_interior(v) != 0 || removable_inside(v)) return true;
     if (s_.lock[v] != 1 || !p_.planar_faces) return false;
     const int f = s_.point_face.size() ? s_.point_face[v] : 0;
-    if (!planar(f)) return false;
+    if (f <= 0) return false;
     const std::vector<int> e = edge_triangles(u, v);
     if (e.size() != 2) return false;
     const bool along = (tags_[e[0]] == 0 && tags_[e[1]] == f) || (tags_[e[0]] == f && tags_[e[1]] == 0);

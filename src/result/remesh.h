@@ -28,8 +28,10 @@ struct RemeshReport {
 /// smallest angle of its two triangles (on the free-form region across edges bent less than
 /// flat_dihedral; on Ω's planar faces within the plane; on the non-design solids' and Ω's other
 /// faces only between triangles in one plane, so no point moves); collapses a short edge into one
-/// of its points when the point that goes is free (lock 0), lies inside a planar Ω face (every
-/// triangle around it on that face), or slides on the cut line of a planar Ω face, the surface
+/// of its points when the point that goes is free (lock 0), lies inside an Ω face (every triangle
+/// around it on that face; on a curved face the points that stay keep their places), lies inside one
+/// plane of a non-design solid's faces with non-design neighbours only (the FE mesh's own boundary
+/// triangles re-triangulated in their plane), or slides on the cut line of an Ω face, the surface
 /// stays manifold (link condition), and no remaining triangle turns by more than max_normal_turn
 /// or ends with a smaller smallest angle than the worst one it replaces; else moves a point of the
 /// triangle towards the mean of its neighbours when that raises their smallest angle: a free point

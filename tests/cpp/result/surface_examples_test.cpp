@@ -25,9 +25,12 @@ struct Example {
   double size;          // mesh size (mm)
   std::string problem;  // supports and load cases
   /// The smallest angle asserted on Ω's kept faces (issue 19 asks 10°; not reached yet). Measured
-  /// at the two settings: rocker 7.11° / 6.95°, cantilever 8.93° (triangles of the FE mesh's own
-  /// boundary on a non-design solid, whose points may not move) / 12.0°, bracket 9.67° / 12.2°,
-  /// mount 5.45° / 12.1°: asserted just under what is measured so it cannot get worse unseen.
+  /// at the two settings: rocker 7.78° / 7.90° (needles on the cylindrical face 5 between a point
+  /// on a B-Rep edge or on the cut line and an FE node 0.4-0.6 mm away, where every collapse makes
+  /// a worse triangle), cantilever 9.32° (an FE boundary triangle of the non-design solid on the
+  /// border of its footprint, whose points may not move) / 12.6°, bracket 9.67° (a 0.8 mm cut-line
+  /// edge whose collapse would break the link condition) / 12.2°, mount 5.45° (the same with a
+  /// 0.2 mm cut-line edge) / 12.1°: asserted just under what is measured so it cannot get worse unseen.
   double min_angle_faces;
   /// The smallest free-form angle asserted (issue 19 asks 10°). The mount at threshold 0.4 with
   /// 60 smoothing pairs measures 7.9° (its default setting and the other three examples reach
@@ -121,14 +124,14 @@ TEST(SurfaceExamples, Rocker) {
                  R"("supports": [{"type": "fixed", "faces": ["Face10"]}], "load_cases": [{"name": "rocker", "loads":
                   [{"type": "force", "faces": ["Face9"], "vector": [0, -1000, 0]},
                    {"type": "force", "faces": ["Face11"], "vector": [600, 0, 0]}]}])",
-                 6.5});
+                 7.5});
 }
 
 TEST(SurfaceExamples, Cantilever) {
   check_example({"cantilever", 3.0,
                  R"("supports": [{"type": "fixed", "faces": ["Face1"]}], "load_cases": [{"name": "tip", "loads":
                   [{"type": "force", "faces": ["NonDesign:Face12"], "vector": [0, 0, -1000]}]}])",
-                 8.5});
+                 9.0});
 }
 
 TEST(SurfaceExamples, Bracket) {
