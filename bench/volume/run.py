@@ -67,14 +67,7 @@ def quality(P, T):
 
 def quality_shares(P, T):
     """(min radius ratio, share below 0.1, share below 0.2, min dihedral angle) of tets T."""
-    a, b, c, d = (P[T[:, i]] for i in range(4))
-    vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a))) / 6
-    areas = sum(0.5 * np.linalg.norm(np.cross(y - x, z - x), axis=1) for x, y, z in ((b, c, d), (a, c, d), (a, b, d), (a, b, c)))
-    u, v, w = b - a, c - a, d - a
-    num = (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w) + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)
-           + np.einsum("ij,ij->i", w, w)[:, None] * np.cross(u, v))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rr = np.where(vol > 0, 3 * (3 * vol / areas) / (np.linalg.norm(num, axis=1) / (12 * vol)), 0.0)
+    rr = radius_ratios(P, T)
     return float(rr.min()), float((rr < 0.1).mean()), float((rr < 0.2).mean()), quality(P, T)[2]
 
 
