@@ -685,21 +685,39 @@ long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floo
 
 namespace {
 
+/// The tets of v's ball below `floor` with v at `x` (P[v] is as it was on return).
+int ball_below(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts, int v, const Vec3& x,
+               double floor) {
+  const Vec3 at = P[v];
+  P[v] = x;
+  int n = 0;
+  for (int q : ts) n += rho(P, tets[q]) < floor;
+  P[v] = at;
+  return n;
+}
+
 /// Node v of a tet below `floor` to the best of the compass search's, the optimisation's and
 /// (when those leave its ball below floor) the perturbation's positions, then optimised again
-/// from there; true when it moved.
+/// from there — each move only when it leaves no more tets of the ball below floor than
+/// there were (raising the worst alone can bring more of them below it); true when it moved.
 bool move_sliver_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v, double floor) {
-  NodeMove m = plan_search_node(P, tets, stars, v);
-  const NodeMove o = plan_optimise_node(P, tets, stars, v);
-  if (!o.empty() && (m.empty() || o.after > m.after)) m = o;
-  if (m.empty() || m.after < floor) {
-    const NodeMove p = plan_perturb_node(P, tets, stars, v);
-    if (!p.empty() && (m.empty() || p.after > m.after)) m = p;
-  }
+  const Adjacency::Row ts = stars.row(v);
+  const int below = ball_below(P, tets, ts, v, P[v], floor);
+  NodeMove m;
+  int m_below = below;
+  auto consider = [&](const NodeMove& c) {
+    if (c.empty()) return;
+    const int n = ball_below(P, tets, ts, v, c.to, floor);
+    if (n > below) return;
+    if (m.empty() || n < m_below || (n == m_below && c.after > m.after)) m = c, m_below = n;
+  };
+  consider(plan_search_node(P, tets, stars, v));
+  consider(plan_optimise_node(P, tets, stars, v));
+  if (m.empty() || m.after < floor) consider(plan_perturb_node(P, tets, stars, v));
   if (m.empty()) return false;
   mesh::apply(P, m);  // qualified: std::apply would be found by ADL too
   const NodeMove polish = plan_optimise_node(P, tets, stars, v);
-  if (!polish.empty()) mesh::apply(P, polish);
+  if (!polish.empty() && ball_below(P, tets, ts, v, polish.to, floor) <= m_below) mesh::apply(P, polish);
   return true;
 }
 

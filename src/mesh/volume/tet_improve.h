@@ -166,7 +166,8 @@ long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>&
 /// The nodes from first_new on of the tets below `floor`, worst tet first, each node once:
 /// moved to the best of search_node's, optimise_node's and (when those leave the ball below
 /// floor) perturb_node's positions, then optimise_node again from there, when that lifts
-/// the worst tet around it. Returns the number of nodes moved.
+/// the worst tet around it and leaves no more tets around it below floor (fewest first, then
+/// the highest worst). Returns the number of nodes moved.
 long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor);
 
 /// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
