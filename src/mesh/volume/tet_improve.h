@@ -164,11 +164,13 @@ void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector
 long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
 
 /// The nodes from first_new on of the tets below `floor`, worst tet first, each node once:
-/// moved to the best of search_node's, optimise_node's and (when those leave the ball below
-/// floor) perturb_node's positions, then optimise_node again from there, when that lifts
-/// the worst tet around it and leaves no more tets around it below floor (fewest first, then
-/// the highest worst). Returns the number of nodes moved.
-long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor);
+/// moved by search_node, else by perturb_node, when that lifts the worst tet around it. With
+/// `optimise`: moved to the best of search_node's, optimise_node's and (when those leave the
+/// ball below floor) perturb_node's positions, then optimise_node again from there, when that
+/// lifts the worst tet around it and leaves no more tets around it below floor (fewest first,
+/// then the highest worst). Returns the number of nodes moved.
+long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor,
+                          bool optimise = false);
 
 /// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
 /// each is taken out with the best of wider cavities than insert_points_at_slivers tries —
@@ -181,9 +183,11 @@ long remove_tets_below(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, 
                        const Progress& progress = {});
 
 /// Rounds at the tets below `floor` until none is left or a round removes none: the nodes
-/// of the slivers perturbed (perturb_sliver_nodes, nodes from first_new on), the best edge
-/// removal or 2-3 flip at each (flip_bad_tets with best), and wider cavities re-filled (remove_tets_below, 2 sweeps;
-/// the points it adds are the next round's to move). Returns the number of tets below floor left.
+/// of the slivers perturbed (perturb_sliver_nodes, nodes from first_new on), edge removal and
+/// 2-3 flips at them, and wider cavities re-filled (remove_tets_below, 2 sweeps; the points it
+/// adds are the next round's to move); then, for the tets still below floor, the same rounds
+/// with perturb_sliver_nodes' optimise and flip_bad_tets' best (each phase up to `rounds`).
+/// Returns the number of tets below floor left.
 long remove_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress = {});
 
