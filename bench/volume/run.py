@@ -22,7 +22,9 @@ instead the product's path on every part of ../shared/data (the examples with th
 non-design solids, NIST 1-6 and 11, linkrods) at the default size and at the --factors given:
 `topopt mesh --mesher native`, pinned to one CPU (taskset), and reads the written mesh back to
 measure tets, the worst radius ratio, the share of tets below 0.1 and 0.2, the smallest
-dihedral angle, the conformity check's verdict (flat and inverted tets) and the time. Rows go
+dihedral angle, the conformity check's verdict (flat and inverted tets), the time and the
+tets below 0.1 by class (classify_slivers: boundary nodes, B-Rep edge or vertex, all four on one
+face; --classes run.json tabulates them). Rows go
 to --json as they finish, so two executables' runs can be tabulated side by side with
 --table old.json,new.json.
 """
@@ -65,19 +67,12 @@ def quality(P, T):
 
 def quality_shares(P, T):
     """(min radius ratio, share below 0.1, share below 0.2, min dihedral angle) of tets T."""
-    a, b, c, d = (P[T[:, i]] for i in range(4))
-    vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a))) / 6
-    areas = sum(0.5 * np.linalg.norm(np.cross(y - x, z - x), axis=1) for x, y, z in ((b, c, d), (a, c, d), (a, b, d), (a, b, c)))
-    u, v, w = b - a, c - a, d - a
-    num = (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w) + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)
-           + np.einsum("ij,ij->i", w, w)[:, None] * np.cross(u, v))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rr = np.where(vol > 0, 3 * (3 * vol / areas) / (np.linalg.norm(num, axis=1) / (12 * vol)), 0.0)
+    rr = radius_ratios(P, T)
     return float(rr.min()), float((rr < 0.1).mean()), float((rr < 0.2).mean()), quality(P, T)[2]
 
 
 def read_msh_tets(path):
-    """Nodes (#V by 3) and tets (#T by 4, 0-based) of a Gmsh MSH 4.1 ASCII file."""
+    """Nodes (#V by 3, row = node tag; row 0 unused) and tets (#T by 4 node tags) of a Gmsh MSH 4.1 ASCII file."""
     with open(path) as f:
         lines = f.read().split("\n")
     i = lines.index("$Nodes") + 1
@@ -101,6 +96,86 @@ def read_msh_tets(path):
             tets.append(np.array(" ".join(lines[i + 1:i + 1 + n]).split(), dtype=np.int64).reshape(-1, 5)[:, 1:])
         i += 1 + n
     return P, np.vstack(tets)
+
+
+def read_msh_faces(path):
+    """Boundary triangles (#F by 3, node tags as read_msh_tets's rows) and the entity tag of each (#F) of a Gmsh MSH 4.1 ASCII file."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    i = lines.index("$Elements") + 1
+    blocks = int(lines[i].split()[0])
+    i += 1
+    tris, tags = [], []
+    for _ in range(blocks):
+        dim, tag, kind, n = (int(x) for x in lines[i].split())
+        if kind == 2:
+            tris.append(np.array(" ".join(lines[i + 1:i + 1 + n]).split(), dtype=np.int64).reshape(-1, 4)[:, 1:])
+            tags.append(np.full(n, tag))
+        i += 1 + n
+    if not tris:
+        return np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.vstack(tris), np.concatenate(tags)
+
+
+def radius_ratios(P, T):
+    """The radius ratio 3 r_in / R of each tet (#T; 0 for a flat one)."""
+    a, b, c, d = (P[T[:, i]] for i in range(4))
+    vol = np.abs(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a))) / 6
+    areas = sum(0.5 * np.linalg.norm(np.cross(y - x, z - x), axis=1) for x, y, z in ((b, c, d), (a, c, d), (a, b, d), (a, b, c)))
+    u, v, w = b - a, c - a, d - a
+    num = (np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w) + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)
+           + np.einsum("ij,ij->i", w, w)[:, None] * np.cross(u, v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(vol > 0, 3 * (3 * vol / areas) / (np.linalg.norm(num, axis=1) / (12 * vol)), 0.0)
+
+
+def classify_slivers(P, T, F, ftag, floor=0.1):
+    """The tets below `floor` by class: how many of their nodes lie on the boundary (0-4), how
+    many of them have a node on a B-Rep edge or vertex (a node in triangles of two or more
+    faces), and of those with four boundary nodes how many have all four on one face (a flat
+    boundary configuration). P: #V by 3, T: #T by 4 tets, F: #F by 3 boundary triangles with
+    face tags ftag (#F). Returns a dict of counts."""
+    rr = radius_ratios(P, T)
+    bad = T[rr < floor]
+    nv = len(P)
+    on_boundary = np.zeros(nv, dtype=bool)
+    on_boundary[F.ravel()] = True
+    # faces per node: distinct (node, tag) pairs counted per node
+    pairs = np.unique(np.stack([F.ravel(), np.repeat(ftag, 3)], axis=1), axis=0) if len(F) else np.zeros((0, 2), int)
+    faces_at = np.bincount(pairs[:, 0], minlength=nv) if len(pairs) else np.zeros(nv, int)
+    node_faces = {}
+    for v, t in pairs:
+        node_faces.setdefault(int(v), set()).add(int(t))
+    nb = on_boundary[bad].sum(axis=1)
+    out = {"below": int(len(bad))}
+    for k in range(5):
+        out["boundary_nodes_%d" % k] = int((nb == k).sum())
+    out["on_brep_edge"] = int((faces_at[bad] >= 2).any(axis=1).sum()) if len(bad) else 0
+    out["on_brep_vertex"] = int((faces_at[bad] >= 3).any(axis=1).sum()) if len(bad) else 0
+    one_face = 0
+    for t in bad[nb == 4]:
+        common = set.intersection(*(node_faces.get(int(v), set()) for v in t))
+        one_face += bool(common)
+    out["all_on_one_face"] = one_face
+    out["free_node"] = int((nb < 4).sum())
+    # a tet on a poor boundary triangle cannot be good whatever its fourth node: the slivers
+    # with a face on the boundary whose triangle has 2 r_in / R below 0.2
+    def tri_quality(a, b, c):
+        la, lb, lc = (np.linalg.norm(y - x, axis=-1) for x, y in ((b, c), (c, a), (a, b)))
+        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=-1)
+        s = (la + lb + lc) / 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(area > 0, 2 * (area / s) / (la * lb * lc / (4 * area)), 0.0)
+    keys = {tuple(sorted(map(int, f))) for f in F}
+    poor = 0
+    for t in bad:
+        worst = 1.0
+        for f in ((t[1], t[2], t[3]), (t[0], t[2], t[3]), (t[0], t[1], t[3]), (t[0], t[1], t[2])):
+            if tuple(sorted(map(int, f))) in keys:
+                worst = min(worst, float(tri_quality(P[f[0]], P[f[1]], P[f[2]])))
+        poor += worst < 0.2
+    out["on_poor_boundary_triangle"] = poor
+    return out
 
 
 def product_parts():
@@ -133,11 +208,13 @@ def product_row(topopt, part, nd, factor, tmp):
     s = json.load(open(stats))
     P, T = read_msh_tets(msh)
     rmin, below1, below2, dih = quality_shares(P, T)
+    F, ftag = read_msh_faces(msh)
     c = s["conformity"]
     os.remove(stats)
     return {"tets": len(T), "rr_min": rmin, "below_0.1": below1, "below_0.2": below2, "dihedral_min": dih,
             "conformity": c["ok"], "flat": c.get("flat_tets", "-"), "inverted": c["inverted_tets"],
-            "seconds": round(dt, 1), "cpu_seconds": round(cpu, 1), "mesh_seconds": round(s["seconds"]["mesh"], 1)}
+            "seconds": round(dt, 1), "cpu_seconds": round(cpu, 1), "mesh_seconds": round(s["seconds"]["mesh"], 1),
+            "slivers": classify_slivers(P, T, F, ftag)}
 
 
 def product(args):
@@ -173,6 +250,26 @@ def table(files):
         print("| %s | %s | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %s / %s | %s |" % (
             name, size, a["tets"], b["tets"], a["rr_min"], b["rr_min"], pct(a["below_0.1"]), pct(b["below_0.1"]),
             pct(a["below_0.2"]), pct(b["below_0.2"]), b["flat"], b["inverted"], "ok" if b["conformity"] else "DEFECTS"))
+
+
+def classes(path):
+    """The sliver classes of a --json run (classify_slivers) as a Markdown table."""
+    import json
+    rows = json.load(open(path))
+    print("| part | size | tets | worst radius ratio | < 0.1 | 4 / 3 / 2 / 1 / 0 boundary nodes | on a B-Rep edge / vertex |"
+          " 4 nodes on one face | with a free node | on a boundary triangle < 0.2 | CPU s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for key, r in rows.items():
+        name, f = key.split("@")
+        size = "default" if float(f) == 1.0 else "%s×" % f
+        if "error" in r:
+            print("| %s | %s | error: %s | | | | | | | | %s |" % (name, size, r["error"][-80:], r.get("cpu_seconds", "")))
+            continue
+        c = r["slivers"]
+        print("| %s | %s | %d | %.4f | %d | %s | %d / %d | %d | %d | %d | %s |" % (
+            name, size, r["tets"], r["rr_min"], c["below"], " / ".join(str(c["boundary_nodes_%d" % k]) for k in (4, 3, 2, 1, 0)),
+            c["on_brep_edge"], c["on_brep_vertex"], c["all_on_one_face"], c["free_node"],
+            c["on_poor_boundary_triangle"], r["cpu_seconds"]))
 
 
 def run_gmsh(P, F, h):
@@ -239,7 +336,10 @@ def main():
     ap.add_argument("--parts", default="", help="with --product: only these parts (names as in the table)")
     ap.add_argument("--json", default="product.json", help="with --product: rows kept here (a rerun skips them)")
     ap.add_argument("--table", help="old.json,new.json: the two --product runs as one Markdown table")
+    ap.add_argument("--classes", help="a --product run's json: its slivers by class as a Markdown table")
     args = ap.parse_args()
+    if args.classes:
+        return classes(args.classes)
     if args.table:
         return table(args.table)
     if args.product:

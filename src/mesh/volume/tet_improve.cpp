@@ -317,6 +317,77 @@ NodeMove plan_perturb_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, c
   return m;
 }
 
+namespace {
+
+/// The gradient of tet q's radius ratio in the position of its node v, by central differences
+/// of step h (P[v] is as it was on return).
+Vec3 radius_ratio_gradient(std::vector<Vec3>& P, const Tet& q, int v, double h) {
+  Vec3 g;
+  const Vec3 at = P[v];
+  for (int d = 0; d < 3; ++d) {
+    P[v][d] = at[d] + h;
+    const double up = rho(P, q);
+    P[v][d] = at[d] - h;
+    const double down = rho(P, q);
+    P[v] = at;
+    g[d] = (up - down) / (2 * h);
+  }
+  return g;
+}
+
+/// The ascent directions at v's position: the gradient of each tet of ts within kActiveBand of
+/// `worst` (unit), and their sum (unit) when there are several.
+std::vector<Vec3> ascent_directions(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts, int v,
+                                    double worst, double h) {
+  std::vector<Vec3> dirs;
+  Vec3 sum = Vec3::Zero();
+  for (int q : ts) {
+    if (rho(P, tets[q]) > worst + kActiveBand) continue;
+    const Vec3 g = radius_ratio_gradient(P, tets[q], v, h);
+    const double n = g.norm();
+    if (!(n > 0)) continue;
+    dirs.push_back(g / n);
+    sum += g / n;
+  }
+  if (dirs.size() > 1 && sum.norm() > 1e-12) dirs.push_back(sum.normalized());
+  return dirs;
+}
+
+}  // namespace
+
+NodeMove plan_optimise_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
+  const Adjacency::Row ts = stars.row(v);
+  const double len = mean_edge_at(P, tets, ts, v);
+  if (!(len > 0)) return {};
+  const Vec3 old = P[v];
+  const double before = worst_positive(P, tets, ts);
+  if (before < 0) return {};
+  double best = before;
+  for (int it = 0; it < 30; ++it) {
+    const Vec3 here = P[v];
+    Vec3 to = here;
+    double gained = best;
+    for (const Vec3& d : ascent_directions(P, tets, ts, v, best, 1e-6 * len)) {
+      // line search: the first step, halving from len / 5, that raises the worst
+      for (double step = 0.2 * len, k = 0; k < 12; step *= 0.5, ++k) {
+        P[v] = here + step * d;
+        const double now = worst_positive(P, tets, ts);
+        if (now > best) {
+          if (now > gained) gained = now, to = P[v];
+          break;
+        }
+      }
+      P[v] = here;
+    }
+    if (to == here) break;
+    P[v] = to, best = gained;
+  }
+  NodeMove m{v, old, P[v], before, best};
+  P[v] = old;
+  if (!(best > before)) return {};
+  return m;
+}
+
 void apply(std::vector<Vec3>& P, const NodeMove& m) { P[m.v] = m.to; }
 
 namespace {
@@ -421,7 +492,25 @@ void apply(TetSweep& s, const CavityStar& c) {
 
 // ---- drivers
 
-long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad) {
+namespace {
+
+/// The edge removal or 2-3 flip at tet t: the first that improves (its edges, then its faces),
+/// or with `best` the one of them all whose new worst radius ratio is highest.
+TetReplacement plan_reconnection(const TetSweep& s, int t, bool best) {
+  const Tet v = s.tets[t];
+  TetReplacement r;
+  auto consider = [&r, best](TetReplacement c) {
+    if (!c.empty() && (r.empty() || (best && c.after > r.after))) r = std::move(c);
+  };
+  for (int i = 0; i < 4 && (best || r.empty()); ++i)
+    for (int j = i + 1; j < 4 && (best || r.empty()); ++j) consider(plan_remove_edge(s, v[i], v[j]));
+  for (int fi = 0; fi < 4 && (best || r.empty()); ++fi) consider(plan_flip23(s, t, fi));
+  return r;
+}
+
+}  // namespace
+
+long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad, bool best) {
   long flips = 0;
   for (int sweep = 0; sweep < 4; ++sweep) {
     long here = 0;
@@ -429,11 +518,7 @@ long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad) {
     const size_t n0 = tets.size();
     for (size_t t = 0; t < n0; ++t) {
       if (s.touched[t] || rho(P, tets[t]) >= bad) continue;
-      const Tet v = tets[t];
-      TetReplacement r;
-      for (int i = 0; i < 4 && r.empty(); ++i)
-        for (int j = i + 1; j < 4 && r.empty(); ++j) r = plan_remove_edge(s, v[i], v[j]);
-      for (int fi = 0; fi < 4 && r.empty(); ++fi) r = plan_flip23(s, static_cast<int>(t), fi);
+      const TetReplacement r = plan_reconnection(s, static_cast<int>(t), best);
       if (r.empty()) continue;
       apply(s, r);
       ++here;
@@ -598,7 +683,48 @@ long remove_tets_below(std::vector<Vec3>& P, std::vector<Tet>& tets, double floo
   return done;
 }
 
-long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, int first_new, double floor) {
+namespace {
+
+/// The tets of v's ball below `floor` with v at `x` (P[v] is as it was on return).
+int ball_below(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts, int v, const Vec3& x,
+               double floor) {
+  const Vec3 at = P[v];
+  P[v] = x;
+  int n = 0;
+  for (int q : ts) n += rho(P, tets[q]) < floor;
+  P[v] = at;
+  return n;
+}
+
+/// Node v of a tet below `floor` to the best of the compass search's, the optimisation's and
+/// (when those leave its ball below floor) the perturbation's positions, then optimised again
+/// from there — each move only when it leaves no more tets of the ball below floor than
+/// there were (raising the worst alone can bring more of them below it); true when it moved.
+bool move_sliver_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v, double floor) {
+  const Adjacency::Row ts = stars.row(v);
+  const int below = ball_below(P, tets, ts, v, P[v], floor);
+  NodeMove m;
+  int m_below = below;
+  auto consider = [&](const NodeMove& c) {
+    if (c.empty()) return;
+    const int n = ball_below(P, tets, ts, v, c.to, floor);
+    if (n > below) return;
+    if (m.empty() || n < m_below || (n == m_below && c.after > m.after)) m = c, m_below = n;
+  };
+  consider(plan_search_node(P, tets, stars, v));
+  consider(plan_optimise_node(P, tets, stars, v));
+  if (m.empty() || m.after < floor) consider(plan_perturb_node(P, tets, stars, v));
+  if (m.empty()) return false;
+  mesh::apply(P, m);  // qualified: std::apply would be found by ADL too
+  const NodeMove polish = plan_optimise_node(P, tets, stars, v);
+  if (!polish.empty() && ball_below(P, tets, ts, v, polish.to, floor) <= m_below) mesh::apply(P, polish);
+  return true;
+}
+
+}  // namespace
+
+long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, int first_new, double floor,
+                          bool optimise) {
   const Adjacency stars = node_stars(P.size(), tets);
   std::vector<char> seen(P.size(), 0);
   long moved = 0;
@@ -606,6 +732,10 @@ long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, in
     for (int v : tets[t]) {
       if (v < first_new || seen[v]) continue;
       seen[v] = 1;
+      if (optimise) {
+        moved += move_sliver_node(P, tets, stars, v, floor);
+        continue;
+      }
       NodeMove m = plan_search_node(P, tets, stars, v);
       if (m.empty()) m = plan_perturb_node(P, tets, stars, v);
       if (m.empty()) continue;
@@ -618,18 +748,19 @@ long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, in
 long remove_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress) {
   long left = static_cast<long>(tets_below(P, tets, floor).size());
-  for (int round = 0; round < rounds && left > 0; ++round) {
-    progress.check_cancel("volume meshing (slivers)");
-    perturb_sliver_nodes(P, tets, first_new, floor);
-    flip_bad_tets(P, tets, floor);
-    remove_tets_below(P, tets, floor, 2, progress);
-    const long now = static_cast<long>(tets_below(P, tets, floor).size());
-    if (now >= left) {
+  // first the plain rounds, then, for what they leave, the rounds with optimise_node and the
+  // best flips (run first, those left NIST 5's fill with tets below 0.1 that these clear)
+  for (const bool optimise : {false, true})
+    for (int round = 0; round < rounds && left > 0; ++round) {
+      progress.check_cancel("volume meshing (slivers)");
+      perturb_sliver_nodes(P, tets, first_new, floor, optimise);
+      flip_bad_tets(P, tets, floor, optimise);
+      remove_tets_below(P, tets, floor, 2, progress);
+      const long now = static_cast<long>(tets_below(P, tets, floor).size());
+      const bool fell = now < left;
       left = now;
-      break;
+      if (!fell) break;
     }
-    left = now;
-  }
   return left;
 }
 

@@ -12,8 +12,9 @@
 // a triangulation of their ring; on a ring of three it is the 3-2 flip), flip23 (the face of
 // two tets replaced by the edge between their apexes), smooth_node (to the centroid of its
 // neighbours), search_node (compass search for the position with the best worst tet around
-// it), refill_cavity (a cavity of tets re-filled as a star from one new point: sliver
-// removal by point insertion, which also removes a tet with two faces on the boundary).
+// it), perturb_node (pattern search over many directions), optimise_node (steepest ascent of
+// the worst tet around a node with a line search), refill_cavity (a cavity of tets re-filled as a star from one new
+// point: sliver removal by point insertion, which also removes a tet with two faces on the boundary).
 //
 // Only tets in the given list are ever changed: the caller's fixed tets (the existing ones
 // and the boundary) stay, because a face is flipped only between two listed tets, an edge only
@@ -105,6 +106,17 @@ NodeMove plan_perturb_node(std::vector<Eigen::Vector3d>& P, const std::vector<Te
                            int v);
 /// Directions the perturbation tries per step.
 constexpr int kPerturbDirections = 32;
+/// Optimisation-based smoothing (check-only): steepest ascent of the worst radius ratio around
+/// v. Each step takes the tets within kActiveBand of the worst (the active set), their
+/// gradients in v's position by central differences, and tries as directions each gradient
+/// and their normalised sum; along each, a line search from a fifth of v's mean edge, halved
+/// up to 12 times, keeps the first step that raises the worst radius ratio with every tet
+/// around positive (orient3d); the best direction's step is taken. Up to 30 steps, ending when
+/// none helps. Returns the best position when it is better.
+NodeMove plan_optimise_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars,
+                            int v);
+/// Tets within this radius ratio of the ball's worst are active in plan_optimise_node.
+constexpr double kActiveBand = 0.02;
 /// Makes move m (P[m.v] = m.to).
 void apply(std::vector<Eigen::Vector3d>& P, const NodeMove& m);
 
@@ -134,8 +146,10 @@ constexpr double kSliverShare = 0.25;
 // ---- drivers
 
 /// Sweeps of edge removal then 2-3 flips over the tets below `bad` (each tet changed at most
-/// once per sweep, up to 4 sweeps while any flip happens). Returns the number of changes.
-long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
+/// once per sweep, up to 4 sweeps while any flip happens). `best`: every edge removal and
+/// 2-3 flip at a tet is planned and the one whose new worst radius ratio is highest is made;
+/// otherwise the first improving one (edges, then faces). Returns the number of changes.
+long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad, bool best = false);
 /// `iterations` sweeps of smooth_node over the nodes from first_new on.
 void smooth_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int first_new,
                   int iterations);
@@ -150,9 +164,13 @@ void search_nodes_of_bad_tets(std::vector<Eigen::Vector3d>& P, const std::vector
 long insert_points_at_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad);
 
 /// The nodes from first_new on of the tets below `floor`, worst tet first, each node once:
-/// moved by search_node, else by perturb_node, when that lifts the worst tet around it.
-/// Returns the number of nodes moved.
-long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor);
+/// moved by search_node, else by perturb_node, when that lifts the worst tet around it. With
+/// `optimise`: moved to the best of search_node's, optimise_node's and (when those leave the
+/// ball below floor) perturb_node's positions, then optimise_node again from there, when that
+/// lifts the worst tet around it and leaves no more tets around it below floor (fewest first,
+/// then the highest worst). Returns the number of nodes moved.
+long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, int first_new, double floor,
+                          bool optimise = false);
 
 /// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
 /// each is taken out with the best of wider cavities than insert_points_at_slivers tries —
@@ -166,8 +184,10 @@ long remove_tets_below(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, 
 
 /// Rounds at the tets below `floor` until none is left or a round removes none: the nodes
 /// of the slivers perturbed (perturb_sliver_nodes, nodes from first_new on), edge removal and
-/// 2-3 flips at them, and wider cavities re-filled (remove_tets_below, 2 sweeps; the points
-/// it adds are the next round's to move). Returns the number of tets below floor left.
+/// 2-3 flips at them, and wider cavities re-filled (remove_tets_below, 2 sweeps; the points it
+/// adds are the next round's to move); then, for the tets still below floor, the same rounds
+/// with perturb_sliver_nodes' optimise and flip_bad_tets' best (each phase up to `rounds`).
+/// Returns the number of tets below floor left.
 long remove_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress = {});
 

@@ -36,7 +36,7 @@ void expect_conformal_with_volumes(const TetMesh& m, const brep::TwoBReps& model
   ASSERT_EQ(c.expected_volume.size(), c.domain_volume.size());
   for (size_t d = 0; d < c.domain_volume.size(); ++d)
     EXPECT_NEAR(c.domain_volume[d], c.expected_volume[d], 0.005 * c.expected_volume[d]) << "domain " << d;
-  EXPECT_GT(tet_quality(m).min_radius_ratio, 0.02);
+  EXPECT_GT(tet_quality(m).min_radius_ratio, 0.1);
   EXPECT_GE(m.face.minCoeff(), 1);
   EXPECT_LE(m.face.maxCoeff(), model.part.num_faces());
   EXPECT_GE(m.nd_face.minCoeff(), 0);

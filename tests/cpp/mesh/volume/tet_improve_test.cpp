@@ -359,6 +359,31 @@ TEST(TetImprove, PerturbNodeFindsABetterPlaceForTheNodeOfAFlatTet) {
   EXPECT_TRUE(plan_perturb_node(P, tets, stars, 6).empty());
 }
 
+TEST(TetImprove, OptimiseNodeClimbsFromAFlatCapToNearlyTheBestPosition) {
+  // node 6 at 0.02 under the centre of the face x + y + z = 1: the tet on it is a flat cap
+  // (radius ratio < 0.1); the ascent of the worst tet leads it to near the centre, where all
+  // eight tets have 0.7321 (the best position, by symmetry), every step positive
+  DisplacedStar d;
+  auto& [tets, P, P0, stars] = d;
+  P[6] = Vec3::Constant((1.0 - 0.02 * std::sqrt(3.0)) / 3);
+  const Points before = P;
+  ASSERT_LT(worst(P, tets), 0.1);
+  const NodeMove m = plan_optimise_node(P, tets, stars, 6);
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(P, before) << "the plan moved the node";
+  EXPECT_NEAR(m.before, worst(P, tets), 1e-15);
+  EXPECT_GT(m.after, 0.7);
+  EXPECT_LE(m.after, 0.7321 + 1e-4) << "above the best a position can give";
+  EXPECT_LT(m.to.norm(), 0.2 * m.from.norm()) << "towards the centre";
+  apply(P, m);
+  EXPECT_NEAR(worst(P, tets), m.after, 1e-15);
+  for (const Tet& t : tets)
+    EXPECT_GT(predicates::orient3d(P[t[0]].data(), P[t[1]].data(), P[t[2]].data(), P[t[3]].data()), 0);
+  // at the centre every tet is active and no direction raises them all: no move
+  P[6] = Vec3::Zero();
+  EXPECT_TRUE(plan_optimise_node(P, tets, stars, 6).empty());
+}
+
 /// The classic shapes of tets with a small radius ratio (nodes 0-3, w the small length):
 /// flat cap (a node at height w over the centre of the opposite equilateral face), wedge (a
 /// short edge of length w, the opposite edge long and skew to it), needle (an equilateral

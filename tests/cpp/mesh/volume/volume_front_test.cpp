@@ -244,6 +244,7 @@ TEST(VolumeFillQuality, NoSliverOnNist5) {
   expect_no_sliver("nist/NIST_MBE_PMI_5.stp");
 }
 TEST(VolumeFillQuality, NoSliverOnLinkrods) { expect_no_sliver("occt/linkrods.step"); }
+TEST(VolumeFillQuality, NoSliverOnNist1) { expect_no_sliver("nist/NIST_MBE_PMI_1.stp"); }
 
 INSTANTIATE_TEST_SUITE_P(BulkThenFrontAndFrontAlone, VolumeFill, ::testing::Values(true, false),
                          [](const ::testing::TestParamInfo<bool>& i) {
