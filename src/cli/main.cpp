@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -241,7 +242,11 @@ int run_on_ranks(int argc, char** argv) {
       return run_command([&](const Args&) -> int { std::rethrow_exception(failure); }, {}, label.c_str());
     });
     if (session.rank() != 0) {
-      topopt::dist::serve_ranks(session);
+      // --test-fail-after-distribution: a test hook, not in the usage (dist_run.h, ServeParams)
+      topopt::dist::ServeParams serve;
+      serve.fail_after_distribution =
+          std::find(args.begin(), args.end(), "--test-fail-after-distribution") != args.end();
+      topopt::dist::serve_ranks(session, serve);
       return 0;
     }
     const bool solve = !std::strcmp(name, "solve");

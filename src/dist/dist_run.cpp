@@ -87,21 +87,18 @@ std::vector<RankStats> gather_stats(const MpiSession& s, const RankStats& mine) 
   return all;
 }
 
-/// Test hook of tests/cpp/dist/cli_mpi_test.cpp: a rank started with TOPOPT_DIST_TEST_FAULT=1
-/// in its environment (which the test gives one rank only) fails here, after the distribution,
-/// as an error on that rank alone would: the other ranks are then inside collective calls.
+/// ServeParams::fail_after_distribution: this rank fails here, after the distribution, as an
+/// error on that rank alone would: the other ranks are then inside collective calls.
 void test_fault(const MpiSession& s) {
-  const char* fault = std::getenv("TOPOPT_DIST_TEST_FAULT");
-  if (fault && std::string(fault) == "1")
-    throw Error(ErrorCode::Internal, "the fault TOPOPT_DIST_TEST_FAULT=1 asks for, on rank " +
-                                         std::to_string(s.rank()) + " only (a test of how errors end every rank)");
+  throw Error(ErrorCode::Internal, "the fault --test-fail-after-distribution asks for, on rank " +
+                                       std::to_string(s.rank()) + " only (a test of how errors end every rank)");
 }
 
 /// One run on every rank, the settings already shared (broadcast): rank 0 passes the serial
 /// problem, the others empty ones.
 Answer run_here(const MpiSession& s, const Settings& settings, const TetMesh& mesh, const fem::Supports& supports,
                 const Eigen::MatrixXd& loads, std::vector<double> weights, const Progress& progress,
-                const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+                const std::function<void(const simp::IterationRecord&)>& on_iteration, bool fault) {
   weights.resize(settings.cases);
   MPI_Bcast(weights.data(), settings.cases, MPI_DOUBLE, 0, s.comm());
   RankStats mine;
@@ -109,7 +106,7 @@ Answer run_here(const MpiSession& s, const Settings& settings, const TetMesh& me
   auto t0 = std::chrono::steady_clock::now();
   const DistMesh dm = distribute_mesh(s, mesh, partition_tets(s, mesh.T), supports, loads);
   mine.seconds_distribute = seconds_since(t0);
-  test_fault(s);
+  if (fault) test_fault(s);
   mine.tets = dm.local.T.rows();
   mine.owned_nodes = dm.owned_nodes;
   mine.ghost_nodes = dm.local.V.rows() - dm.owned_nodes;
@@ -140,9 +137,9 @@ Answer run_here(const MpiSession& s, const Settings& settings, const TetMesh& me
 /// the failing rank cannot tell the others, which wait for it in a collective call.
 Answer run(const MpiSession& s, const Settings& settings, const TetMesh& mesh, const fem::Supports& supports,
            const Eigen::MatrixXd& loads, const std::vector<double>& weights, const Progress& progress,
-           const std::function<void(const simp::IterationRecord&)>& on_iteration) {
+           const std::function<void(const simp::IterationRecord&)>& on_iteration, bool fault = false) {
   try {
-    return run_here(s, settings, mesh, supports, loads, weights, progress, on_iteration);
+    return run_here(s, settings, mesh, supports, loads, weights, progress, on_iteration, fault);
   } catch (...) {
     s.end_run(std::current_exception());
   }
@@ -197,12 +194,12 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
   return std::move(a.simp);
 }
 
-void serve_ranks(const MpiSession& session) {
+void serve_ranks(const MpiSession& session, const ServeParams& params) {
   while (true) {
     Settings settings;
     share_settings(session, settings);
     if (settings.command == Command::Stop) return;
-    run(session, settings, TetMesh(), fem::Supports(), Eigen::MatrixXd(), {}, {}, {});
+    run(session, settings, TetMesh(), fem::Supports(), Eigen::MatrixXd(), {}, {}, {}, params.fail_after_distribution);
   }
 }
 

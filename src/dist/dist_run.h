@@ -50,9 +50,17 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
                                    const std::function<void(const simp::IterationRecord&)>& on_iteration,
                                    const Eigen::Matrix3Xd& gravity, Amg amg, std::vector<RankStats>* stats = nullptr);
 
+/// How a serving rank runs.
+struct ServeParams {
+  /// Test hook (tests/cpp/dist/cli_mpi_test.cpp; the CLI's hidden --test-fail-after-distribution,
+  /// given to one rank of an MPMD launch): fail every run with Error(Internal) right after the
+  /// mesh is distributed, to test that an error on one rank ends every rank with its message.
+  bool fail_after_distribution = false;
+};
+
 /// Ranks other than 0: takes part in every run rank 0 starts until it calls release_ranks. An
 /// error inside a run ends every rank (MpiSession::end_run).
-void serve_ranks(const MpiSession& session);
+void serve_ranks(const MpiSession& session, const ServeParams& params = {});
 
 /// Rank 0: ends serve_ranks on the other ranks (once, at the end, also after an error).
 void release_ranks(const MpiSession& session);

@@ -32,6 +32,9 @@ struct OptimizeSettings {
   double threshold = -1;         ///< iso-value of the result shape; < 0: the one that meets the volume fraction
   result::SmoothParams smooth;
   result::HygieneParams hygiene;  ///< loose pieces out, closed voids filled (fill_voids)
+  /// "keep_loaded_faces": the design tets on a face a support or a force or pressure acts on
+  /// stay solid (one layer; optimize_job), so the result keeps every loaded and supported face.
+  bool keep_loaded_faces = true;
 };
 
 /// The "output" section.

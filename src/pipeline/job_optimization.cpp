@@ -215,6 +215,7 @@ OptimizeSettings parse_optimization(const json& section) {
       {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver", "sensitivity_filter",
        "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
        "solver_tolerance", "smoothing_iterations", "surface_remesh", "surface_repair", "fill_voids",
+       "keep_loaded_faces",
        // objectives and constraints (parse_responses)
        "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation",
        // geometry controls (parse_controls)
@@ -258,6 +259,7 @@ OptimizeSettings parse_optimization(const json& section) {
   s.smooth.remesh = f.boolean("surface_remesh", true);
   s.smooth.repair = f.boolean("surface_repair", true);
   s.hygiene.fill_voids = f.boolean("fill_voids", true);
+  s.keep_loaded_faces = f.boolean("keep_loaded_faces", true);
   return s;
 }
 

@@ -14,6 +14,7 @@
 #include "io/vtu.h"
 #include "pipeline/output_files.h"
 #include "pipeline/problem_checks.h"
+#include "simp/density_filter.h"
 
 namespace topopt::pipeline {
 namespace fs = std::filesystem;
@@ -101,7 +102,76 @@ void refuse_invalid(const result::ResultCheck& c, double threshold, bool repair,
   throw Error(ErrorCode::MeshingFailed, m.str());
 }
 
+/// `mesh` as SIMP sees it under keep_loaded_faces: the loaded_face_layer of the job's loaded
+/// and supported faces tagged non-design (one tag after the last non-design solid), with a
+/// warning naming the faces. Returns false (and leaves `held` alone) when there is no layer.
+bool hold_loaded_faces(const TetMesh& mesh, const Job& job, const Progress& progress, TetMesh& held) {
+  std::vector<int> faces;
+  const std::vector<char> layer = loaded_face_layer(mesh, loaded_faces(job), &faces);
+  const long count = std::count(layer.begin(), layer.end(), 1);
+  if (count == 0) return false;
+  held = mesh;
+  if (held.domain.size() != held.T.rows()) held.domain = VecXi::Zero(held.T.rows());
+  const int tag = held.domain.size() ? held.domain.maxCoeff() + 1 : 1;
+  for (long t = 0; t < held.T.rows(); ++t)
+    if (layer[t]) held.domain[t] = tag;
+  std::string names;
+  for (size_t i = 0; i < faces.size(); ++i) names += (i ? ", Face" : "Face") + std::to_string(faces[i]);
+  progress.warn("the design material on the loaded or supported " + names + " is kept solid (" + std::to_string(count) +
+                " tets, one layer) so that the result holds those faces; set \"optimization.keep_loaded_faces\": "
+                "false to let the optimisation remove it");
+  return true;
+}
+
+/// The share of `mesh`'s design volume that hold_loaded_faces tagged non-design in `held`.
+double held_share(const TetMesh& mesh, const TetMesh& held) {
+  const VecXd volume = simp::tet_volumes(mesh);
+  const bool tagged = mesh.domain.size() == mesh.T.rows();
+  double design = 0, layer = 0;
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    if (tagged && mesh.domain[t] != 0) continue;
+    design += volume[t];
+    if (held.domain[t] != 0) layer += volume[t];
+  }
+  return design > 0 ? layer / design : 0.0;
+}
+
 }  // namespace
+
+std::vector<int> loaded_faces(const Job& job) {
+  std::vector<int> faces;
+  for (const fem::SupportSpec& s : job.supports) faces.insert(faces.end(), s.faces.begin(), s.faces.end());
+  for (const fem::LoadCase& lc : job.load_cases)
+    for (const fem::LoadSpec& l : lc.items)
+      if (l.kind != fem::LoadSpec::Kind::Gravity) faces.insert(faces.end(), l.faces.begin(), l.faces.end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+std::vector<char> loaded_face_layer(const TetMesh& mesh, const std::vector<int>& faces, std::vector<int>* on_face) {
+  const int top = faces.empty() ? 0 : *std::max_element(faces.begin(), faces.end());
+  std::vector<char> wanted(top + 1, 0);
+  for (int f : faces)
+    if (f > 0) wanted[f] = 1;
+  std::vector<int> node_face(mesh.V.rows(), 0);  // a wanted face each node lies on, 0 for none
+  for (long q = 0; q < mesh.face.size() && q < mesh.F.rows(); ++q)
+    if (mesh.face[q] > 0 && mesh.face[q] <= top && wanted[mesh.face[q]])
+      for (int k = 0; k < 3; ++k) node_face[mesh.F(q, k)] = mesh.face[q];
+  const bool tagged = mesh.domain.size() == mesh.T.rows();
+  std::vector<char> layer(mesh.T.rows(), 0), seen(top + 1, 0);
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    if (tagged && mesh.domain[t] != 0) continue;
+    for (int k = 0; k < 4; ++k)
+      if (const int f = node_face[mesh.T(t, k)]; f > 0) layer[t] = 1, seen[f] = 1;
+  }
+  if (on_face) {
+    on_face->clear();
+    for (int f = 1; f <= top; ++f)
+      if (seen[f]) on_face->push_back(f);
+  }
+  return layer;
+}
 
 std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
   std::vector<char> anchors(mesh.V.rows(), 0);
@@ -150,6 +220,7 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   const Eigen::MatrixXd loads = fem::make_loads(mesh, job.material, job.load_cases);
   check_loads_reach_the_part(loads, supports, job.load_cases);
   simp::SimpParams simp = set.simp;
+  if (simp.responses.stress_limit > 0) simp.responses.load_cases = job.load_cases;
   std::string filter_note;
   simp.filter = chosen_filter(mesh, set.simp.filter, set.filter_automatic, physical_memory_bytes(), &filter_note);
   if (!filter_note.empty()) progress.info(filter_note);
@@ -160,15 +231,21 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
         {d.name, fem::make_loads(mesh, job.material, {fem::LoadCase{d.name, {d.unit}, 1}}).col(0), d.limit});
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  r.simp = (runner ? runner : SimpRunner(simp::optimize))(mesh, job.material, supports, loads, weights, simp, progress,
-                                                          on_iteration, fem::gravity_of(job.load_cases));
+  TetMesh held;  // keep_loaded_faces: the layer on loaded and supported faces non-design for SIMP
+  const bool holding = set.keep_loaded_faces && hold_loaded_faces(mesh, job, progress, held);
+  r.simp =
+      (runner ? runner : SimpRunner(simp::optimize))(holding ? held : mesh, job.material, supports, loads, weights,
+                                                     simp, progress, on_iteration, fem::gravity_of(job.load_cases));
   if (const std::string w = not_crisp_warning(r.simp, simp); !w.empty()) progress.warn(w);
   const auto t1 = std::chrono::steady_clock::now();
   progress.say("surface", -1, "extracting the result shape");
   // the shape keeps the volume SIMP ended with (under a mass objective, what the limits left)
-  const double kept = simp.responses.objective == simp::Objective::Mass && !r.simp.history.empty()
-                          ? r.simp.history.back().volume_fraction
-                          : set.simp.volume_fraction;
+  const double simp_kept = simp.responses.objective == simp::Objective::Mass && !r.simp.history.empty()
+                               ? r.simp.history.back().volume_fraction
+                               : set.simp.volume_fraction;
+  // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
+  const double share = holding ? held_share(mesh, held) : 0.0;
+  const double kept = simp_kept + (1 - simp_kept) * share;
   r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold,
                              anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report);
   const auto t2 = std::chrono::steady_clock::now();

@@ -39,10 +39,23 @@ struct OptimizeResult {
 /// Error(InvalidParameter) for a load case that puts no force on the part or only loads
 /// supported nodes, or a filter radius larger than the part, and Error(TooLarge) for a
 /// filter that would not fit in memory (problem_checks.h); then what fem and simp throw
-/// (NoSupport, Cancelled). runner: the SIMP run (empty: simp::optimize).
+/// (NoSupport, Cancelled). runner: the SIMP run (empty: simp::optimize). With
+/// job.optimization.keep_loaded_faces, SIMP sees the loaded_face_layer of the loaded and
+/// supported faces as non-design (solid, density 1; a warning names the faces).
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {},
                             const SimpRunner& runner = {});
+
+/// The faces of Ω a support or a force or pressure of `job` acts on (1-based, ascending;
+/// gravity has none).
+std::vector<int> loaded_faces(const Job& job);
+
+/// keep_loaded_faces: the design tets (domain 0, all tets without tags) with a node on a
+/// boundary triangle of one of `faces` (Ω's, 1-based): one layer of tets, what a load or a
+/// support there needs of material. Returns #T flags; on_face (optional) gets those of
+/// `faces` that have such tets.
+std::vector<char> loaded_face_layer(const TetMesh& mesh, const std::vector<int>& faces,
+                                    std::vector<int>* on_face = nullptr);
 
 /// The nodes where a support (result::kAnchorSupport) or a force or pressure
 /// (result::kAnchorLoad) acts: #V flags, what the design must connect. Gravity acts

@@ -7,13 +7,12 @@
 #include <cstring>
 
 #include <unordered_map>
-#include <unordered_set>
 
 #include "common/cpu_time.h"
 #include "common/error.h"
-#include "common/face_key.h"
 #include "common/isolate.h"
 #include "fem/elasticity.h"
+#include "fem/kept_part.h"
 #include "result/design_hygiene.h"
 
 namespace topopt::result {
@@ -130,6 +129,33 @@ mesh::VolumeFillResult unpack(const std::string& b) {
   return r;
 }
 
+/// Throws Error(FaceNotFound) naming the first face of Ω that a support or a face load of
+/// `problem` acts on and that the result solid `m` has no triangle of: the design removed the
+/// material there, so the load or support has nothing to act on.
+void check_faces_kept(const TetMesh& m, const VerificationProblem& problem) {
+  std::vector<char> present;
+  for (long q = 0; q < m.face.size(); ++q) {
+    if (m.face[q] >= static_cast<long>(present.size())) present.resize(m.face[q] + 1, 0);
+    if (m.face[q] > 0) present[m.face[q]] = 1;
+  }
+  const auto gone = [&](int f) { return f <= 0 || f >= static_cast<int>(present.size()) || !present[f]; };
+  const std::string fix =
+      ": keep \"optimization.keep_loaded_faces\" on (the default keeps a layer of material on every loaded or "
+      "supported face), add a non-design solid (a load pad) there, or lower the threshold";
+  for (const fem::LoadCase& lc : problem.load_cases)
+    for (const fem::LoadSpec& l : lc.items)
+      for (int f : l.faces)
+        if (l.kind != fem::LoadSpec::Kind::Gravity && gone(f))
+          throw Error(ErrorCode::FaceNotFound, "the design removed the material under the load on Face" +
+                                                   std::to_string(f) + " (load case \"" + lc.name +
+                                                   "\"): the result solid has none of that face" + fix);
+  for (const fem::SupportSpec& sp : problem.supports)
+    for (int f : sp.faces)
+      if (gone(f))
+        throw Error(ErrorCode::FaceNotFound, "the design removed the material on the supported Face" +
+                                                 std::to_string(f) + ": the result solid has none of that face" + fix);
+}
+
 /// Keeps in `m` only the pieces (tets sharing nodes) that hold a fixed dof of `problem`'s
 /// supports; returns the volumes of those left out. Throws Error(NoSupport) naming a piece
 /// left out on which a load acts.
@@ -168,63 +194,10 @@ std::vector<double> drop_unheld_pieces(TetMesh& m, const VerificationProblem& pr
     dropped.push_back(volume[k]);
   }
   if (dropped.empty()) return {};
-  MatX4i T(m.T.rows(), 4);
-  long n = 0;
-  for (long t = 0; t < m.T.rows(); ++t)
-    if (held[piece[t]]) T.row(n++) = m.T.row(t);
-  T.conservativeResize(n, 4);
-  std::vector<int> renum(m.V.rows(), -1);  // the kept pieces' nodes, in their order
-  int nv = 0;
-  for (long t = 0; t < n; ++t)
-    for (int k = 0; k < 4; ++k)
-      if (renum[T(t, k)] < 0) renum[T(t, k)] = nv++;
-  MatX3d V(nv, 3);
-  for (long i = 0; i < m.V.rows(); ++i)
-    if (renum[i] >= 0) V.row(renum[i]) = m.V.row(i);
-  for (long t = 0; t < n; ++t)
-    for (int k = 0; k < 4; ++k) T(t, k) = renum[T(t, k)];
-  long nf = 0;
-  for (long q = 0; q < m.F.rows(); ++q)
-    if (renum[m.F(q, 0)] >= 0) {
-      m.F.row(nf) << renum[m.F(q, 0)], renum[m.F(q, 1)], renum[m.F(q, 2)];
-      m.face[nf] = m.face[q], m.nd_face[nf] = m.nd_face[q], ++nf;
-    }
-  m.F.conservativeResize(nf, 3), m.face.conservativeResize(nf), m.nd_face.conservativeResize(nf);
-  m.V = V, m.T = T;
-  m.domain = VecXi::Zero(n);
+  std::vector<char> keep(m.T.rows());
+  for (long t = 0; t < m.T.rows(); ++t) keep[t] = held[piece[t]];
+  m = fem::kept_part(m, keep, fem::KeptNodes::Compact);
   return dropped;
-}
-
-/// The crisp design's part of `fe` that takes loads: its kept tets (body loads) and only the
-/// boundary triangles that are faces of kept tets (face loads), so a load face the design keeps
-/// only in part is loaded where material is, as on the result solid, and no force lands on
-/// nodes held by removed tets alone (their void stiffness made the compliance ~10^7 times the
-/// as-built one on a top-loaded box).
-TetMesh crisp_loaded_mesh(const TetMesh& fe, const std::vector<char>& kept) {
-  TetMesh loaded = fe;
-  if (loaded.domain.size() != fe.T.rows()) loaded.domain = VecXi::Zero(fe.T.rows());
-  std::unordered_set<FaceKey, FaceKeyHash> kept_faces;
-  long n = 0;
-  for (long t = 0; t < fe.T.rows(); ++t) {
-    if (!kept[t]) continue;
-    for (int k = 0; k < 4; ++k)
-      kept_faces.insert(face_key(fe.T(t, kTetFace[k][0]), fe.T(t, kTetFace[k][1]), fe.T(t, kTetFace[k][2])));
-    loaded.T.row(n) = fe.T.row(t), loaded.domain[n] = loaded.domain[t], ++n;
-  }
-  loaded.T.conservativeResize(n, 4);
-  loaded.domain.conservativeResize(n);
-  long nf = 0;
-  for (long q = 0; q < fe.F.rows(); ++q) {
-    if (!kept_faces.count(face_key(fe.F(q, 0), fe.F(q, 1), fe.F(q, 2)))) continue;
-    loaded.F.row(nf) = fe.F.row(q);
-    if (fe.face.size()) loaded.face[nf] = fe.face[q];
-    if (fe.nd_face.size()) loaded.nd_face[nf] = fe.nd_face[q];
-    ++nf;
-  }
-  loaded.F.conservativeResize(nf, 3);
-  if (fe.face.size()) loaded.face.conservativeResize(nf);
-  if (fe.nd_face.size()) loaded.nd_face.conservativeResize(nf);
-  return loaded;
 }
 
 }  // namespace
@@ -314,6 +287,7 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
     if (e.code() == ErrorCode::Cancelled || e.code() == ErrorCode::Timeout) out_of_time("meshing the result solid");
     throw;
   }
+  check_faces_kept(v.mesh, problem);
   v.unheld_volumes = drop_unheld_pieces(v.mesh, problem);
   for (double vol : v.unheld_volumes)
     progress.warn("verification: a piece of the result of " + std::to_string(static_cast<long>(vol)) +
@@ -324,7 +298,11 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   const std::vector<char> kept = crisp_tets(fe, node_densities(fe, design), threshold);
   VecXd scale(fe.T.rows());
   for (long t = 0; t < fe.T.rows(); ++t) scale[t] = kept[t] ? 1.0 : params.void_stiffness;
-  const TetMesh loaded = crisp_loaded_mesh(fe, kept);
+  // loads on the kept tets and their boundary triangles only: a load face the design keeps only
+  // in part is loaded where material is, as on the result solid, and no force lands on nodes
+  // held by removed tets alone (their void stiffness made the compliance ~10^7 times the
+  // as-built one on a top-loaded box)
+  const TetMesh loaded = fem::kept_part(fe, kept);
   try {
     v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
     v.as_built.seconds += seconds_mesh;

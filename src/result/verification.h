@@ -79,8 +79,10 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
 /// The whole runs within params.seconds: past it, Error(Timeout) naming the step. Pieces of
 /// the result that no support holds are left out (Verification::unheld_volumes, a warning through
 /// progress) when no load acts on them; Error(NoSupport) naming the piece when one does (the
-/// design does not carry that load). Throws what fill_volume and fem throw (MeshingFailed,
-/// FaceNotFound when a support's face is gone).
+/// design does not carry that load). Throws Error(FaceNotFound) naming the face when the result
+/// has nothing left of a face a load or support acts on (the design removed the material there:
+/// the message says to keep optimization.keep_loaded_faces on), and what fill_volume and fem
+/// throw (MeshingFailed).
 Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& design, double threshold,
                            const VerificationProblem& problem, const VerificationParams& params = {},
                            const Progress& progress = {});

@@ -1,6 +1,7 @@
 // make_filter: the one place that builds the filter kind the parameters name (see filter.h).
 #include "simp/filter.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "simp/density_filter.h"
@@ -10,6 +11,18 @@ namespace topopt::simp {
 
 double helmholtz_length(double radius, bool like_gaussian) {
   return like_gaussian ? radius / (3.0 * std::sqrt(2.0)) : radius / (2.0 * std::sqrt(3.0));
+}
+
+double mean_edge_length(const TetMesh& mesh, const std::vector<int>& tets) {
+  const long n = tets.empty() ? mesh.T.rows() : static_cast<long>(tets.size());
+  double sum = 0;
+  long edges = 0;
+  for (long i = 0; i < n; i += std::max<long>(1, n / 20000)) {
+    const long t = tets.empty() ? i : tets[i];
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) sum += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm(), ++edges;
+  }
+  return edges ? sum / static_cast<double>(edges) : 0;
 }
 
 FilterKind choose_filter_kind(FilterKind requested, bool automatic, double pairs, double design_elements,

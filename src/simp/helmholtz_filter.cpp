@@ -40,20 +40,6 @@ Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, d
   return A;
 }
 
-namespace {
-
-/// Mean edge length of the design tets (mm): the h of (ℓ/h)².
-double mean_design_edge(const TetMesh& mesh, const std::vector<int>& design) {
-  if (design.empty()) return 0;
-  double sum = 0;
-  for (int t : design)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) sum += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm();
-  return sum / (6.0 * static_cast<double>(design.size()));
-}
-
-}  // namespace
-
 // Measured (bench/simp/filters.py --helmholtz-solvers, cantilever 181 k tets, 8 iterations,
 // 1 thread), CPU Jacobi / multigrid: 0.78 at ℓ/h = 0.99, 0.84 at 1.98, 1.37 at 3.30; the ratio
 // crosses 1 near ℓ/h = 2.45, (ℓ/h)² = 6. Below, a V-cycle costs more than the Jacobi
@@ -75,7 +61,7 @@ HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& de
   volume_.resize(static_cast<long>(design.size()));
   for (size_t i = 0; i < design.size(); ++i) volume_[static_cast<long>(i)] = volume[design[i]];
   assemble(mesh, design);
-  mean_edge_ = mean_design_edge(mesh, design);
+  mean_edge_ = mean_edge_length(mesh, design);
   if (helmholtz_uses_multigrid(params.helmholtz_solver, length_, mean_edge_)) set_up_multigrid();
 }
 

@@ -15,15 +15,6 @@
 
 namespace topopt::simp {
 
-double mean_edge_length(const TetMesh& mesh) {
-  double s = 0;
-  long n = 0;
-  for (long t = 0; t < mesh.T.rows(); t += std::max<long>(1, mesh.T.rows() / 20000))
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) s += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm(), ++n;
-  return n ? s / n : 0;
-}
-
 double filter_radius(const TetMesh& mesh, const FilterParams& params) {
   return params.radius > 0 ? params.radius : 1.5 * mean_edge_length(mesh);
 }
@@ -269,7 +260,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   res.design = problem.design();
   const int num_design = static_cast<int>(res.design.size());
   check_responses(params, 3 * mesh.V.rows());
-  Responses responses(params, material, supports, loads);
+  Responses responses(params, material, supports);
   const int num_variables = problem.num_variables();
   const SimpParams stepping = update_settings(params);  // smaller steps under a stress limit
   DesignUpdate update(stepping, num_variables, responses.constraints(static_cast<int>(loads.cols())));

@@ -151,9 +151,6 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
                     const Progress& progress = {}, const std::function<void(const IterationRecord&)>& on_iteration = {},
                     const Eigen::Matrix3Xd& gravity = {});
 
-/// Mean edge length of the mesh's tets (for default filter radii).
-double mean_edge_length(const TetMesh& mesh);
-
 /// The filter radius SIMP uses for `params` on `mesh`: the given one, or 1.5 × the mean
 /// edge length when it is <= 0.
 double filter_radius(const TetMesh& mesh, const FilterParams& params);

@@ -142,6 +142,7 @@ def apply(study, result):
     study.ComplianceHistory = [float(h["compliance"]) for h in result["history"]]
     study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
     study.Threshold = float(result.get("threshold", 0.5))
+    study.RunThreshold = study.Threshold  # result.step's: the slider moves Threshold only
     study.Status = result.get("status", "done")
     feature = _result_feature(study, shape, result["surface_points"], result["surface_triangles"],
                               result.get("surface_tags"), nodes, tets, domain)
@@ -203,6 +204,22 @@ def run(study, on_progress=None, cancel=None, verbose=True):
     return feature
 
 
+def extract_at(study, threshold, cancel=None, stored=None):
+    """The result shape of the study's stored densities at `threshold` (in (0, 1)), extracted in
+    the worker process; the document is not touched. stored: checks.stored_mesh(study) when
+    the caller has it. Returns the worker's answer (surface_points #P×3, surface_triangles
+    #Q×3, surface_tags #Q). cancel(): polled, True cancels. Raises TopOptError if the study
+    has no result, if what it stored is damaged, or if the worker fails or runs past
+    REEXTRACT_TIMEOUT seconds."""
+    if not study.Densities:
+        raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
+    threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
+    nodes, tets, domain, densities = stored if stored is not None else checks.stored_mesh(study)
+    return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
+                                                 "densities": densities},
+                      params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
+
+
 def reextract(study, threshold, cancel=None):
     """Re-extracts the result shape from the stored densities at another threshold (no
     re-run), in the worker process, and moves the density view's cut there; one undo step
@@ -212,11 +229,9 @@ def reextract(study, threshold, cancel=None):
     is then unchanged). The study's Threshold is the shown shape's: runs never read it."""
     if not study.Densities:
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
-    threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
-    nodes, tets, domain, densities = checks.stored_mesh(study)
-    result = worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
-                                                   "densities": densities},
-                        params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
+    stored = checks.stored_mesh(study)
+    nodes, tets, domain, _ = stored
+    result = extract_at(study, threshold, cancel, stored)
     shape = result_mesh(result["surface_points"], result["surface_triangles"])
     with transaction(study.Document, "TopOpt threshold %.2f" % threshold):
         study.Threshold = threshold

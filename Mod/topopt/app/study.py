@@ -189,6 +189,9 @@ class Study:
         _add(obj, "App::PropertyBool", "Verify", "Output",
              "Analyse the result solid after each run (its own tet mesh, the study's supports and loads): "
              "the as-built compliance and stresses", True)
+        _add(obj, "App::PropertyFloat", "RunThreshold", "Result",
+             "Density threshold of the last run's result (the one its result.step was written at); the "
+             "threshold slider moves Threshold, and Result as solid and Export STEP follow it", -1.0)
         _add(obj, "App::PropertyStringList", "ResultFiles", "Result",
              "The files the last run wrote (result.step, verification.json, verification.vtu)")
         _add(obj, "App::PropertyFileIncluded", "ResultStep", "Result", "The last run's result.step (one solid)")
@@ -200,7 +203,8 @@ class Study:
         _add(obj, "App::PropertyFloat", "ComplianceCrisp", "Result",
              "Compliance of the crisp design (densities 0/1 at the threshold) on the FE mesh (N·mm); "
              "0 = not verified", 0.0)
-        for name in ("ResultFiles", "ResultStep", "VerificationVtu", "VerificationReport", "ComplianceAsBuilt", "ComplianceCrisp"):
+        for name in ("RunThreshold", "ResultFiles", "ResultStep", "VerificationVtu", "VerificationReport",
+                     "ComplianceAsBuilt", "ComplianceCrisp"):
             obj.setEditorMode(name, 1)
 
     def onDocumentRestored(self, obj):

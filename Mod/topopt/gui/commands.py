@@ -233,26 +233,32 @@ class ExportStl(_ResultCommand):
 
 class ExportStep(_ResultCommand):
     menu, icon = "Export result as STEP", "TopOptExportStep.svg"
-    tip = "Write the study's result as one CAD solid to a STEP file (the result.step of its last run)"
+    tip = ("Write the study's result as one CAD solid to a STEP file, at the threshold the result is shown at "
+           "(the threshold slider's)")
 
     @_guarded
     def Activated(self):
-        from topopt.app import asbuilt
-        asbuilt.step_path(active_study())  # refuses before the file dialog when the run wrote no STEP
-        _export("Export result solid", "STEP (*.step *.stp)", api.export_step)
+        from topopt.app import asbuilt, threshold_solid
+        study = active_study()
+        t = threshold_solid.chosen(study)  # the slider's: the shown result's threshold
+        if threshold_solid.is_the_runs(study, t):
+            asbuilt.step_path(study)  # refuses before the file dialog when the run wrote no STEP
+        _export("Export result solid", "STEP (*.step *.stp)", lambda s, path: api.export_step(s, path, threshold=t))
 
 
 class ResultAsSolid(_ResultCommand):
     menu, icon = "Result as solid", "TopOptResultSolid.svg"
-    tip = ("Add the study's result as a Part solid (read from the result.step of its last run) to use in "
-           "further CAD work")
+    tip = ("Add the study's result as a Part solid, at the threshold the result is shown at (the threshold "
+           "slider's), to use in further CAD work")
 
     @_guarded
     def Activated(self):
+        from topopt.app import threshold_solid
         study = active_study()
-        feature = api.result_solid(study)
-        FreeCAD.Console.PrintMessage("TopOpt: %s: one solid, %d faces, %.6g mm³\n" % (
-            feature.Label, len(feature.Shape.Faces), feature.Shape.Volume))
+        t = threshold_solid.chosen(study)
+        feature = api.result_solid(study, threshold=t)
+        FreeCAD.Console.PrintMessage("TopOpt: %s at threshold %.2f: one solid, %d faces, %.6g mm³\n" % (
+            feature.Label, t, len(feature.Shape.Faces), feature.Shape.Volume))
         feature.ViewObject.Visibility = True  # the solid in place of the result mesh
         if study.Result is not None:
             study.Result.ViewObject.Visibility = False

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "common/types.h"
+#include "fem/boundary_conditions.h"
 
 namespace topopt::simp {
 
@@ -39,6 +40,10 @@ struct ResponseParams {
   double stress_limit = 0;
   double stress_pnorm = 8;         ///< P of the p-norm, in [2, 64]: larger follows the maximum closer
   double stress_relaxation = 0.5;  ///< q of the qp-relaxation, in (0, 1]; below the penalty p
+  /// Under a stress limit: the load cases SIMP's nodal loads were made from (fem::make_loads).
+  /// The crisp design's stress (IterationRecord::stress_crisp) is analysed with them made anew
+  /// on its solid tets only (crisp_max_von_mises), so needed then.
+  std::vector<fem::LoadCase> load_cases;
   /// Frequency: the subspace iteration stops when the first eigenvalues change by less than this.
   double eigen_tolerance = 1e-10;
   /// True when the problem needs MMA (anything beyond compliance under a volume fraction).

@@ -90,7 +90,7 @@ void Responses::add_stress(ComplianceProblem& problem, MmaTerms& t, int& row) {
   VecXd density = VecXd::Ones(mesh.T.rows());
   const VecXd& rho = problem.physical_densities();
   for (size_t i = 0; i < problem.design().size(); ++i) density[problem.design()[i]] = rho[i];
-  t.stress_crisp = crisp_max_von_mises(mesh, material_, supports_, loads_, density);
+  t.stress_crisp = crisp_max_von_mises(mesh, material_, supports_, params_.responses.load_cases, density);
 }
 
 SimpParams update_settings(const SimpParams& params) {
@@ -123,6 +123,10 @@ void check_responses(const SimpParams& params, long num_dofs) {
     throw Error(ErrorCode::InvalidParameter,
                 "the stress limit needs a p-norm exponent in [2, 64] (8 is usual) and a relaxation exponent in (0, 1] "
                 "(0.5 is usual)");
+  if (r.stress_limit > 0 && r.load_cases.empty())
+    throw Error(ErrorCode::InvalidParameter,
+                "the stress limit needs the load cases of the loads (responses.load_cases) for the crisp design's "
+                "stress");
   if (r.needs_mma() && params.update != UpdateKind::MMA)
     throw Error(ErrorCode::InvalidParameter,
                 "a mass objective, a displacement limit or a stress limit needs the MMA update (\"update\": \"mma\"); "

@@ -36,11 +36,10 @@ struct MmaTerms {
 class Responses {
  public:
   /// material: its mass density (t/mm³) is the Frequency objective's; material, supports and
-  /// loads ((3*#V) by #cases, as optimize() is given them) are the crisp design's analysis
-  /// under a stress limit. All are kept by reference and must outlive this object.
-  Responses(const SimpParams& params, const fem::Material& material, const fem::Supports& supports,
-            const Eigen::MatrixXd& loads)
-      : params_(params), material_(material), supports_(supports), loads_(loads) {}
+  /// params.responses.load_cases are the crisp design's analysis under a stress limit. All are
+  /// kept by reference and must outlive this object.
+  Responses(const SimpParams& params, const fem::Material& material, const fem::Supports& supports)
+      : params_(params), material_(material), supports_(supports) {}
   /// The number of constraints terms() gives with `num_cases` load cases.
   int constraints(int num_cases) const;
   /// The terms at the design of the last problem.compliance() call, given its compliance c,
@@ -57,7 +56,6 @@ class Responses {
   const SimpParams& params_;
   const fem::Material& material_;
   const fem::Supports& supports_;
-  const Eigen::MatrixXd& loads_;
   VecXd stress_scale_;           // #cases: c_k of the last iteration (empty before the first)
   double first_eigenvalue_ = 0;  // λ1 of the first iteration (the objective's scale)
   Eigen::MatrixXd modes_;        // the last eigen subspace (the next one's start)

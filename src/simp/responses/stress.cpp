@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fem/kept_part.h"
+
 namespace topopt::simp {
 namespace {
 
@@ -56,9 +58,12 @@ VecXd pnorm_stress(ComplianceProblem& problem, const ResponseParams& params, Eig
 }
 
 double crisp_max_von_mises(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
-                           const Eigen::MatrixXd& loads, const VecXd& density, double threshold, double e_min) {
+                           const std::vector<fem::LoadCase>& cases, const VecXd& density, double threshold,
+                           double e_min) {
   VecXd scale(mesh.T.rows());
-  for (long t = 0; t < scale.size(); ++t) scale[t] = density[t] >= threshold ? 1.0 : e_min;
+  std::vector<char> solid(mesh.T.rows());
+  for (long t = 0; t < scale.size(); ++t) solid[t] = density[t] >= threshold, scale[t] = solid[t] ? 1.0 : e_min;
+  const Eigen::MatrixXd loads = fem::make_loads(fem::kept_part(mesh, solid), material, cases);
   fem::SolverParams exact;
   exact.recycle_factor = false;
   fem::Elasticity fe(mesh, material, supports, exact);

@@ -16,10 +16,13 @@ VecXd pnorm_stress(ComplianceProblem& problem, const ResponseParams& params, Eig
 
 /// The largest von Mises stress (MPa) of the crisp design over the load cases: the tets with
 /// density >= threshold (non-design tets always) solid, the others void (stiffness e_min),
-/// analysed anew on the same mesh; the maximum is taken over the solid tets. density: #T
-/// (SimpResult::density); loads: (3*#V) by #cases.
+/// analysed anew on the same mesh; the maximum is taken over the solid tets. The loads are
+/// `cases` made on the solid tets and their boundary triangles only (fem::kept_part): a face
+/// load spreads over the part of its face the design keeps, a body load weighs the solid tets,
+/// and no force lands on nodes that only removed tets hold. density: #T
+/// (SimpResult::density); supports: on the whole mesh.
 double crisp_max_von_mises(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
-                           const Eigen::MatrixXd& loads, const VecXd& density, double threshold = 0.5,
+                           const std::vector<fem::LoadCase>& cases, const VecXd& density, double threshold = 0.5,
                            double e_min = 1e-9);
 
 }  // namespace topopt::simp

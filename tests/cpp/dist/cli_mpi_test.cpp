@@ -122,20 +122,21 @@ TEST(CliMpi, OtherCommandsAndSerialOnlySettingsAreRefusedOnTwoRanks) {
 }  // namespace
 
 TEST(CliMpi, AnErrorOnOneRankEndsEveryRankWithItsMessage) {
-  // rank 1 alone is started with the test fault (dist_run.cpp), which fails it after the mesh is
-  // distributed while rank 0 goes on into the solver's collective calls; `timeout` ends a hang
+  // rank 1 alone is started with the hidden test hook --test-fail-after-distribution (dist_run.h,
+  // ServeParams), which fails it after the mesh is distributed while rank 0 goes on into the
+  // solver's collective calls; `timeout` ends a hang
   const fs::path dir = make_job("fault");
   const std::string job = (dir / "job.json").string(), out = " --out-dir " + (dir / "two").string();
   const std::string launcher = "timeout -k 10 150 env " + std::string(TOPOPT_MPIRUN) + " -np 1 " + TOPOPT_CLI +
-                               " solve " + job + out + " : -np 1 env TOPOPT_DIST_TEST_FAULT=1";
+                               " solve " + job + out + " : -np 1";
   const auto t0 = std::chrono::steady_clock::now();
-  const CliResult r = run_cli("solve " + job + out, launcher);
+  const CliResult r = run_cli("solve " + job + out + " --test-fail-after-distribution", launcher);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_NE(r.code, 124) << "the ranks hung until timeout ended them:\n" << r.out;
   EXPECT_EQ(r.code, 3) << "the exit code of an internal error, from the failing rank\n" << r.out;
   EXPECT_LT(seconds, 120);
   EXPECT_NE(r.out.find("topopt solve (MPI rank 1): error ("), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("TOPOPT_DIST_TEST_FAULT=1 asks for, on rank 1 only"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--test-fail-after-distribution asks for, on rank 1 only"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("topopt solve (MPI rank 0)"), std::string::npos) << "rank 0 did not fail:\n" << r.out;
   EXPECT_FALSE(fs::exists(dir / "two" / "result.vtu")) << "no result from a failed run";
   fs::remove_all(dir);

@@ -210,6 +210,36 @@ TEST(Verification, TheCrispDesignIsLoadedOnlyWhereItKeepsTheLoadFace) {
   EXPECT_NEAR(v.ratio(), 1.0, 0.15) << "as built " << v.as_built.compliance << ", crisp " << v.crisp.compliance;
 }
 
+TEST(Verification, NamesTheLoadedOrSupportedFaceTheDesignRemoved) {
+  // a load on the box's top face z = 10, which neither the bar (up to z = 9) nor the end
+  // blocks (up to z = 8) reach: the design removed the material under it (keep_loaded_faces
+  // off), and the verification says so by face instead of failing deep in the loads
+  Fixture f = bar_fixture();
+  fem::LoadSpec top;
+  top.vector = {0, 0, -100};
+  top.faces = {6};
+  f.problem.load_cases = {{"top", {top}, 1.0}};
+  try {
+    verify_result(f.surface, f.mesh, f.density, 0.5, f.problem);
+    FAIL() << "a load on removed material was verified";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::FaceNotFound);
+    const std::string m = e.what();
+    EXPECT_NE(m.find("the design removed the material under the load on Face6 (load case \"top\")"), std::string::npos)
+        << m;
+    EXPECT_NE(m.find("keep_loaded_faces"), std::string::npos) << m;
+  }
+  f.problem.load_cases = bar_fixture().problem.load_cases;
+  f.problem.supports[0].faces = {3};  // y = 0: nothing of the design reaches it either
+  try {
+    verify_result(f.surface, f.mesh, f.density, 0.5, f.problem);
+    FAIL() << "a support on removed material was verified";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::FaceNotFound);
+    EXPECT_NE(std::string(e.what()).find("removed the material on the supported Face3"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Verification, RunsWithinItsBudgetOrSaysWhichStepRanOut) {
   const Fixture f = bar_fixture();
   VerificationParams params;

@@ -12,6 +12,7 @@
 #include "mesh/core/structured_box.h"
 #include "simp/density_filter.h"
 #include "simp/update.h"
+#include "testing/self_weight.h"
 
 namespace topopt::simp {
 namespace {
@@ -41,11 +42,7 @@ void check_gradient(SimpParams params, unsigned seed, const Eigen::Matrix3Xd& gr
   Case c = cantilever({6, 2, 2});
   params.solver.recycle_factor = false;  // every solve to machine precision
   // with self-weight the loads hold each case's full weight (as fem::make_loads gives it)
-  Eigen::MatrixXd loads = c.loads;
-  for (long k = 0; k < gravity.cols(); ++k) {
-    const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {gravity(0, k), gravity(1, k), gravity(2, k)}, 0, {}};
-    loads.col(k) += fem::make_loads(c.mesh, c.mat, {fem::LoadCase{"g", {weight}, 1}}).col(0);
-  }
+  const Eigen::MatrixXd loads = testing::with_self_weight(c.mesh, c.mat, c.loads, gravity);
   ComplianceProblem prob(c.mesh, c.mat, c.supports, loads, {1.0, 0.5}, params, {}, gravity);
   const int nd = static_cast<int>(prob.design().size());
   std::mt19937 rng(seed);

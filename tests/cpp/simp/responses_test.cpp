@@ -16,8 +16,10 @@
 
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
+#include "fem/kept_part.h"
 #include "mesh/core/structured_box.h"
 #include "testing/ccx_modes.h"
+#include "testing/self_weight.h"
 
 namespace topopt::simp {
 namespace {
@@ -29,6 +31,7 @@ struct Beam {
   fem::Material mat;
   fem::Supports supports;
   Eigen::MatrixXd loads;
+  std::vector<fem::LoadCase> cases;  ///< what loads were made from
 };
 
 Beam beam(std::array<int, 3> cells) {
@@ -41,7 +44,8 @@ Beam beam(std::array<int, 3> cells) {
   b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
   const fem::LoadSpec push{fem::LoadSpec::Kind::Force, {2}, {0, 0, -60}, 0, {}};
-  b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}});
+  b.cases = {fem::LoadCase{"a", {pull}, 1}, fem::LoadCase{"b", {push}, 1}};
+  b.loads = fem::make_loads(b.mesh, b.mat, b.cases);
   return b;
 }
 
@@ -51,51 +55,9 @@ DisplacementLimit tip_limit(const Beam& b, const std::array<double, 3>& directio
   return {"Face2", fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"gauge", {unit}, 1}}).col(0), limit};
 }
 
-/// The tets of `m` with keep[t], their nodes renumbered (unused ones dropped), the boundary
-/// triangles of `m` whose tet is kept with their face numbers; the faces the cut opens are free
-/// surface and get no triangles (nothing acts on them). domain as in `m`.
+/// The tets of `m` with keep[t] and their boundary triangles, nodes renumbered (fem::kept_part).
 TetMesh keep_tets(const TetMesh& m, const std::vector<bool>& keep) {
-  std::map<std::array<int, 3>, long> tet_of;  // a triangle of m's boundary -> its tet
-  for (long t = 0; t < m.T.rows(); ++t)
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<int, 3> f;
-      for (int a = 0, k = 0; a < 4; ++a)
-        if (a != skip) f[k++] = m.T(t, a);
-      std::sort(f.begin(), f.end());
-      tet_of[f] = t;
-    }
-  std::vector<int> node(m.V.rows(), -1);
-  std::vector<long> tets, tris;
-  for (long t = 0; t < m.T.rows(); ++t)
-    if (keep[t]) tets.push_back(t);
-  for (long f = 0; f < m.F.rows(); ++f) {
-    std::array<int, 3> k{m.F(f, 0), m.F(f, 1), m.F(f, 2)};
-    std::sort(k.begin(), k.end());
-    if (keep[tet_of.at(k)]) tris.push_back(f);
-  }
-  TetMesh out;
-  int nv = 0;
-  out.T.resize(static_cast<long>(tets.size()), 4);
-  out.domain.resize(out.T.rows());
-  for (long i = 0; i < out.T.rows(); ++i) {
-    for (int a = 0; a < 4; ++a) {
-      int& n = node[m.T(tets[i], a)];
-      if (n < 0) n = nv++;
-      out.T(i, a) = n;
-    }
-    out.domain[i] = m.domain[tets[i]];
-  }
-  out.V.resize(nv, 3);
-  for (long v = 0; v < m.V.rows(); ++v)
-    if (node[v] >= 0) out.V.row(node[v]) = m.V.row(v);
-  out.F.resize(static_cast<long>(tris.size()), 3);
-  out.face.resize(out.F.rows());
-  out.nd_face = VecXi::Zero(out.F.rows());
-  for (long i = 0; i < out.F.rows(); ++i) {
-    for (int a = 0; a < 3; ++a) out.F(i, a) = node[m.F(tris[i], a)];
-    out.face[i] = m.face[tris[i]];
-  }
-  return out;
+  return fem::kept_part(m, std::vector<char>(keep.begin(), keep.end()), fem::KeptNodes::Compact);
 }
 
 /// A 20 × 20 × 2 mm L (the square with its corner x > 8, y > 8 cut away), held at the top of
@@ -118,7 +80,8 @@ Beam l_bracket() {
   b.mesh = keep_tets(box, keep);
   b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {4})});
   const fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -200, 0}, 0, {}};
-  b.loads = fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"down", {pull}, 1}});
+  b.cases = {fem::LoadCase{"down", {pull}, 1}};
+  b.loads = fem::make_loads(b.mesh, b.mat, b.cases);
   return b;
 }
 
@@ -174,11 +137,7 @@ bool one_piece_holds(const TetMesh& mesh, const VecXd& density, int num_pads, co
 void check_displacement_gradient(SimpParams params, unsigned seed, const Eigen::Matrix3Xd& gravity = {}) {
   Beam b = beam({6, 2, 2});
   params.solver.recycle_factor = false;  // every solve to machine precision
-  Eigen::MatrixXd loads = b.loads;
-  for (long k = 0; k < gravity.cols(); ++k) {
-    const fem::LoadSpec weight{fem::LoadSpec::Kind::Gravity, {}, {gravity(0, k), gravity(1, k), gravity(2, k)}, 0, {}};
-    loads.col(k) += fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"g", {weight}, 1}}).col(0);
-  }
+  const Eigen::MatrixXd loads = testing::with_self_weight(b.mesh, b.mat, b.loads, gravity);
   ComplianceProblem prob(b.mesh, b.mat, b.supports, loads, {}, params, {}, gravity);
   const DisplacementLimit gauge = tip_limit(b, {0, 0.6, -0.8}, 1);
   const int nd = static_cast<int>(prob.design().size());
@@ -288,15 +247,11 @@ TEST(Responses, StressGradientMatchesFiniteDifferences) {
     p.responses.stress_limit = 50;
     p.responses.stress_pnorm = 6;
     Eigen::Matrix3Xd g;
-    Eigen::MatrixXd loads = b.loads;
     if (gravity) {
       g.resize(3, 2);
       g << 0, 3e8, -1e9, 0, 0, 5e8;
-      for (long k = 0; k < 2; ++k) {
-        const fem::LoadSpec w{fem::LoadSpec::Kind::Gravity, {}, {g(0, k), g(1, k), g(2, k)}, 0, {}};
-        loads.col(k) += fem::make_loads(b.mesh, b.mat, {fem::LoadCase{"g", {w}, 1}}).col(0);
-      }
     }
+    const Eigen::MatrixXd loads = testing::with_self_weight(b.mesh, b.mat, b.loads, g);
     ComplianceProblem prob(b.mesh, b.mat, b.supports, loads, {}, p, {}, g);
     const int nd = static_cast<int>(prob.design().size());
     std::mt19937 rng(21);
@@ -335,8 +290,9 @@ TEST(Responses, MassUnderAStressLimitKeepsTheCrispDesignsStressWithinIt) {
   // well below full, and its crisp version (solid or void, analysed anew) must hold the limit
   Beam b = beam({16, 6, 2});
   b.loads = b.loads.col(0).eval();  // the downward pull alone
+  b.cases.resize(1);
   const VecXd full = VecXd::Ones(b.mesh.T.rows());
-  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, full);
+  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.cases, full);
   SimpParams p;
   p.filter.radius = 4;
   p.update = UpdateKind::MMA;
@@ -345,8 +301,9 @@ TEST(Responses, MassUnderAStressLimitKeepsTheCrispDesignsStressWithinIt) {
   p.volume_fraction = 0.8;
   p.responses.objective = Objective::Mass;
   p.responses.stress_limit = 2 * solid;
+  p.responses.load_cases = b.cases;
   const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, r.density);
+  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.cases, r.density);
   EXPECT_LE(crisp, 1.05 * p.responses.stress_limit) << "solid block " << solid << " MPa";
   EXPECT_LT(r.history.back().volume_fraction, 0.7);
   EXPECT_GT(r.history.back().stress_relaxed, 0);
@@ -357,12 +314,52 @@ TEST(Responses, MassUnderAStressLimitKeepsTheCrispDesignsStressWithinIt) {
   // beam (filter radius 4 over 2 mm cells, β stopped at 8) it is not; the L bracket's is.
 }
 
+TEST(Responses, CrispStressLoadsOnlyTheMaterialTheDesignKeeps) {
+  // a bare beam (no load pad) whose crisp design removed the upper half of the loaded end face:
+  // the tip force must act on the lower half that is left, as on the crisp part analysed alone.
+  // Made on the whole mesh, part of it landed on nodes of removed tets only, held by e_min.
+  mesh::StructuredBoxParams box;
+  box.size = {30, 10, 5};
+  box.cells = {15, 5, 3};
+  const TetMesh mesh = mesh::structured_box_mesh(box);
+  const fem::Material mat;
+  const std::vector<fem::SupportSpec> held{fem::support_on(fem::SupportSpec::Kind::Fixed, {1})};
+  const std::vector<fem::LoadCase> cases{
+      fem::LoadCase{"down", {fem::LoadSpec{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}}}, 1}};
+  VecXd density = VecXd::Ones(mesh.T.rows());
+  std::vector<char> kept(mesh.T.rows(), 1);
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+    for (int a = 0; a < 4; ++a) c += mesh.V.row(mesh.T(t, a)) / 4;
+    if (c.x() > 24 && c.y() > 5) density[t] = 0.1, kept[t] = 0;
+  }
+  const double crisp = crisp_max_von_mises(mesh, mat, fem::make_supports(mesh, held), cases, density);
+  const TetMesh part = fem::kept_part(mesh, kept, fem::KeptNodes::Compact);
+  fem::Elasticity alone(part, mat, fem::make_supports(part, held));
+  const Eigen::MatrixXd u = alone.solve(fem::make_loads(part, mat, cases));
+  const double expected = alone.von_mises(u.col(0)).maxCoeff();
+  EXPECT_NEAR(crisp, expected, 1e-3 * expected);
+  // the whole mesh's loads put a share of the force on removed material: a different stress
+  const double on_all = [&]() {
+    fem::Elasticity fe(mesh, mat, fem::make_supports(mesh, held));
+    VecXd scale(mesh.T.rows());
+    for (long t = 0; t < mesh.T.rows(); ++t) scale[t] = kept[t] ? 1.0 : 1e-9;
+    fe.set_scale(scale);
+    const VecXd vm = fe.solid_von_mises(fe.solve(fem::make_loads(mesh, mat, cases)).col(0));
+    double top = 0;
+    for (long t = 0; t < mesh.T.rows(); ++t)
+      if (kept[t]) top = std::max(top, vm[t]);
+    return top;
+  }();
+  EXPECT_GT(std::abs(on_all - expected), 0.05 * expected) << "the old loads give " << on_all << " MPa";
+}
+
 TEST(Responses, StressLimitRoundsTheReentrantCornerOfAnLBracket) {
   // the lightest L under a stress limit, and the stiffest L of the same volume: the first must
   // keep the limit on its crisp design and carry less stress than the second, whose re-entrant
   // corner stays sharp
   const Beam b = l_bracket();
-  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, VecXd::Ones(b.mesh.T.rows()));
+  const double solid = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.cases, VecXd::Ones(b.mesh.T.rows()));
   SimpParams p;
   p.filter.radius = 1.5;
   p.update = UpdateKind::MMA;
@@ -370,8 +367,9 @@ TEST(Responses, StressLimitRoundsTheReentrantCornerOfAnLBracket) {
   p.volume_fraction = 0.8;
   p.responses.objective = Objective::Mass;
   p.responses.stress_limit = 1.2 * solid;
+  p.responses.load_cases = b.cases;
   const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, r.density);
+  const double crisp = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.cases, r.density);
   const double volume = r.history.back().volume_fraction;
   EXPECT_LE(crisp, 1.1 * p.responses.stress_limit) << "solid L " << solid << " MPa";
   EXPECT_GT(volume, 0.2);
@@ -382,7 +380,7 @@ TEST(Responses, StressLimitRoundsTheReentrantCornerOfAnLBracket) {
   stiff.volume_fraction = volume;
   stiff.max_iterations = 250;
   const SimpResult c = optimize(b.mesh, b.mat, b.supports, b.loads, {}, stiff);
-  const double corner = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.loads, c.density);
+  const double corner = crisp_max_von_mises(b.mesh, b.mat, b.supports, b.cases, c.density);
   EXPECT_LT(crisp, corner) << "the compliance design of volume " << c.history.back().volume_fraction;
   std::cout << "L bracket: solid " << solid << " MPa, limit " << p.responses.stress_limit << " MPa, stress design "
             << crisp << " MPa at volume " << volume << " (" << r.history.size() << " iterations), compliance design "

@@ -33,8 +33,9 @@ def box_study(name="Box", iterations=6, mesh_size=4.0, load_face="Face2"):
 
 def top_loaded_box_study(name):
     """box_study's box fixed at x = 0 (Face1) but pressed down on its top (Face6, 100 N), 10
-    iterations at 3 mm: both faces stay on the result, as the verification needs (a tip load
-    on the end face Face2 does not: the design leaves that face). Returns (doc, study)."""
+    iterations at 3 mm: both faces stay on the result, as the verification needs (since
+    optimization.keep_loaded_faces, on by default, a tip load on the end face Face2 keeps its
+    face too; without it the design left that face). Returns (doc, study)."""
     return box_study(name, iterations=10, mesh_size=3.0, load_face="Face6")
 
 

@@ -89,6 +89,38 @@ class ResultAsBuilt(unittest.TestCase):
         self.assertEqual(cells["s"].tolist(), [1.5, 2.5])
         self.assertEqual(results.nodal_maximum(t, cells["s"], 5).tolist(), [1.5, 2.5, 2.5, 2.5, 2.5])
 
+    def test_z_the_solid_and_the_step_follow_the_threshold(self):
+        # the slider's threshold (study.Threshold after a re-extraction), not the run's, makes
+        # Result as solid and Export STEP; back at the run's, they are result.step's again
+        from topopt.app import runner
+        run = self.study.RunThreshold
+        self.assertAlmostEqual(run, self.study.Threshold)
+        at_run = api.result_solid(self.study).Shape.Volume
+        higher = round(min(0.9, run + 0.25), 2)
+        runner.reextract(self.study, higher)
+        self.assertAlmostEqual(self.study.Threshold, higher)
+        self.assertAlmostEqual(self.study.RunThreshold, run)  # the run's is kept
+        shown = self.study.Result.Mesh.Volume
+        solid = api.result_solid(self.study).Shape
+        self.assertEqual(len(solid.Solids), 1)
+        self.assertTrue(solid.isValid())
+        self.assertLess(abs(solid.Volume - shown) / shown, 0.005)
+        self.assertLess(solid.Volume, 0.97 * at_run)
+        path = api.export_step(self.study, os.path.join(self.folder, "higher.step"))
+        read = Part.read(path)
+        self.assertEqual(len(read.Solids), 1)
+        self.assertLess(abs(read.Volume - shown) / shown, 0.005)
+        # an explicit threshold other than the shown one: extracted anew, the document's result unchanged
+        lower = round(max(0.1, run - 0.2), 2)
+        below = api.result_solid(self.study, threshold=lower).Shape.Volume
+        self.assertGreater(below, at_run * 1.01)
+        self.assertAlmostEqual(self.study.Threshold, higher)
+        back = api.result_solid(self.study, threshold=run).Shape.Volume
+        self.assertAlmostEqual(back, at_run, delta=1e-6 * at_run)
+        with self.assertRaises(TopOptError) as e:
+            api.result_solid(self.study, threshold=1.5)
+        self.assertIn("strictly between 0 and 1", str(e.exception))
+
     def test_zz_rerun_without_the_files_removes_what_they_made_and_refuses(self):
         api.result_solid(self.study)
         self.study.WriteStep = False

@@ -172,6 +172,46 @@ class ResultAsCad(unittest.TestCase):
                          "TopOpt result as solid")
         screenshot("result_solid.png")
 
+    def test_z_the_solid_follows_the_threshold_slider(self):
+        # the slider moved in the study's panel re-extracts the shown result; Result as solid then
+        # makes the solid at that threshold (its volume the shown result's), not the run's
+        run = self.study.RunThreshold
+        self._select()
+        FreeCADGui.runCommand("TopOpt_ResultAsSolid")
+        settle()
+        at_run = self.study.ResultSolid.Shape.Volume
+        panel = panels.open_study_panel(self.study)
+        settle()
+        try:
+            higher = int(round(100 * min(0.9, run + 0.25)))
+            panel.threshold.setValue(higher)
+            panel.reextract()
+            settle()
+            self.assertAlmostEqual(self.study.Threshold, higher / 100.0)
+            self.assertIn("%.2f: keeps" % (higher / 100.0), panel.threshold_label.text())
+            self.study.Result.ViewObject.Visibility = True
+            self.study.ResultSolid.ViewObject.Visibility = False
+            screenshot("slider_moved.png")
+            self._select()
+            FreeCADGui.runCommand("TopOpt_ResultAsSolid")
+            settle()
+            solid = self.study.ResultSolid
+            shown = self.study.Result.Mesh.Volume
+            self.assertLess(abs(solid.Shape.Volume - shown) / shown, 0.005)
+            self.assertLess(solid.Shape.Volume, 0.97 * at_run)
+            FreeCAD.Console.PrintMessage("TopOpt test: solid at the run's threshold %.2f: %.1f mm³, at the slider's "
+                                         "%.2f: %.1f mm³ (shown mesh %.1f mm³)\n"
+                                         % (run, at_run, higher / 100.0, solid.Shape.Volume, shown))
+            screenshot("solid_follows_slider.png")
+        finally:
+            if panel.is_open():
+                panel.reject()
+            settle()
+
+    def _select(self):
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(self.study)
+
     def test_verification_von_mises_in_fem_post_processing(self):
         from topopt.app import asbuilt
         pipe, res = self.study.VerificationFields, self.study.VerificationResult
