@@ -1,9 +1,8 @@
 """The whole user flow on the rocker in a real FreeCAD window (under Xvfb), as a FreeCAD user
 goes through it: import the STEP files, pick the part and the rings, New study, supports and
 loads with explicit directions (TopOpt's force panel), Mesh, Run, Stop, Run again, the
-threshold slider with undo, save, reopen. Screenshots of every step go to
-TOPOPT_SCREENSHOTS (default /tmp/topopt-screenshots/rocker) for a person to look at.
-(Result as solid and Export STEP come with issue 19 and are not part of this flow yet.)
+threshold slider with undo, Result as solid, Export STEP, save, reopen. Screenshots of every
+step go to TOPOPT_SCREENSHOTS (default /tmp/topopt-screenshots/rocker) for a person to look at.
 
 The rocker's load case (shared data README): the bore at (0, 0) (Face10) fixed, 1000 N in -Y
 on the bore at (80, 10) (Face9), 600 N in +X on the bore at (40, 55) (Face11)."""
@@ -83,6 +82,7 @@ class RockerFlow(unittest.TestCase):
         panel = self.step_run_stop_run(study)
         self.step_results(study)
         self.step_slider_and_undo(study, panel)
+        self.step_result_as_cad(study)
         self.step_save_and_reopen(doc, study)
 
     # --- the steps, in order ------------------------------------------------------------------
@@ -276,6 +276,35 @@ class RockerFlow(unittest.TestCase):
         self.assertAlmostEqual(study.Result.Mesh.Volume, volume, delta=1e-6 * volume)
         doc.redo()
         self.assertAlmostEqual(study.Threshold, 0.25)
+
+    def step_result_as_cad(self, study):
+        """Back at the run's threshold, the toolbar's Result as solid gives one valid solid of
+        the result mesh's volume, and Export STEP writes a file OCCT reads back as that solid."""
+        import Part
+        from topopt.app import api
+        doc = study.Document
+        doc.undo()  # the slider back at the run's threshold
+        settle()
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(study)
+        FreeCADGui.runCommand("TopOpt_ResultAsSolid")
+        settle()
+        solid = study.ResultSolid
+        self.assertIsNotNone(solid, report_text()[-2000:])
+        self.assertTrue(solid.Shape.isValid())
+        self.assertEqual(len(solid.Shape.Solids), 1)
+        volume = study.Result.Mesh.Volume
+        self.assertAlmostEqual(solid.Shape.Volume, volume, delta=0.005 * volume)
+        for o in doc.Objects:
+            if o.ViewObject is not None and o is not solid:
+                o.Visibility = False
+        fit()
+        screenshot("15_result_as_solid")
+        path = api.export_step(study, os.path.join(TMP, "rocker_result.step"))
+        back = Part.read(path)
+        self.assertTrue(back.isValid())
+        self.assertAlmostEqual(back.Volume, volume, delta=0.005 * volume)
+        solid.Visibility = False
 
     def step_save_and_reopen(self, doc, study):
         path = os.path.join(TMP, "rocker_study.FCStd")
