@@ -3,8 +3,9 @@
 of ../shared/data/README.md, steel, volume fraction 0.3) through `topopt optimize`, once free
 and once with each geometry control (docs/optimization.md, "controls"). For each run: tets,
 iterations, final compliance (SIMP's, on the tet mesh), SIMP wall time, whole-command wall
-time, all with OMP_NUM_THREADS=1 and one run after another in this one script; and a picture of
-the result surface (result.stl, rendered with matplotlib) in the work folder.
+time, all with OMP_NUM_THREADS=1 and one run after another in this one script; the overhang
+share of the result surface built along +x and +y (45°); and a picture of the result surface
+(result.stl, rendered with matplotlib) in the work folder.
 
 usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
                              [--controls free,draw]  (labels containing one of these words)
@@ -34,6 +35,9 @@ def controls_for(name, box):
            "extrusion along y": {"extrusion": [0, 1, 0]}}
     if name == "cantilever":
         out["pattern x (3 x 18 mm)"] = {"patterns": [{"direction": [1, 0, 0], "pitch": 18, "count": 3}]}
+    if name == "cantilever":  # upright on its fixed end (Face1, x = 0), and on its side (y = 0)
+        out["overhang upright (build +x from Face1)"] = {"overhang": {"direction": [1, 0, 0], "base_face": "Face1"}}
+        out["overhang on its side (build +y)"] = {"overhang": {"direction": [0, 1, 0]}}
     out["draw z one-sided"] = {"draw_direction": {"direction": [0, 0, 1]}}
     out["draw z split at mid-height"] = {"draw_direction": {"direction": [0, 0, 1], "parting_point": mid}}
     return out
@@ -45,6 +49,24 @@ def step_box(path):
     pts = re.findall(r"CARTESIAN_POINT\s*\(\s*'[^']*'\s*,\s*\(([^)]*)\)", open(path).read())
     xyz = np.array([[float(v) for v in p.split(",")] for p in pts if p.count(",") == 2])
     return xyz.min(0).tolist(), xyz.max(0).tolist()
+
+
+BUILDS = {"+x": np.array([1.0, 0, 0]), "+y": np.array([0, 1.0, 0])}  # the overhang shares reported
+
+
+def overhang_share(stl, up, angle=45.0, tol=1e-3):
+    """Share of the surface's downward-facing area (normal n with n·up < 0, off the base plate
+    at the lowest point along up) whose normal lies within `angle` of −up: too flat to print
+    without supports (the measure of simp/controls/overhang_measure.h)."""
+    tris = benchlib.read_stl(stl)
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    area = np.linalg.norm(n, axis=1) / 2
+    s = tris @ up
+    plate = s.min()
+    on_plate = (s.min(1) >= plate - tol) & (s.max(1) <= plate + tol)
+    down = (n @ up < 0) & ~on_plate & (area > 0)
+    flat = down & (-(n @ up) > np.cos(np.radians(angle)) * 2 * area)
+    return area[flat].sum() / max(area[down].sum(), 1e-30)
 
 
 def run(cmd):
@@ -72,8 +94,9 @@ def main():
         return
     os.makedirs(a.work, exist_ok=True)
     topopt = os.path.join(a.build, "topopt")
-    print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP (s) | command (s) | picture |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP (s) | command (s) | "
+          "overhang share, build +x / +y | picture |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name, (size, case) in EXAMPLES.items():
         if a.only and name != a.only:
             continue
@@ -105,9 +128,11 @@ def main():
             nvar = re.search(r"(\d+) variables for", p.stdout + p.stderr)
             png = out + ".png"
             benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
-            print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f | %s |" % (
+            stl = os.path.join(out, "result.stl")
+            shares = " / ".join("%.1f %%" % (100 * overhang_share(stl, up)) for up in BUILDS.values())
+            print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f | %s | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
-                "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, os.path.basename(png)))
+                "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, shares, os.path.basename(png)))
             sys.stdout.flush()
 
 

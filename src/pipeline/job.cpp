@@ -226,6 +226,8 @@ void check_faces(const Job& job, int num_faces, int num_nondesign_faces) {
     check(job.supports[i].faces, job.supports[i].nd_faces, "support " + std::to_string(i + 1));
   for (const auto& lc : job.load_cases)
     for (const auto& l : lc.items) check(l.faces, l.nd_faces, "load case \"" + lc.name + "\"");
+  if (const int base = job.optimization.simp.controls.overhang.base_face; base > 0)
+    check({base}, {}, "optimization.controls.overhang.base_face");
 }
 
 void require_supports_and_loads(const Job& job) {

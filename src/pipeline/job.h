@@ -82,7 +82,7 @@ Job read_job(const std::string& path);
 /// current folder).
 Job parse_job(const std::string& text, const std::string& base_dir);
 
-/// Throws Error(FaceNotFound) if a support or load names a face above `num_faces` (the
+/// Throws Error(FaceNotFound) if a support, load or the overhang's base face names a face above `num_faces` (the
 /// part's face count), or a non-design face above `num_nondesign_faces` (skipped if < 0).
 void check_faces(const Job& job, int num_faces, int num_nondesign_faces);
 

@@ -172,13 +172,46 @@ void parse_draw_direction(const Fields& controls, simp::DrawDirection& d) {
     f.bad("smoothness", "must lie in (0, 0.01] (the ε of the smooth maximum along the columns; 1e-4 is usual)");
 }
 
+/// "controls"."overhang": {"direction": [x, y, z], "angle": degrees, "base_face": "FaceN",
+/// "cell": mm, "exponent", "xi0", "smoothness"} (docs/optimization.md).
+void parse_overhang(const Fields& controls, simp::OverhangControl& o) {
+  if (!controls.has("overhang")) return;
+  const Fields f(controls.at("overhang"), controls.name("overhang"),
+                 {"direction", "angle", "base_face", "cell", "exponent", "xi0", "smoothness"},
+                 "{\"direction\": [0, 0, 1], \"angle\": 45, \"base_face\": \"Face5\"}");
+  o.enabled = true;
+  o.direction = vector3(f, "direction");
+  o.angle = f.number("angle", o.angle);
+  if (!(o.angle >= 10 && o.angle <= 80))
+    f.bad("angle",
+          "must lie in [10, 80] degrees: the smallest angle to the base plate that prints without "
+          "supports (45 is usual)");
+  if (f.has("base_face")) {
+    std::vector<int> faces, nondesign;
+    if (!f.at("base_face").is_string()) f.bad("base_face", "must be a face name such as \"Face5\"");
+    parse_face_name(f.at("base_face").get<std::string>(), faces, nondesign);
+    if (faces.empty()) f.bad("base_face", "must be a face of the part (\"Face5\"), not of a non-design solid");
+    o.base_face = faces[0];
+  }
+  o.cell = f.number("cell", 0);
+  if (o.cell < 0) f.bad("cell", "must be positive (mm, the overhang lattice's spacing), or 0 for the tolerance");
+  o.exponent = f.number("exponent", o.exponent);
+  o.xi0 = f.number("xi0", o.xi0);
+  if (!(o.xi0 > 0 && o.xi0 < 1)) f.bad("xi0", "must lie in (0, 1) (0.5 is usual)");
+  if (!(o.exponent + std::log(5.0) / std::log(o.xi0) >= 1))
+    f.bad("exponent", "must exceed 1 + ln 5 / ln(1/xi0) (40 is usual with xi0 = 0.5)");
+  o.smoothness = f.number("smoothness", o.smoothness);
+  if (!(o.smoothness > 0 && o.smoothness <= 0.01))
+    f.bad("smoothness", "must lie in (0, 0.01] (the ε of the smooth minimum; 1e-4 is usual)");
+}
+
 /// "controls": {"symmetry_planes": [{"point", "normal"}], "cyclic": [{"point", "axis",
 /// "sectors"}], "patterns": [{"direction", "pitch", "count"}], "extrusion": [x, y, z],
-/// "draw_direction": {...}, "tolerance"} (docs/optimization.md).
+/// "draw_direction": {...}, "overhang": {...}, "tolerance"} (docs/optimization.md).
 void parse_controls(const Fields& opt, simp::ControlsParams& c) {
   if (!opt.has("controls")) return;
   const Fields f(opt.at("controls"), opt.name("controls"),
-                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "draw_direction", "tolerance"},
+                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "draw_direction", "overhang", "tolerance"},
                  "{\"symmetry_planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0]}]}");
   each_item(
       f, "symmetry_planes",
@@ -203,6 +236,7 @@ void parse_controls(const Fields& opt, simp::ControlsParams& c) {
       {"direction", "pitch", "count"}, "{\"direction\": [1, 0, 0], \"pitch\": 20, \"count\": 3}");
   if (f.has("extrusion")) c.extrude = true, c.extrusion = vector3(f, "extrusion");
   parse_draw_direction(f, c.draw);
+  parse_overhang(f, c.overhang);
   c.tolerance = f.number("tolerance", 0);
   if (c.tolerance < 0) f.bad("tolerance", "must be positive (mm), or 0 for the mean edge length");
 }

@@ -9,6 +9,7 @@
 #include "common/error.h"
 #include "simp/controls/design_map.h"
 #include "simp/controls/draw_filter.h"
+#include "simp/controls/overhang_filter.h"
 #include "simp/density_filter.h"
 #include "simp/responses/responses.h"
 #include "simp/update.h"
@@ -28,9 +29,10 @@ void check_params(const SimpParams& params) {
                 "the projection needs 1 <= beta_start <= beta_max, a factor above 1, at least one iteration per "
                 "beta and a threshold eta in (0, 1)");
   if (params.sensitivity_filter && params.controls.any())
-    throw Error(ErrorCode::InvalidParameter,
-                "the geometry controls (symmetry, cyclic, pattern, extrusion, draw direction) work with the density "
-                "filter: turn the sensitivity filter off");
+    throw Error(
+        ErrorCode::InvalidParameter,
+        "the geometry controls (symmetry, cyclic, pattern, extrusion, draw direction, overhang) work with the density "
+        "filter: turn the sensitivity filter off");
 }
 
 void check_volume_fraction(double volume_fraction, const std::string& name) {
@@ -71,6 +73,11 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
     draw_ = std::make_unique<DrawFilter>(design_centroids(mesh, design_), vd_, params.controls.draw, cell);
     progress.info("controls: " + draw_->describe());
   }
+  if (params.controls.overhang.enabled) {
+    const double cell = params.controls.overhang.cell > 0 ? params.controls.overhang.cell : tolerance;
+    overhang_ = std::make_unique<OverhangFilter>(mesh, design_, params.controls.overhang, cell);
+    progress.info("controls: " + overhang_->describe());
+  }
   // self-weight: loads holds every tet's full weight; a design tet's share scales with ρ̄
   if (gravity.size() && !gravity.isZero()) {
     if (gravity.cols() != loads.cols())
@@ -81,7 +88,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   }
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
-  if (!params.projection.enabled && !draw_)
+  if (!params.projection.enabled && !draw_ && !overhang_)
     volume_weights_ =
         controls_->apply_transpose(params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
 }
@@ -92,6 +99,7 @@ void ComplianceProblem::forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_
   const VecXd z = controls_->apply(x);
   rho_filtered = params_.sensitivity_filter ? z : filter_->apply(z);
   rho_tilde = draw_ ? draw_->apply(rho_filtered) : rho_filtered;
+  if (overhang_) rho_tilde = overhang_->apply(rho_tilde);
   rho_bar = rho_tilde;
   if (params_.projection.enabled)
     for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
@@ -136,6 +144,7 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
 VecXd ComplianceProblem::chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const {
   if (params_.projection.enabled)
     for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= proj_.derivative(rho_tilde[i]);
+  if (overhang_) d_bar = overhang_->apply_transpose(draw_ ? draw_->apply(rho_filtered) : rho_filtered, d_bar);
   if (draw_) d_bar = draw_->apply_transpose(rho_filtered, d_bar);
   return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
 }

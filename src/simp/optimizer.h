@@ -72,6 +72,7 @@ struct SimpResult {
 /// filter, projection and FE model are built once; evaluate() runs one FE analysis.
 class DesignMap;
 class DrawFilter;
+class OverhangFilter;
 
 class ComplianceProblem {
  public:
@@ -124,7 +125,8 @@ class ComplianceProblem {
   double design_volume_ = 0;
   std::unique_ptr<DesignMap> controls_;  // x → z, before the filter
   std::unique_ptr<Filter> filter_;
-  std::unique_ptr<DrawFilter> draw_;  // draw direction: after the filter, before the projection
+  std::unique_ptr<DrawFilter> draw_;          // draw direction: after the filter, before the projection
+  std::unique_ptr<OverhangFilter> overhang_;  // overhang: after the draw direction, before the projection
   std::unique_ptr<fem::Elasticity> fe_;
   Eigen::MatrixXd loads_;     // as given: with every tet's full weight
   Eigen::Matrix3Xd gravity_;  // 3 x #cases, empty without self-weight
@@ -135,7 +137,7 @@ class ComplianceProblem {
   VecXd scale_;
   Eigen::MatrixXd U_;   // displacements of the last compliance() call
   VecXd rho_filtered_;  // #D: its filtered densities
-  VecXd rho_tilde_;     // #D: the same through the draw direction (rho_filtered_ without it)
+  VecXd rho_tilde_;     // #D: the same through the draw direction and overhang (rho_filtered_ without them)
   VecXd rho_bar_;       // #D: its physical densities
   VecXd chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const;
   void forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde, VecXd& rho_bar) const;

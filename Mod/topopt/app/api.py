@@ -230,16 +230,34 @@ def _whole(value, name, low, high):
     return int(x)
 
 
+def _overhang(direction, angle, base_face, cell):
+    """The job's "overhang" dict of set_controls' arguments (checked there)."""
+    o = {"direction": _vector(direction, "build_direction"),
+         "angle": checks.in_range(angle, "overhang_angle", 10, 80)}
+    if base_face is not None:
+        name = "Face%d" % _whole(base_face, "base_face", 1, 1e9) if not isinstance(base_face, str) else base_face
+        o["base_face"] = name
+    if checks.in_range(cell, "overhang_cell", 0, None) > 0:
+        o["cell"] = float(cell)
+    return o
+
+
 def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=None, tolerance=0.0,
-                 draw_direction=None, parting_point=None, draw_cell=0.0):
+                 draw_direction=None, parting_point=None, draw_cell=0.0, build_direction=None,
+                 overhang_angle=45.0, base_face=None, overhang_cell=0.0):
     """Sets the study's geometry controls (docs/optimization.md, "controls"); called without
     arguments it clears them. symmetry_planes: [(point, normal), ...]; cyclic: [(point, axis,
     sectors), ...]; patterns: [(direction, pitch mm, count), ...]; extrusion: a direction or
     None; tolerance: mm, 0 = the mesh's mean edge length. draw_direction: the direction a
     casting die is drawn in, or None; parting_point: with it, a point of the parting plane
     (split casting: two dies drawn apart along ±draw_direction), None for one-sided casting;
-    draw_cell: mm, the draw grid's cell side (0: the tolerance). Vectors are [x, y, z] in model
-    axes. Returns the controls as the job's dict. Raises TopOptError naming the argument."""
+    draw_cell: mm, the draw grid's cell side (0: the tolerance). build_direction: the direction
+    an additive process builds the part in (from the base plate up), or None: with it the design
+    prints without supports at overhang_angle (degrees from the plate, [10, 80], 45 usual) on the
+    base plate base_face ("Face5" or 5, a flat face of the part facing against the direction;
+    None: the plate touches the part's lowest point), overhang_cell: mm, the overhang lattice's
+    spacing (0: the tolerance). Vectors are [x, y, z] in model axes. Returns the controls as the
+    job's dict. Raises TopOptError naming the argument."""
     c = {}
     if symmetry_planes:
         c["symmetry_planes"] = [{"point": _vector(p, "symmetry plane %d point" % (i + 1)),
@@ -265,6 +283,11 @@ def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=No
         c["draw_direction"] = draw
     elif parting_point is not None:
         raise TopOptError("parting_point needs draw_direction: give the direction the dies are drawn in",
+                          "InvalidParameter")
+    if build_direction is not None:
+        c["overhang"] = _overhang(build_direction, overhang_angle, base_face, overhang_cell)
+    elif base_face is not None:
+        raise TopOptError("base_face needs build_direction: give the direction the part is built in",
                           "InvalidParameter")
     if checks.in_range(tolerance, "tolerance", 0, None) > 0:
         c["tolerance"] = float(tolerance)

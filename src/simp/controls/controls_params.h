@@ -1,6 +1,6 @@
 // The geometry controls of SIMP (issue 22): symmetry planes, cyclic and linear-pattern
 // repetition and extrusion, as options for DesignMap (design_map.h), and the draw direction
-// (draw_filter.h).
+// (draw_filter.h) and the overhang of additive manufacturing (overhang_filter.h).
 #pragma once
 #include <Eigen/Core>
 #include <vector>
@@ -48,6 +48,26 @@ struct DrawDirection {
   double smoothness = 1e-4;
 };
 
+/// Overhang control for additive manufacturing (Langelaar's AM filter, overhang_filter.h): the
+/// design prints without supports when built along `direction` from a base plate. A surface
+/// facing down is self-supporting when it rises at least `angle` from the base plate.
+struct OverhangControl {
+  bool enabled = false;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< build direction, plate upwards; not zero
+  /// degrees in [10, 80]: the smallest angle between a downward-facing surface and the base
+  /// plate that prints without supports (45 for most metal and polymer processes)
+  double angle = 45;
+  /// Ω's face (FreeCAD's FaceN number) the part stands on: flat, facing against `direction`.
+  /// 0: the base plate touches the lowest point of Ω along `direction`.
+  int base_face = 0;
+  /// mm: the lattice spacing across the build direction (layers are cell·tan(angle) apart);
+  /// <= 0: ControlsParams::tolerance resolved
+  double cell = 0;
+  double exponent = 40;      ///< P of the smooth maximum (Σ ξᵢ^P)^(1/Q) of the supports, >= 1
+  double xi0 = 0.5;          ///< ξ₀ in (0, 1): Q = P + ln 5 / ln ξ₀, exact when all 5 supports equal ξ₀
+  double smoothness = 1e-4;  ///< ε of the smooth minimum with the density; in (0, 0.01]
+};
+
 /// Geometry controls, combinable. Defaults: none.
 struct ControlsParams {
   std::vector<MirrorPlane> mirrors;      ///< several planes allowed
@@ -58,12 +78,13 @@ struct ControlsParams {
   /// mm: how far a mirrored/rotated/shifted centroid may lie from the design element that
   /// takes it, and the width of the extrusion's columns; <= 0: the mesh's mean edge length.
   double tolerance = 0;
-  DrawDirection draw;  ///< after the density filter, before the projection (draw_filter.h)
+  DrawDirection draw;        ///< after the density filter, before the projection (draw_filter.h)
+  OverhangControl overhang;  ///< after the draw direction, before the projection (overhang_filter.h)
 
   /// True when a control ties design elements (symmetry, repetition, extrusion: DesignMap).
   bool ties() const { return !mirrors.empty() || !cyclic.empty() || !patterns.empty() || extrude; }
   /// True when any control is set.
-  bool any() const { return ties() || draw.enabled; }
+  bool any() const { return ties() || draw.enabled || overhang.enabled; }
 };
 
 }  // namespace topopt::simp

@@ -70,5 +70,48 @@ TEST(JobControls, MistakesNameTheKeyAndWhatToGive) {
   }
 }
 
+TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
+  const Job job = parse_job(with_controls(R"({"overhang": {"direction": [1, 0, 0], "angle": 50, "base_face": "Face1",
+                                                           "cell": 2}})"),
+                            "/tmp");
+  const simp::OverhangControl& o = job.optimization.simp.controls.overhang;
+  EXPECT_TRUE(o.enabled);
+  EXPECT_TRUE(job.optimization.simp.controls.any());
+  EXPECT_EQ(o.direction, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(o.angle, 50);
+  EXPECT_EQ(o.base_face, 1);
+  EXPECT_EQ(o.cell, 2);
+  const simp::OverhangControl plain =
+      parse_job(with_controls(R"({"overhang": {"direction": [0, 0, 1]}})"), "/tmp").optimization.simp.controls.overhang;
+  EXPECT_EQ(plain.angle, 45);
+  EXPECT_EQ(plain.base_face, 0);
+  EXPECT_FALSE(parse_job("{}", "/tmp").optimization.simp.controls.overhang.enabled);
+  expect_refused(R"({"overhang": {"angle": 45}})", {"'optimization.controls.overhang.direction'"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 0]}})",
+                 {"'optimization.controls.overhang.direction'", "[0, 0, 0]"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angle": 5}})",
+                 {"'optimization.controls.overhang.angle'", "[10, 80] degrees"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "base_face": 3}})",
+                 {"'optimization.controls.overhang.base_face'", "\"Face5\""});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "base_face": "NonDesign:Face2"}})",
+                 {"'optimization.controls.overhang.base_face'", "not of a non-design solid"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "xi0": 1}})", {"'optimization.controls.overhang.xi0'"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "exponent": 2}})",
+                 {"'optimization.controls.overhang.exponent'"});
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angel": 40}})",
+                 {"'optimization.controls.overhang.angel'", "did you mean 'angle'?"});
+  const Job far = parse_job(with_controls(R"({"overhang": {"direction": [0, 0, 1], "base_face": "Face9"}})"), "/tmp");
+  try {
+    check_faces(far, 6, -1);
+    ADD_FAILURE() << "Face9 of a 6-face part accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::FaceNotFound);
+    EXPECT_NE(
+        std::string(e.what()).find("optimization.controls.overhang.base_face names Face9, but the part has only 6"),
+        std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace topopt::pipeline

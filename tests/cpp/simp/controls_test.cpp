@@ -161,6 +161,20 @@ TEST(Controls, DrawDirectionGradientsMatchFiniteDifferences) {
   check_gradient(p, 8);
 }
 
+TEST(Controls, OverhangGradientsMatchFiniteDifferences) {
+  SimpParams p;
+  p.projection.enabled = true;
+  p.projection.beta_start = 4;
+  p.controls.overhang.enabled = true;
+  p.controls.overhang.direction = {0, 0.3, 1};  // inclined: layers cut across the mesh's cells
+  p.controls.overhang.cell = 1.5;
+  check_gradient(p, 9);
+  p.controls.draw.enabled = true;  // combined with a draw direction across it
+  p.controls.draw.direction = {1, 0, 0};
+  p.controls.draw.cell = 2;
+  check_gradient(p, 10);
+}
+
 /// Rays along z through (x, y) on a grid of 56 × 18 over x in (0, 28), y in (-5, 5), the crisp
 /// design sampled every 0.05 mm inside the box. Returns the share of rays that cross the
 /// design's boundary more than `allowed` times and, in *undercut, the share that a die could

@@ -1,7 +1,8 @@
 """Geometry controls through the Python API: api.set_controls writes the study's
 GeometryControls, the job carries them as the "controls" object the core reads, bad arguments
 are refused naming the argument, and a run with a control (in the worker) uses it: a mirror
-plane that is no symmetry of the part is refused by the core naming the plane."""
+plane that is no symmetry of the part is refused by the core naming the plane, and so is a base
+plate face that does not face against the build direction."""
 import unittest
 
 import FreeCAD
@@ -34,6 +35,12 @@ class Controls(unittest.TestCase):
         api.set_controls(self.study, draw_direction=(0, 1, 0))  # one-sided: no parting plane
         c = api.job_of(self.study)["optimization"]["controls"]
         self.assertEqual(c["draw_direction"], {"direction": [0, 1, 0]})
+        api.set_controls(self.study, build_direction=(0, 0, 1), base_face="Face5", overhang_cell=2)
+        c = api.job_of(self.study)["optimization"]["controls"]
+        self.assertEqual(c["overhang"], {"direction": [0, 0, 1], "angle": 45, "base_face": "Face5", "cell": 2})
+        api.set_controls(self.study, build_direction=(1, 0, 0), overhang_angle=50, base_face=1)
+        c = api.job_of(self.study)["optimization"]["controls"]
+        self.assertEqual(c["overhang"], {"direction": [1, 0, 0], "angle": 50, "base_face": "Face1"})
         api.set_controls(self.study)  # cleared
         self.assertEqual(self.study.GeometryControls, "")
         self.assertNotIn("controls", api.job_of(self.study)["optimization"])
@@ -45,7 +52,12 @@ class Controls(unittest.TestCase):
                               (dict(extrusion=(1, 2)), "extrusion"),
                               (dict(draw_direction=(0, 0, 0)), "draw_direction"),
                               (dict(parting_point=(0, 0, 1)), "parting_point"),
-                              (dict(draw_direction=(0, 0, 1), draw_cell=-1), "draw_cell")]:
+                              (dict(draw_direction=(0, 0, 1), draw_cell=-1), "draw_cell"),
+                              (dict(build_direction=(0, 0, 0)), "build_direction"),
+                              (dict(build_direction=(0, 0, 1), overhang_angle=85), "overhang_angle"),
+                              (dict(build_direction=(0, 0, 1), base_face="Top"), "is not a face name"),
+                              (dict(base_face="Face5"), "base_face needs build_direction"),
+                              (dict(build_direction=(0, 0, 1), overhang_cell=-1), "overhang_cell")]:
             with self.assertRaises(api.TopOptError) as ctx:
                 api.set_controls(self.study, **kwargs)
             self.assertIn(words, str(ctx.exception))
@@ -63,6 +75,13 @@ class Controls(unittest.TestCase):
         result = api.run(self.study, verbose=False)
         self.assertGreater(result.Mesh.CountFacets, 0)
         api.set_controls(self.study, draw_direction=(0, 0, 1), parting_point=(0, 0, 5))
+        result = api.run(self.study, verbose=False)
+        self.assertGreater(result.Mesh.CountFacets, 0)
+        api.set_controls(self.study, build_direction=(0, 0, 1), base_face="Face6")  # the top: faces up, refused
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.run(self.study, verbose=False)
+        self.assertIn("Face6 is not a flat face facing against the build direction", str(ctx.exception))
+        api.set_controls(self.study, build_direction=(0, 0, 1), base_face="Face5")
         result = api.run(self.study, verbose=False)
         self.assertGreater(result.Mesh.CountFacets, 0)
 
