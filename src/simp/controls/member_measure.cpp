@@ -75,8 +75,8 @@ VecXd distance_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, d
 }
 
 /// The local thickness of each point: 2 max r_f over the balls (centre C_f, radius r_f) that
-/// hold it. Points sorted by x, so each ball visits the points within its x range only.
-VecXd local_thickness(const MatX3d& C, const VecXd& r) {
+/// hold it within `reach`. Points sorted by x, so each ball visits the points within its x range only.
+VecXd local_thickness(const MatX3d& C, const VecXd& r, double reach) {
   const long n = C.rows();
   std::vector<long> order(static_cast<size_t>(n));
   std::iota(order.begin(), order.end(), 0L);
@@ -85,10 +85,10 @@ VecXd local_thickness(const MatX3d& C, const VecXd& r) {
   for (long k = 0; k < n; ++k) xs[k] = C(order[k], 0);
   VecXd t = VecXd::Zero(n);
   for (long f = 0; f < n; ++f) {
-    auto k = std::lower_bound(xs.begin(), xs.end(), C(f, 0) - r[f]) - xs.begin();
-    for (; k < n && xs[k] <= C(f, 0) + r[f]; ++k) {
+    auto k = std::lower_bound(xs.begin(), xs.end(), C(f, 0) - r[f] - reach) - xs.begin();
+    for (; k < n && xs[k] <= C(f, 0) + r[f] + reach; ++k) {
       const long e = order[k];
-      if ((C.row(e) - C.row(f)).norm() <= r[f]) t[e] = std::max(t[e], 2 * r[f]);
+      if ((C.row(e) - C.row(f)).norm() <= r[f] + reach) t[e] = std::max(t[e], 2 * r[f]);
     }
   }
   return t;
@@ -109,7 +109,7 @@ MemberMeasure measure_members(const TetMesh& mesh, const VecXd& density, const M
   }
   const double diagonal = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
   const VecXd r = distance_to_triangles(mesh.V, solid_boundary(mesh, solid, params.part_boundary), C, diagonal);
-  const VecXd thick = local_thickness(C, r);
+  const VecXd thick = local_thickness(C, r, params.reach);
   MemberMeasure m;
   m.inscribed = VecXd::Zero(nt);
   m.thickness = VecXd::Zero(nt);

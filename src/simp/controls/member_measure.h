@@ -15,6 +15,10 @@ struct MemberMeasureParams {
   /// density filter is normalised over the part, so a member along the part's boundary is
   /// measured as if mirrored there, and the part's own corners are not the design's).
   bool part_boundary = false;
+  /// mm: a tet belongs to a ball when its centroid lies within the ball's radius plus this (half
+  /// the mesh size: a crisp design is a staircase of tets, and a tet in a staircase corner would
+  /// otherwise lie in no ball wider than its own centroid's distance to the corner).
+  double reach = 0;
 };
 
 /// Per tet and overall sizes (mm).
@@ -22,7 +26,7 @@ struct MemberMeasure {
   /// #T: the distance from the tet's centroid to the nearest boundary triangle of the solid
   /// (0 for void tets; the part's diagonal when the solid has no boundary of the kind asked).
   VecXd inscribed;
-  /// #T: the local thickness, 2 max { inscribed_f : |c_t − c_f| <= inscribed_f } over solid f
+  /// #T: the local thickness, 2 max { inscribed_f : |c_t − c_f| <= inscribed_f + reach } over solid f
   /// (0 for void tets).
   VecXd thickness;
   double smallest_member = 0;  ///< min thickness over the solid design tets (domain 0)
