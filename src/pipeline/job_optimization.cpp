@@ -205,13 +205,34 @@ void parse_overhang(const Fields& controls, simp::OverhangControl& o) {
     f.bad("smoothness", "must lie in (0, 0.01] (the ε of the smooth minimum; 1e-4 is usual)");
 }
 
+/// "controls"."min_member_size" and "max_member_size" (mm) with their options (docs/optimization.md).
+void parse_member_size(const Fields& f, simp::MemberSizeParams& m) {
+  m.min_size = f.number("min_member_size", 0);
+  if (f.has("min_member_size") && !(m.min_size > 0 && m.min_size < 1e6))
+    f.bad("min_member_size", "must be a positive size in mm (the thinnest member and gap; at least 2 mesh sizes)");
+  m.eta_shift = f.number("min_member_eta_shift", m.eta_shift);
+  if (!(m.eta_shift > 0.05 && m.eta_shift < 0.45))
+    f.bad("min_member_eta_shift", "must lie in (0.05, 0.45) (0.25 is usual)");
+  m.max_size = f.number("max_member_size", 0);
+  if (f.has("max_member_size") && !(m.max_size > 0 && m.max_size < 1e6))
+    f.bad("max_member_size", "must be a positive size in mm (the widest solid ball allowed; at least 3 mesh sizes)");
+  if (m.min_size > 0 && m.max_size > 0 && m.max_size <= m.min_size)
+    f.bad("max_member_size", "must be larger than min_member_size");
+  m.max_solid = f.number("max_member_solid", m.max_solid);
+  if (!(m.max_solid > 0.5 && m.max_solid < 1))
+    f.bad("max_member_solid", "must lie in (0.5, 1) (0.9 is usual: the largest solid share of a ball)");
+  m.pnorm = f.number("max_member_pnorm", m.pnorm);
+  if (!(m.pnorm >= 4 && m.pnorm <= 64)) f.bad("max_member_pnorm", "must lie in [4, 64] (16 is usual)");
+}
+
 /// "controls": {"symmetry_planes": [{"point", "normal"}], "cyclic": [{"point", "axis",
 /// "sectors"}], "patterns": [{"direction", "pitch", "count"}], "extrusion": [x, y, z],
-/// "draw_direction": {...}, "overhang": {...}, "tolerance"} (docs/optimization.md).
+/// "draw_direction": {...}, "overhang": {...}, "tolerance", member sizes} (docs/optimization.md).
 void parse_controls(const Fields& opt, simp::ControlsParams& c) {
   if (!opt.has("controls")) return;
   const Fields f(opt.at("controls"), opt.name("controls"),
-                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "draw_direction", "overhang", "tolerance"},
+                 {"symmetry_planes", "cyclic", "patterns", "extrusion", "draw_direction", "overhang", "tolerance",
+                  "min_member_size", "min_member_eta_shift", "max_member_size", "max_member_solid", "max_member_pnorm"},
                  "{\"symmetry_planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0]}]}");
   each_item(
       f, "symmetry_planes",
@@ -239,6 +260,29 @@ void parse_controls(const Fields& opt, simp::ControlsParams& c) {
   parse_overhang(f, c.overhang);
   c.tolerance = f.number("tolerance", 0);
   if (c.tolerance < 0) f.bad("tolerance", "must be positive (mm), or 0 for the mean edge length");
+  parse_member_size(f, c.member);
+}
+
+/// What the member sizes ask of the other settings: a minimum size sets the filter radius (so
+/// "filter_radius" may not be given) and needs the projection; a maximum size needs MMA, the
+/// default then.
+void settle_member_size(const Fields& f, OptimizeSettings& s) {
+  simp::SimpParams& p = s.simp;
+  const simp::MemberSizeParams& m = p.controls.member;
+  if (m.min_size > 0) {
+    if (f.has("filter_radius"))
+      f.bad("filter_radius", "must be left out with controls.min_member_size (the size sets the radius)");
+    if (!p.projection.enabled)
+      f.bad("heaviside", "must be on with controls.min_member_size (the robust formulation projects three designs)");
+    p.filter.radius =
+        simp::robust_filter_radius(m.min_size, p.filter.kind, simp::robust_thresholds(p.projection.eta, m.eta_shift));
+  }
+  if (m.max_size > 0) {
+    if (f.has("update") && p.update == simp::UpdateKind::OC)
+      f.bad("update",
+            "must be \"mma\" with controls.max_member_size (a local volume constraint); leave it out to get MMA");
+    p.update = simp::UpdateKind::MMA;
+  }
 }
 
 }  // namespace
@@ -286,6 +330,7 @@ OptimizeSettings parse_optimization(const json& section) {
   parse_solver(f, p.solver);
   parse_stopping(f, p);
   parse_responses(f, s);
+  settle_member_size(f, s);
   s.threshold = f.number("threshold", -1);
   if (f.has("threshold") && !(s.threshold > 0 && s.threshold < 1))
     f.bad("threshold", "must lie strictly between 0 and 1, or be null for the one that keeps the volume fraction");

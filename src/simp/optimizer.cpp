@@ -33,6 +33,10 @@ void check_params(const SimpParams& params) {
         ErrorCode::InvalidParameter,
         "the geometry controls (symmetry, cyclic, pattern, extrusion, draw direction, overhang) work with the density "
         "filter: turn the sensitivity filter off");
+  if (params.controls.member.max_size > 0 && params.update != UpdateKind::MMA)
+    throw Error(ErrorCode::InvalidParameter,
+                "controls.max_member_size needs the MMA update (a local volume constraint beside the volume "
+                "fraction): set \"update\": \"mma\"");
 }
 
 void check_volume_fraction(double volume_fraction, const std::string& name) {
@@ -48,6 +52,9 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
     : mesh_(mesh), params_(params), loads_(loads), weights_(weights), progress_(progress) {
   proj_.eta = params.projection.eta;
   proj_.beta = params.projection.enabled ? params.projection.beta_start : 1.0;
+  const MemberSizeParams& member = params.controls.member;
+  robust_ = member.min_size > 0;
+  eta_ = robust_ ? robust_thresholds(proj_.eta, member.eta_shift) : RobustThresholds{proj_.eta, proj_.eta, proj_.eta};
   check_volume_fraction(params.volume_fraction);
   if (!(params.law.penalty >= 1)) throw Error(ErrorCode::InvalidParameter, "the SIMP penalty must be at least 1");
   const long nt = mesh.T.rows();
@@ -61,8 +68,10 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   vd_.resize(num_design);
   for (int i = 0; i < num_design; ++i) vd_[i] = volume[design_[i]];
   design_volume_ = vd_.sum();
+  check_member_size(member, mean_edge_length(mesh), params.projection.enabled);
   FilterParams fp = params.filter;
-  fp.radius = filter_radius(mesh, fp);
+  fp.radius =
+      robust_ ? robust_filter_radius(member.min_size, fp.kind, eta_, fp.like_gaussian) : filter_radius(mesh, fp);
   filter_ = make_filter(mesh, design_, volume, fp, progress);
   progress.info("filter: " + filter_->describe());
   const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
@@ -95,14 +104,20 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
 
 ComplianceProblem::~ComplianceProblem() = default;
 
-void ComplianceProblem::forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde, VecXd& rho_bar) const {
+void ComplianceProblem::filtered(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde) const {
   const VecXd z = controls_->apply(x);
   rho_filtered = params_.sensitivity_filter ? z : filter_->apply(z);
   rho_tilde = draw_ ? draw_->apply(rho_filtered) : rho_filtered;
   if (overhang_) rho_tilde = overhang_->apply(rho_tilde);
-  rho_bar = rho_tilde;
-  if (params_.projection.enabled)
-    for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = proj_.value(rho_tilde[i]);
+}
+
+VecXd ComplianceProblem::project(const VecXd& rho_tilde, double eta) const {
+  if (!params_.projection.enabled) return rho_tilde;
+  Heaviside h = proj_;
+  h.eta = eta;
+  VecXd rho_bar(rho_tilde.size());
+  for (long i = 0; i < rho_bar.size(); ++i) rho_bar[i] = h.value(rho_tilde[i]);
+  return rho_bar;
 }
 
 int ComplianceProblem::num_variables() const { return controls_->num_variables(); }
@@ -110,14 +125,24 @@ int ComplianceProblem::num_variables() const { return controls_->num_variables()
 VecXd ComplianceProblem::design_field(const VecXd& x) const { return controls_->apply(x); }
 
 VecXd ComplianceProblem::physical(const VecXd& x) const {
-  VecXd rf, rt, rb;
-  forward(x, rf, rt, rb);
-  return rb;
+  VecXd rf, rt;
+  filtered(x, rf, rt);
+  return project(rt, eta_.intermediate);
+}
+
+VecXd ComplianceProblem::physical_to_variables(const VecXd& x, const VecXd& d) const {
+  VecXd rf, rt;
+  filtered(x, rf, rt);
+  return chain(rf, rt, d, eta_.intermediate);
 }
 
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   const int num_design = static_cast<int>(design_.size());
-  forward(x, rho_filtered_, rho_tilde_, rho_bar_);
+  filtered(x, rho_filtered_, rho_tilde_);
+  rho_bar_ = project(rho_tilde_, eta_.eroded);
+  if (robust_)  // the dilated volume's bound follows the intermediate design (Wang et al. 2011)
+    volume_scale_ = volume_of(project(rho_tilde_, eta_.intermediate)) /
+                    std::max(1e-300, volume_of(project(rho_tilde_, eta_.dilated)));
   // ---- FE analysis
   for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar_[i]);
   fe_->set_scale(scale_);
@@ -137,13 +162,16 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
     c += weights_[k] * F.col(k).dot(U_.col(k));
     if (dc) dc_bar += weights_[k] * (load_derivative(2 * U_.col(k), k) - stiffness_derivative(U_.col(k), U_.col(k)));
   }
-  if (dc) *dc = chain(rho_filtered_, rho_tilde_, dc_bar);
+  if (dc) *dc = chain(rho_filtered_, rho_tilde_, dc_bar, eta_.eroded);
   return c;
 }
 
-VecXd ComplianceProblem::chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const {
-  if (params_.projection.enabled)
-    for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= proj_.derivative(rho_tilde[i]);
+VecXd ComplianceProblem::chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar, double eta) const {
+  if (params_.projection.enabled) {
+    Heaviside h = proj_;
+    h.eta = eta;
+    for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= h.derivative(rho_tilde[i]);
+  }
   if (overhang_) d_bar = overhang_->apply_transpose(draw_ ? draw_->apply(rho_filtered) : rho_filtered, d_bar);
   if (draw_) d_bar = draw_->apply_transpose(rho_filtered, d_bar);
   return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
@@ -175,12 +203,11 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
     if (dv) *dv = volume_weights_;
     return volume_weights_.dot(x);
   }
-  VecXd rho_filtered, rho_tilde, rho_bar;
-  forward(x, rho_filtered, rho_tilde, rho_bar);
-  if (dv) {
-    *dv = chain(rho_filtered, rho_tilde, vd_ / design_volume_);
-  }
-  return vd_.dot(rho_bar) / design_volume_;
+  // with a minimum member size: the dilated design's volume, scaled (volume_scale_)
+  VecXd rho_filtered, rho_tilde;
+  filtered(x, rho_filtered, rho_tilde);
+  if (dv) *dv = volume_scale_ * chain(rho_filtered, rho_tilde, vd_ / design_volume_, eta_.dilated);
+  return volume_scale_ * volume_of(project(rho_tilde, eta_.dilated));
 }
 
 double ComplianceProblem::grey_share(const VecXd& x) const {
@@ -233,6 +260,21 @@ class DesignUpdate {
   MoveLimits moves_;
 };
 
+/// The maximum member size's constraint (member_size.h) appended to MMA's terms at x (#N),
+/// when one is set (`local` not null).
+void add_local_volume(const ComplianceProblem& problem, LocalVolumeConstraint* local, const VecXd& x, MmaTerms& t) {
+  if (!local) return;
+  VecXd grad;
+  const VecXd rho = problem.physical(x);
+  local->adapt(rho);
+  const double f = local->evaluate(rho, &grad);
+  const long m = t.f.size();
+  t.f.conservativeResize(m + 1);
+  t.df.conservativeResize(m + 1, x.size());
+  t.f[m] = f;
+  t.df.row(m) = problem.physical_to_variables(x, grad).transpose();
+}
+
 /// Keeps an iteration in the history and reports it (callback and progress line).
 void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult& res,
                       const std::function<void(const IterationRecord&)>& on_iteration, const Progress& progress) {
@@ -272,7 +314,10 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
   Responses responses(params, material, supports);
   const int num_variables = problem.num_variables();
   const SimpParams stepping = update_settings(params);  // smaller steps under a stress limit
-  DesignUpdate update(stepping, num_variables, responses.constraints(static_cast<int>(loads.cols())));
+  std::unique_ptr<LocalVolumeConstraint> local;         // the maximum member size
+  if (params.controls.member.max_size > 0)
+    local = std::make_unique<LocalVolumeConstraint>(mesh, res.design, tet_volumes(mesh), params.controls.member);
+  DesignUpdate update(stepping, num_variables, responses.constraints(static_cast<int>(loads.cols())) + (local ? 1 : 0));
   Continuation schedule(stepping.projection, params.tol_change, params.tol_objective);
   VecXd x = VecXd::Constant(num_variables, params.volume_fraction);
   for (int it = 1; it <= params.max_iterations; ++it) {
@@ -286,7 +331,8 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     // ---- filter (sensitivity filtering; the density filter is inside the chain rule)
     if (params.sensitivity_filter) dc = problem.filter_sensitivity(x, dc);
     // ---- update
-    const MmaTerms mma = params.update == UpdateKind::MMA ? responses.terms(problem, c, dc, vol, dv) : MmaTerms{};
+    MmaTerms mma = params.update == UpdateKind::MMA ? responses.terms(problem, c, dc, vol, dv) : MmaTerms{};
+    add_local_volume(problem, local.get(), x, mma);
     const VecXd xnew = update.step(problem, x, dc, dv, mma);
     IterationRecord rec{it,
                         c,

@@ -12,6 +12,7 @@
 #include "fem/elasticity.h"
 #include "simp/continuation.h"
 #include "simp/controls/controls_params.h"
+#include "simp/controls/member_size.h"
 #include "simp/filter.h"
 #include "simp/responses/response_params.h"
 #include "simp/simp_law.h"
@@ -33,7 +34,7 @@ struct SimpParams {
   double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
   ResponseParams responses;  ///< objective and limits beyond the volume fraction (responses/)
-  ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion, draw direction); none
+  ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion, draw direction, member size)
 };
 
 /// One iteration, as reported to the caller and kept in the history.
@@ -69,7 +70,12 @@ struct SimpResult {
 };
 
 /// The objective and constraint of SIMP as functions of the design variables x (#D): the
-/// filter, projection and FE model are built once; evaluate() runs one FE analysis.
+/// filter, projection and FE model are built once; compliance() runs one FE analysis.
+/// With a minimum member size (controls.member.min_size, the robust formulation of
+/// member_size.h) the filter radius follows from that size, the FE analysis and the
+/// compliance are the eroded design's, the volume is the dilated design's scaled so that it
+/// equals the intermediate's at the x of the last compliance() call (the bound's update of
+/// Wang et al. 2011, held fixed in dv), and physical() is the intermediate design.
 class DesignMap;
 class DrawFilter;
 class OverhangFilter;
@@ -93,8 +99,11 @@ class ComplianceProblem {
   double compliance(const VecXd& x, VecXd* dc = nullptr);
   /// Volume fraction of the design domain with the physical densities, and d/dx (#N) if asked.
   double volume_fraction(const VecXd& x, VecXd* dv = nullptr) const;
-  /// Physical densities ρ̄ (#D) of x (#N).
+  /// Physical densities ρ̄ (#D) of x (#N): the design returned (the intermediate one with a
+  /// minimum member size).
   VecXd physical(const VecXd& x) const;
+  /// Chain rule of physical(): a sensitivity d (#D) w.r.t. physical(x) turned into one w.r.t. x (#N).
+  VecXd physical_to_variables(const VecXd& x, const VecXd& d) const;
   /// Share of the design volume whose physical density ρ̄(x) lies strictly between 0.1 and 0.9.
   double grey_share(const VecXd& x) const;
   /// Sensitivities of compliance filtered by Sigmund's filter (when params ask for it).
@@ -102,13 +111,14 @@ class ComplianceProblem {
   const std::vector<int>& design() const { return design_; }
   /// The displacements U ((3*#V) by #cases) of the last compliance() call.
   const Eigen::MatrixXd& displacements() const { return U_; }
-  /// #D: the physical densities ρ̄ of the last compliance() call.
+  /// #D: the physical densities ρ̄ the last compliance() call analysed (the eroded design with a
+  /// minimum member size).
   const VecXd& physical_densities() const { return rho_bar_; }
   /// The FE model (for adjoint solves with the stiffness of the last compliance() call).
   fem::Elasticity& elasticity() { return *fe_; }
   /// Chain rule: a sensitivity w.r.t. the physical densities ρ̄ (#D) of the last compliance()
   /// call's x turned into one w.r.t. the design variables x (#D), through projection and filter.
-  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_filtered_, rho_tilde_, d_bar); }
+  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_filtered_, rho_tilde_, d_bar, eta_.eroded); }
   /// #D: E'(ρ̄_i) a_iᵀ K0_i b_i for the densities of the last compliance() call; a, b: 3*#V
   /// (the stiffness term of an adjoint sensitivity, −this for λ = a, u = b).
   VecXd stiffness_derivative(const VecXd& a, const VecXd& b) const;
@@ -133,14 +143,19 @@ class ComplianceProblem {
   VecXd quarter_mass_;        // #D: ρ_material vol / 4 of each design tet (t)
   std::vector<double> weights_;
   Heaviside proj_;
+  RobustThresholds eta_;     // all three the projection's η without a minimum member size
+  bool robust_ = false;      // a minimum member size: the three designs of the robust formulation
+  double volume_scale_ = 1;  // robust: V_intermediate / V_dilated at the last compliance() call
   Progress progress_;
   VecXd scale_;
   Eigen::MatrixXd U_;   // displacements of the last compliance() call
   VecXd rho_filtered_;  // #D: its filtered densities
   VecXd rho_tilde_;     // #D: the same through the draw direction and overhang (rho_filtered_ without them)
   VecXd rho_bar_;       // #D: its physical densities
-  VecXd chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar) const;
-  void forward(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde, VecXd& rho_bar) const;
+  VecXd chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar, double eta) const;
+  void filtered(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde) const;
+  VecXd project(const VecXd& rho_tilde, double eta) const;
+  double volume_of(const VecXd& rho_bar) const { return vd_.dot(rho_bar) / design_volume_; }
 };
 
 /// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1),

@@ -244,7 +244,8 @@ def _overhang(direction, angle, base_face, cell):
 
 def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=None, tolerance=0.0,
                  draw_direction=None, parting_point=None, draw_cell=0.0, build_direction=None,
-                 overhang_angle=45.0, base_face=None, overhang_cell=0.0):
+                 overhang_angle=45.0, base_face=None, overhang_cell=0.0, min_member_size=0.0,
+                 max_member_size=0.0):
     """Sets the study's geometry controls (docs/optimization.md, "controls"); called without
     arguments it clears them. symmetry_planes: [(point, normal), ...]; cyclic: [(point, axis,
     sectors), ...]; patterns: [(direction, pitch mm, count), ...]; extrusion: a direction or
@@ -256,8 +257,11 @@ def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=No
     prints without supports at overhang_angle (degrees from the plate, [10, 80], 45 usual) on the
     base plate base_face ("Face5" or 5, a flat face of the part facing against the direction;
     None: the plate touches the part's lowest point), overhang_cell: mm, the overhang lattice's
-    spacing (0: the tolerance). Vectors are [x, y, z] in model axes. Returns the controls as the
-    job's dict. Raises TopOptError naming the argument."""
+    spacing (0: the tolerance). min_member_size: mm, the thinnest member and gap (robust
+    formulation; sets the filter radius; 0: none); max_member_size: mm, the widest solid ball (a
+    local volume constraint; needs MMA, so the study's Update becomes "mma"; 0: none). Vectors
+    are [x, y, z] in model axes. Returns the controls as the job's dict. Raises TopOptError
+    naming the argument."""
     c = {}
     if symmetry_planes:
         c["symmetry_planes"] = [{"point": _vector(p, "symmetry plane %d point" % (i + 1)),
@@ -291,8 +295,15 @@ def set_controls(study, symmetry_planes=(), cyclic=(), patterns=(), extrusion=No
                           "InvalidParameter")
     if checks.in_range(tolerance, "tolerance", 0, None) > 0:
         c["tolerance"] = float(tolerance)
-    check_optimization(study, controls=c)
+    if checks.in_range(min_member_size, "min_member_size", 0, None) > 0:
+        c["min_member_size"] = float(min_member_size)
+    if checks.in_range(max_member_size, "max_member_size", 0, None) > 0:
+        c["max_member_size"] = float(max_member_size)
+    update = "mma" if "max_member_size" in c else None
+    check_optimization(study, controls=c, update=update)
     study.GeometryControls = json.dumps(c) if c else ""
+    if update and study.Update == "oc":
+        study.Update = "mma"  # the local volume constraint needs MMA; visible in the property editor
     return c
 
 

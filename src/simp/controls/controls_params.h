@@ -1,6 +1,7 @@
 // The geometry controls of SIMP (issue 22): symmetry planes, cyclic and linear-pattern
 // repetition and extrusion, as options for DesignMap (design_map.h), and the draw direction
-// (draw_filter.h) and the overhang of additive manufacturing (overhang_filter.h).
+// (draw_filter.h), the overhang of additive manufacturing (overhang_filter.h), and the minimum
+// and maximum member size (member_size.h).
 #pragma once
 #include <Eigen/Core>
 #include <vector>
@@ -68,6 +69,19 @@ struct OverhangControl {
   double smoothness = 1e-4;  ///< ε of the smooth minimum with the density; in (0, 0.01]
 };
 
+/// Minimum and maximum member size (member_size.h). Both sizes are diameters in mm; <= 0: off.
+struct MemberSizeParams {
+  /// Smallest member and gap of the design: the robust formulation (eroded, intermediate and
+  /// dilated projections) with the filter radius robust_filter_radius(min_size, ...).
+  double min_size = 0;
+  double eta_shift = 0.25;  ///< Δη: η_e = η + Δη, η_d = η − Δη; in (0.05, 0.45)
+  /// Largest member: no solid ball of this diameter (the local volume constraint, with MMA).
+  double max_size = 0;
+  double max_solid = 0.9;  ///< 1 − ε: the largest solid share of an element's ball; in (0.5, 1)
+  double pnorm = 16;       ///< P of the aggregation, in [4, 64]
+  bool any() const { return min_size > 0 || max_size > 0; }
+};
+
 /// Geometry controls, combinable. Defaults: none.
 struct ControlsParams {
   std::vector<MirrorPlane> mirrors;      ///< several planes allowed
@@ -80,11 +94,12 @@ struct ControlsParams {
   double tolerance = 0;
   DrawDirection draw;        ///< after the density filter, before the projection (draw_filter.h)
   OverhangControl overhang;  ///< after the draw direction, before the projection (overhang_filter.h)
+  MemberSizeParams member;   ///< minimum and maximum member size (member_size.h)
 
   /// True when a control ties design elements (symmetry, repetition, extrusion: DesignMap).
   bool ties() const { return !mirrors.empty() || !cyclic.empty() || !patterns.empty() || extrude; }
   /// True when any control is set.
-  bool any() const { return ties() || draw.enabled || overhang.enabled; }
+  bool any() const { return ties() || draw.enabled || overhang.enabled || member.any(); }
 };
 
 }  // namespace topopt::simp

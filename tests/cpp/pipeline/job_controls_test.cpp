@@ -110,6 +110,36 @@ TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
         std::string(e.what()).find("optimization.controls.overhang.base_face names Face9, but the part has only 6"),
         std::string::npos)
         << e.what();
+    }
+  }
+}
+
+TEST(JobControls, MemberSizesSetTheRadiusAndTheUpdate) {
+  const Job job = parse_job(with_controls(R"({"min_member_size": 4, "max_member_size": 12})"), "/tmp");
+  const simp::SimpParams& p = job.optimization.simp;
+  EXPECT_EQ(p.controls.member.min_size, 4);
+  EXPECT_EQ(p.controls.member.max_size, 12);
+  EXPECT_TRUE(p.controls.any());
+  // the radius the size asks for (Gaussian filter, thresholds 0.5 ± 0.25), and MMA for the maximum size
+  EXPECT_NEAR(p.filter.radius,
+              simp::robust_filter_radius(4, simp::FilterKind::Gaussian, simp::robust_thresholds(0.5, 0.25)), 1e-12);
+  EXPECT_GT(p.filter.radius, 4);
+  EXPECT_EQ(p.update, simp::UpdateKind::MMA);
+  expect_refused(R"({"min_member_size": -2})", {"'optimization.controls.min_member_size'", "positive size in mm"});
+  expect_refused(R"({"min_member_size": 6, "max_member_size": 5})",
+                 {"'optimization.controls.max_member_size'", "larger than min_member_size"});
+  expect_refused(R"({"max_member_size": 5, "max_member_solid": 1.2})", {"'optimization.controls.max_member_solid'"});
+  for (const std::string& other :
+       {std::string(R"("filter_radius": 3)"), std::string(R"("heaviside": false)"), std::string(R"("update": "oc")")}) {
+    const std::string key = other.substr(1, other.find('"', 1) - 1);
+    const std::string controls = key == "update" ? R"({"max_member_size": 8})" : R"({"min_member_size": 4})";
+    try {
+      parse_job(R"({"optimization": {)" + other + R"(, "controls": )" + controls + "}}", "/tmp");
+      ADD_FAILURE() << "no error for " << other;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("'optimization." + key + "'"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("member_size"), std::string::npos) << e.what();
+    }
   }
 }
 

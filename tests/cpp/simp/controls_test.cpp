@@ -17,31 +17,15 @@
 #include "simp/controls/design_map.h"
 #include "simp/controls/draw_filter.h"
 #include "simp/optimizer.h"
+#include "simp/test_beam.h"
 
 namespace topopt::simp {
 namespace {
 
-/// A square beam 30 × 10 × 10 mm centred on the x axis, fixed at x = 0, a load pad at
-/// x = 30 pulled along -y and pushed along -z with different forces (an asymmetric load, so
-/// that a free design is not symmetric about the diagonal planes).
-struct Beam {
-  mesh::StructuredBoxParams box;
-  TetMesh mesh;
-  fem::Material mat;
-  fem::Supports supports;
-  Eigen::MatrixXd loads;
-
-  explicit Beam(std::array<int, 3> cells) {
-    box.origin = {0, -5, -5};
-    box.size = {30, 10, 10};
-    box.cells = cells;
-    box.nondesign = {{28, -5, -5, 30, 5, 5}};
-    mesh = mesh::structured_box_mesh(box);
-    supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
-    fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, -30}, 0, {}};
-    loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {pull}, 1}});
-  }
-  double cell(int axis) const { return box.size[axis] / box.cells[axis]; }
+/// The test beam, pulled along -y and pushed along -z with different forces (an asymmetric
+/// load, so that a free design is not symmetric about the diagonal planes).
+struct Beam : TestBeam {
+  explicit Beam(std::array<int, 3> cells) : TestBeam(cells, {0, -100, -30}) {}
 
   /// The density at p of the per-tet field rho (#T): the tet of the Kuhn split that holds p,
   /// 0 outside the box.

@@ -45,6 +45,24 @@ class Controls(unittest.TestCase):
         self.assertEqual(self.study.GeometryControls, "")
         self.assertNotIn("controls", api.job_of(self.study)["optimization"])
 
+    def test_member_sizes_reach_the_job_and_the_core_checks_them(self):
+        self.assertEqual(self.study.Update, "oc")
+        api.set_controls(self.study, min_member_size=10, max_member_size=24)
+        opt = api.job_of(self.study)["optimization"]
+        self.assertEqual(opt["controls"]["min_member_size"], 10)
+        self.assertEqual(opt["controls"]["max_member_size"], 24)
+        self.assertEqual(self.study.Update, "mma")  # the local volume constraint needs MMA
+        for kwargs, words in [(dict(min_member_size=-1), "min_member_size"),
+                              (dict(min_member_size=10, max_member_size=8), "max_member_size")]:
+            with self.assertRaises(api.TopOptError) as ctx:
+                api.set_controls(self.study, **kwargs)
+            self.assertIn(words, str(ctx.exception))
+        # 5 mm on a 4 mm mesh: below two mesh sizes, refused by the core once the mesh is known
+        api.set_controls(self.study, min_member_size=5)
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.run(self.study, verbose=False)
+        self.assertIn("controls.min_member_size is below two mesh sizes", str(ctx.exception))
+
     def test_bad_arguments_name_what_to_fix(self):
         for kwargs, words in [(dict(symmetry_planes=[((0, 5, 5), (0, 0, 0))]), "symmetry plane 1 normal"),
                               (dict(cyclic=[((0, 0, 0), (1, 0, 0), 2.5)]), "cyclic 1 sectors"),
