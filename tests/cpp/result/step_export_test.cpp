@@ -60,7 +60,7 @@ TEST(StepExport, OneValidSolidWithTheSurfacesVolumeAndMergedPlanarFaces) {
   for (long q = 0; q < s.tag.size(); ++q) free_form += s.tag[q] == 0;
   EXPECT_LE(r.faces, free_form + r.planar_faces);
   // without merging every triangle is a face
-  EXPECT_EQ(describe_solid(result_solid(s, {.unify = false})).faces, s.F.rows());
+  EXPECT_EQ(describe_solid(result_solid(s, {.unify = false, .coarsen = {.tolerance = 0}})).faces, s.F.rows());
 }
 
 TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
