@@ -8,6 +8,7 @@ FreeCAD, and comes back as a TopOptError. Arguments are checked here before anyt
 import json
 import os
 import shutil
+import tempfile
 
 import Part
 
@@ -413,21 +414,27 @@ def export_stl(study, path):
 
 
 def export_step(study, path):
-    """Writes the study's result as one CAD solid to a STEP file at `path`: the result.step
-    its last run wrote (the shape at the run's threshold; the threshold slider does not change
-    it). Returns the path. Raises TopOptError if the study has no result, if its run wrote no
-    STEP file (saying which setting to turn on), if the folder does not exist, or if the file
-    cannot be written."""
+    """Writes the study's result as one CAD solid to a STEP file at `path`: the shape at the
+    study's current Threshold (the run's result.step when the threshold slider has not moved;
+    else the shape the slider shows, written by the core from the stored densities). Returns
+    the path. Raises TopOptError if the study has no result, if its run wrote no STEP file
+    (saying which setting to turn on), if the shape cannot become a valid solid, if the folder
+    does not exist, or if the file cannot be written."""
     from . import asbuilt
     path = _output_path(study, path, ".step")
-    source = asbuilt.step_path(study)
-    return _written(path, lambda: shutil.copyfile(source, path))
+    folder = tempfile.mkdtemp(prefix="topopt-step-")
+    try:
+        source = asbuilt.step_at_threshold(study, folder)
+        return _written(path, lambda: shutil.copyfile(source, path))
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def result_solid(study):
     """Adds (or refreshes) the study's ResultSolid: a Part::Feature holding the one solid read
-    from the result.step of its last run, in one undo step ("TopOpt result as solid"). Returns
-    the feature. Raises TopOptError if the study has no result or its run wrote no STEP file
+    from the study's result as STEP at its current Threshold (asbuilt.step_at_threshold: the
+    last run's result.step unless the threshold slider moved), in one undo step ("TopOpt
+    result as solid"). Returns the feature. Raises TopOptError if the study has no result or its run wrote no STEP file
     (saying which setting to turn on), or if the file does not hold one valid solid; the
     document is then unchanged."""
     from . import asbuilt, runner
@@ -435,7 +442,11 @@ def result_solid(study):
     if not is_study(study):
         raise TopOptError("%r is not a TopOpt study: pass the object api.new_study returned" % (study,),
                           "InvalidParameter")
-    shape = asbuilt.read_step(asbuilt.step_path(study))
+    folder = tempfile.mkdtemp(prefix="topopt-step-")
+    try:
+        shape = asbuilt.read_step(asbuilt.step_at_threshold(study, folder))
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
     with runner.transaction(study.Document, "TopOpt result as solid"):
         feature = asbuilt.make_solid_feature(study, shape)
         quiet.recompute(study.Document)
