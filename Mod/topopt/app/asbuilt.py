@@ -119,10 +119,11 @@ def step_at_threshold(study, folder, timeout=None):
     the worker writes into `folder` from the stored densities (extract_surface with "step",
     the shape the slider shows). Raises TopOptError when the study has no result or the
     shape cannot become a valid solid (saying what to change)."""
+    run_step = step_path(study)  # a run that wrote no STEP (WriteStep off) gets none at any threshold
     threshold = float(getattr(study, "Threshold", -1.0))
     run = run_threshold(study)
     if not 0 < threshold < 1 or (run is not None and abs(run - threshold) < 1e-9):
-        return step_path(study)
+        return run_step
     from . import checks, worker
     if not study.Densities:
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
