@@ -43,7 +43,8 @@ const char* kUsage =
     "     \"job\": {...} (the job, inline: optimize, mesh), \"part\", \"nondesign\": shape files\n"
     "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
     "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
-    "     extract_surface: threshold, volume_fraction, smoothing_iterations), \"output\": DIR}\n"
+    "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
+    "     DIR/result.step, the shape as one CAD solid), \"output\": DIR}\n"
     "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
     "  progress {\"stage\", \"fraction\", \"message\"}, iterations {\"iteration\", \"compliance\",\n"
     "  \"volume\", \"change\", \"seconds\"}, {\"warning\"}, and last {\"done\": true} or {\"error\":\n"
@@ -325,6 +326,16 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   json result = {{"threshold", used}, {"warnings", hygiene.warnings}, {"min_feature", hygiene.min_feature}};
   ch.progress("write", -1, "writing the results");
   put_result_surface(result, r.output, s);
+  if (param(r, "step", 0) != 0) {  // the shape at this threshold as one CAD solid, DIR/result.step
+    ch.progress("step", -1, "writing the result as a STEP solid");
+    const result::StepExportReport step = result::write_result_step((fs::path(r.output) / "result.step").string(), s);
+    result["step"] = {{"faces", step.faces},
+                      {"triangles", step.triangles},
+                      {"volume", step.volume},
+                      {"bytes", step.bytes},
+                      {"seconds", step.seconds}};
+    result["files"] = json::array({"result.step"});
+  }
   return result;
 }
 

@@ -21,6 +21,9 @@ int cmd_mesh(const Args& args);
 int cmd_solve(const Args& args, const dist::MpiSession* session);
 int cmd_optimize(const Args& args, const dist::MpiSession* session);
 int cmd_surface(const Args& args);
+/// topopt result JOB.json --threshold T: the shape of a finished optimize run at another
+/// threshold, written as STEP (and STL) without optimising again.
+int cmd_result(const Args& args);
 /// topopt worker REQUEST.json: one request of the FreeCAD workbench, run out of FreeCAD's process
 /// (JSON lines on stdout, results in files; see cmd_worker.cpp and worker_channel.h).
 int cmd_worker(const Args& args);

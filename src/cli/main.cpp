@@ -156,6 +156,7 @@ const char* kUsage =
     "  surface   native surface mesh of one model, with its checks (closed, oriented, no self-intersection)\n"
     "  solve     linear elastic analysis of a job file\n"
     "  optimize  topology optimisation of a job file: mesh, SIMP, result surface\n"
+    "  result    the result of a finished optimize at another threshold, as STEP (and STL)\n"
     "  worker    one request of the FreeCAD workbench, run out of FreeCAD's process\n"
     "Run 'topopt <command> --help' for a command's options.\n";
 
@@ -282,6 +283,7 @@ int main(int argc, char** argv) {
       {"solve", [](const Args& a) { return cmd_solve(a, nullptr); }},
       {"optimize", [](const Args& a) { return cmd_optimize(a, nullptr); }},
       {"surface", cmd_surface},
+      {"result", cmd_result},
       {"worker", cmd_worker}};
   auto it = commands.find(argv[1]);
   if (it == commands.end()) {

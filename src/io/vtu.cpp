@@ -2,6 +2,8 @@
 #include "io/vtu.h"
 
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include "common/error.h"
 
@@ -55,6 +57,38 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<V
   bool ok = std::ferror(f) == 0;
   ok &= std::fclose(f) == 0;
   if (!ok) throw Error(ErrorCode::Io, "error while writing " + path + " (disk full?)");
+}
+
+namespace {
+/// The whole number after `key="` in `text` from `from` on (-1 when absent).
+long attribute_number(const std::string& text, const std::string& key, size_t from = 0) {
+  const size_t at = text.find(key + "=\"", from);
+  return at == std::string::npos ? -1 : std::atol(text.c_str() + at + key.size() + 2);
+}
+}  // namespace
+
+std::vector<double> read_vtu_cell_field(const std::string& path, const std::string& name, long* points) {
+  std::ifstream in(path);
+  if (!in) throw Error(ErrorCode::Io, "cannot read '" + path + "' (missing or not readable)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  const long cells = attribute_number(text, "NumberOfCells");
+  if (points) *points = attribute_number(text, "NumberOfPoints");
+  const size_t cell_data = text.find("<CellData");
+  const size_t field = cell_data == std::string::npos ? cell_data : text.find("Name=\"" + name + "\"", cell_data);
+  const size_t start = field == std::string::npos ? field : text.find('>', field);
+  const size_t end = start == std::string::npos ? start : text.find("</DataArray>", start);
+  if (cells < 0 || end == std::string::npos)
+    throw Error(ErrorCode::Io,
+                "'" + path + "' holds no cell field \"" + name + "\" (not a density.vtu of topopt optimize?)");
+  std::istringstream numbers(text.substr(start + 1, end - start - 1));
+  std::vector<double> values;
+  for (double v; numbers >> v;) values.push_back(v);
+  if (static_cast<long>(values.size()) != cells)
+    throw Error(ErrorCode::Io, "'" + path + "': the field \"" + name + "\" holds " + std::to_string(values.size()) +
+                                   " values for " + std::to_string(cells) + " cells (file cut short?)");
+  return values;
 }
 
 }  // namespace topopt::io

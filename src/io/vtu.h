@@ -19,4 +19,9 @@ struct VtuField {
 void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<VtuField>& point_data,
                const std::vector<VtuField>& cell_data);
 
+/// The cell field `name` of a .vtu that write_vtu wrote (ASCII): one number per cell,
+/// NumberOfCells of them; `points` (optional) gets NumberOfPoints. Throws Error(Io) when the
+/// file cannot be read, lacks the field or holds fewer or more numbers than cells.
+std::vector<double> read_vtu_cell_field(const std::string& path, const std::string& name, long* points = nullptr);
+
 }  // namespace topopt::io

@@ -26,8 +26,11 @@ json figures_json(const result::AnalysisFigures& a) {
 }
 
 json step_json(const result::StepExportReport& s) {
-  return {{"valid", s.valid},   {"solids", s.solids}, {"faces", s.faces},     {"planar_faces", s.planar_faces},
-          {"volume", s.volume}, {"bytes", s.bytes},   {"seconds", s.seconds}, {"cpu_seconds", s.cpu_seconds}};
+  return {{"valid", s.valid},         {"solids", s.solids},
+          {"faces", s.faces},         {"planar_faces", s.planar_faces},
+          {"volume", s.volume},       {"bytes", s.bytes},
+          {"seconds", s.seconds},     {"cpu_seconds", s.cpu_seconds},
+          {"triangles", s.triangles}, {"unmerged_bodies", s.unmerged_bodies}};
 }
 
 json verification_json(const result::Verification& v) {
@@ -99,6 +102,7 @@ ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const Optimi
           }));
           out.step->bytes = static_cast<long>(fs::file_size(path));
           report["step"] = step_json(*out.step);
+          report["step"]["threshold"] = r.threshold;  // the shape's: the workbench's slider may move away from it
         },
         out, failures, progress);
   }

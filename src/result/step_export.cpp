@@ -3,13 +3,17 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+#include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepCheck.hxx>
 #include <BRepCheck_Analyzer.hxx>
+#include <BRepCheck_Result.hxx>
 #include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
 #include <GProp_GProps.hxx>
 #include <Geom_Line.hxx>
 #include <Geom_Plane.hxx>
@@ -17,11 +21,14 @@
 #include <Interface_Static.hxx>
 #include <STEPControl_Writer.hxx>
 #include <ShapeUpgrade_UnifySameDomain.hxx>
+#include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
+#include <TopoDS_Iterator.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
 #include <TopoDS_Vertex.hxx>
@@ -110,22 +117,24 @@ TopoDS_Face triangle_face(const TriSurface& s, SharedTopology& topo, long q) {
 std::string report_text(const StepExportReport& r) {
   std::ostringstream o;
   o.precision(17);
-  o << r.valid << " " << r.solids << " " << r.faces << " " << r.planar_faces << " " << r.volume;
+  o << r.valid << " " << r.solids << " " << r.faces << " " << r.planar_faces << " " << r.volume << " " << r.triangles
+    << " " << r.unmerged_bodies;
   return o.str();
 }
 
 StepExportReport report_of(const std::string& text) {
   StepExportReport r;
   std::istringstream in(text);
-  in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume;
+  in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume >> r.triangles >> r.unmerged_bodies;
   if (!in) throw Error(ErrorCode::Internal, "the STEP export's child answered '" + text + "'");
   return r;
 }
 
-void write_step_file(const TopoDS_Shape& shape, const std::string& path) {
+void write_step_file(const TopoDS_Shape& shape, const std::string& path, bool pcurves) {
   STEPControl_Writer writer;
   Interface_Static::SetCVal("write.step.schema", "AP214IS");
   Interface_Static::SetCVal("write.step.unit", "MM");
+  Interface_Static::SetIVal("write.surfacecurve.mode", pcurves ? 1 : 0);
   if (writer.Transfer(shape, STEPControl_ManifoldSolidBrep) != IFSelect_RetDone)
     throw Error(ErrorCode::InvalidShape, "OCCT could not translate the result solid to STEP");
   if (writer.Write(path.c_str()) != IFSelect_RetDone)
@@ -161,8 +170,8 @@ SurfacePieces surface_pieces(const TriSurface& s) {
 }
 
 /// One solid per body of the surface, each void's shell added to the body that holds it (by
-/// OCCT's classifier, at one of the void's points); a compound when there are several bodies.
-TopoDS_Shape solids_of(const TriSurface& s, const SurfacePieces& pieces) {
+/// OCCT's classifier, at one of the void's points).
+std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pieces) {
   SharedTopology topo(s);
   BRep_Builder builder;
   std::vector<TopoDS_Solid> bodies;
@@ -193,11 +202,20 @@ TopoDS_Shape solids_of(const TriSurface& s, const SurfacePieces& pieces) {
                                                "(\"optimization.smooth\")");
     builder.Add(*holder, shell);
   }
-  if (bodies.size() == 1) return bodies[0];
-  TopoDS_Compound all;
-  builder.MakeCompound(all);
-  for (const TopoDS_Solid& b : bodies) builder.Add(all, b);
-  return all;
+  return bodies;
+}
+
+/// `body` with coplanar faces and collinear edges merged, body by body (OCCT's
+/// ShapeUpgrade_UnifySameDomain). Where the merged body fails OCCT's check and the facets
+/// passed it, the facets are kept (`refused` counts such bodies): on the bracket's detached
+/// clamp pad the merge made a shell BRepCheck calls unorientable (near a bore's facets).
+TopoDS_Shape merged(const TopoDS_Solid& body, const StepExportParams& params, int& refused) {
+  ShapeUpgrade_UnifySameDomain unify(body, true, true, false);
+  unify.SetAngularTolerance(params.angular_tolerance);
+  unify.Build();
+  if (BRepCheck_Analyzer(unify.Shape()).IsValid() || !BRepCheck_Analyzer(body).IsValid()) return unify.Shape();
+  ++refused;
+  return body;
 }
 
 }  // namespace
@@ -207,21 +225,64 @@ int result_bodies(const TriSurface& s) {
   return static_cast<int>(std::count_if(pieces.volume.begin(), pieces.volume.end(), [](double v) { return v > 0; }));
 }
 
-TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params) {
-  const SurfaceCheck check = check_surface(s.V, s.F);
+TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& params, CoarsenReport* coarsened) {
+  const SurfaceCheck check = check_surface(given.V, given.F);
   if (!check.closed_manifold() || check.volume <= 0)
     throw Error(
         ErrorCode::InvalidShape,
         "the result surface is not closed and outward (" + std::to_string(check.unpaired_edges) +
             " unpaired edges): it cannot become a solid; try other smoothing settings (\"optimization.smooth\")");
+  const TriSurface s = coarsen_free_form(given, params.coarsen, coarsened);
   // the bodies of the result (a detached non-design solid is one more) with their voids
   // inside, not a single shell of several pieces (BRepCheck: not connected)
-  const TopoDS_Shape solid = solids_of(s, surface_pieces(s));
-  if (!params.unify) return solid;
-  ShapeUpgrade_UnifySameDomain unify(solid, true, true, false);
-  unify.SetAngularTolerance(params.angular_tolerance);
-  unify.Build();
-  return unify.Shape();
+  const std::vector<TopoDS_Solid> bodies = solids_of(s, surface_pieces(s));
+  int refused = 0;
+  BRep_Builder builder;
+  TopoDS_Compound all;
+  builder.MakeCompound(all);
+  for (const TopoDS_Solid& body : bodies)
+    builder.Add(all, params.unify ? merged(body, params, refused) : TopoDS_Shape(body));
+  if (coarsened) coarsened->unmerged_bodies = refused;
+  if (bodies.size() != 1) return all;
+  return TopoDS_Iterator(all).Value();
+}
+
+std::string solid_faults(const TopoDS_Shape& shape, int limit) {
+  const BRepCheck_Analyzer analyzer(shape);
+  std::ostringstream out;
+  int found = 0;
+  const auto note = [&](const char* kind, int index, const TopoDS_Shape& sub, BRepCheck_Status status) {
+    if (status == BRepCheck_NoError || found++ >= limit) return;
+    if (found > 1) out << "; ";
+    out << kind << " " << index;
+    if (sub.ShapeType() == TopAbs_FACE || sub.ShapeType() == TopAbs_EDGE || sub.ShapeType() == TopAbs_VERTEX) {
+      Bnd_Box box;
+      BRepBndLib::Add(sub, box);
+      const gp_Pnt c = box.IsVoid() ? gp_Pnt() : gp_Pnt((box.CornerMin().XYZ() + box.CornerMax().XYZ()) / 2);
+      out << " near (" << c.X() << ", " << c.Y() << ", " << c.Z() << ")";
+    }
+    out << ": ";
+    BRepCheck::Print(status, out);
+  };
+  const std::pair<TopAbs_ShapeEnum, const char*> kinds[] = {{TopAbs_VERTEX, "vertex"}, {TopAbs_EDGE, "edge"},
+                                                            {TopAbs_WIRE, "wire"},     {TopAbs_FACE, "face"},
+                                                            {TopAbs_SHELL, "shell"},   {TopAbs_SOLID, "solid"}};
+  for (const auto& [type, kind] : kinds) {
+    TopTools_IndexedMapOfShape subs;
+    TopExp::MapShapes(shape, type, subs);
+    for (int i = 1; i <= subs.Extent(); ++i) {
+      const Handle(BRepCheck_Result)& result = analyzer.Result(subs(i));
+      if (result.IsNull()) continue;
+      for (BRepCheck_Status status : result->Status()) note(kind, i, subs(i), status);
+      for (result->InitContextIterator(); result->MoreShapeInContext(); result->NextShapeInContext())
+        for (BRepCheck_Status status : result->StatusOnShape()) note(kind, i, subs(i), status);
+    }
+  }
+  if (found > limit) out << " (" << found - limit << " more)";
+  std::string text = out.str();
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
 }
 
 StepExportReport describe_solid(const TopoDS_Shape& shape) {
@@ -254,15 +315,19 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
           if (null >= 0) dup2(null, 1), close(null);
         }
         return brep::guard_occt("building the result solid", [&]() {
-          const TopoDS_Shape solid = result_solid(s, params);
-          const StepExportReport r = describe_solid(solid);
+          CoarsenReport coarsened;
+          const TopoDS_Shape solid = result_solid(s, params, &coarsened);
+          StepExportReport r = describe_solid(solid);
+          r.triangles = coarsened.triangles_after;
+          r.unmerged_bodies = coarsened.unmerged_bodies;
           const int bodies = result_bodies(s);
           if (!r.valid || r.solids != bodies)
             throw Error(ErrorCode::InvalidShape,
                         "the result solid is not " + std::to_string(bodies) + " valid solid(s) (" +
-                            std::to_string(r.solids) + " solids, OCCT's check " + (r.valid ? "passed" : "failed") +
+                            std::to_string(r.solids) + " solids, OCCT's check " +
+                            (r.valid ? std::string("passed") : "failed: " + solid_faults(solid, 3)) +
                             "); the STL is written: try other smoothing settings (\"optimization.smooth\")");
-          write_step_file(solid, path);
+          write_step_file(solid, path, params.pcurves);
           return report_text(r);
         });
       },

@@ -10,6 +10,7 @@
 
 #include "common/progress.h"
 #include "result/iso_surface.h"
+#include "result/step_coarsen.h"
 
 class TopoDS_Shape;
 
@@ -24,28 +25,38 @@ struct StepExportParams {
   /// Angle (radians) within which two facets count as coplanar when merging. Ω's planar faces
   /// are exactly planar; a small value keeps the free-form region's facets apart.
   double angular_tolerance = 1e-6;
+  /// The free-form region's coarsening before it becomes faces (step_coarsen.h;
+  /// coarsen.tolerance <= 0: every triangle becomes a face).
+  CoarsenParams coarsen;
+  /// Write the edges' 2D curves on their planes (STEP PCURVEs). Off: the planes' edges are
+  /// written as 3D lines only (a reader computes the 2D curves of a planar face), which
+  /// makes the file about half as large.
+  bool pcurves = false;
 };
 
 /// What the solid written holds, as OCCT's checks found it after building.
 struct StepExportReport {
-  bool valid = false;      ///< BRepCheck_Analyzer found no fault
-  int solids = 0;          ///< solids in the shape (1 when all went well)
-  int faces = 0;           ///< B-Rep faces after merging
-  int planar_faces = 0;    ///< faces on a Geom_Plane
-  double volume = 0;       ///< mm³, by OCCT's GProp
-  double seconds = 0;      ///< building, checking and writing (wall time)
-  double cpu_seconds = 0;  ///< the same in CPU time of the child that did it
-  long bytes = 0;          ///< size of the STEP file
+  bool valid = false;       ///< BRepCheck_Analyzer found no fault
+  int solids = 0;           ///< solids in the shape (1 when all went well)
+  int faces = 0;            ///< B-Rep faces after merging
+  int planar_faces = 0;     ///< faces on a Geom_Plane
+  long triangles = 0;       ///< triangles that became faces (after coarsening), before merging
+  int unmerged_bodies = 0;  ///< bodies written as facets: OCCT's check refused their merged faces
+  double volume = 0;        ///< mm³, by OCCT's GProp
+  double seconds = 0;       ///< building, checking and writing (wall time)
+  double cpu_seconds = 0;   ///< the same in CPU time of the child that did it
+  long bytes = 0;           ///< size of the STEP file
 };
 
-/// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): a planar
+/// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): the
+/// free-form region coarsened (params.coarsen; `coarsened`, optional: what it did), a planar
 /// face per triangle sharing its edges with the neighbours, then, with params.unify, coplanar
 /// faces merged. One solid per body of the surface (result_bodies; a compound of them when
 /// there are several, e.g. a detached non-design solid), closed voids as inner shells of the
 /// body holding them. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
 /// first triangle without area or an open surface (what to change: the smoothing settings).
 /// Runs OCCT in this process: callers with foreign or untrusted surfaces use write_result_step.
-TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {});
+TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {}, CoarsenReport* coarsened = nullptr);
 
 /// The bodies of the result surface `s`: its pieces (triangles sharing points) that enclose a
 /// positive volume (a piece of negative volume is a closed void inside a body).
@@ -54,6 +65,12 @@ int result_bodies(const TriSurface& s);
 /// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer) and
 /// measures its volume; seconds and bytes are left 0.
 StepExportReport describe_solid(const TopoDS_Shape& shape);
+
+/// What OCCT's BRepCheck_Analyzer refuses in `shape`: up to `limit` faults, each as the kind
+/// and index of the sub-shape (OCCT's TopExp order), where it lies (centre of its box, for
+/// vertices, edges and faces) and the check that failed, e.g. "face 12 near (1, 2, 3):
+/// Self Intersecting Wire"; "" when the shape is valid.
+std::string solid_faults(const TopoDS_Shape& shape, int limit = 5);
 
 /// Builds result_solid(s) and writes it to `path` as STEP (AP214, mm), in a child process
 /// with the time budget params.seconds, so that a fault or a hang inside OCCT costs the

@@ -8,6 +8,7 @@ FreeCAD, and comes back as a TopOptError. Arguments are checked here before anyt
 import json
 import os
 import shutil
+import tempfile
 
 import Part
 
@@ -448,39 +449,39 @@ def export_stl(study, path):
 
 def export_step(study, path, threshold=None):
     """Writes the study's result as one CAD solid to a STEP file at `path`, at `threshold` (None:
-    the study's current Threshold, where the threshold slider left it): at the last run's
-    threshold the result.step that run wrote, at another one the result shape there made a
-    solid (threshold_solid.solid_at). Returns the path. Raises TopOptError if the study has no
-    result, if its run wrote no STEP file (saying which setting to turn on), if the folder does
-    not exist, or if the file cannot be written."""
-    from . import asbuilt, threshold_solid
+    the study's current Threshold, where the threshold slider left it): the run's result.step at
+    the run's threshold, else the shape at that threshold written by the core from the stored
+    densities (asbuilt.step_at_threshold). Returns the path. Raises TopOptError if the study has
+    no result, if its run wrote no STEP file (saying which setting to turn on), if the shape
+    cannot become a valid solid, if the folder does not exist, or if the file cannot be
+    written."""
+    from . import asbuilt
     path = _output_path(study, path, ".step")
-    t = threshold_solid.chosen(study, threshold)
-    if threshold_solid.is_the_runs(study, t):
-        source = asbuilt.step_path(study)
+    folder = tempfile.mkdtemp(prefix="topopt-step-")
+    try:
+        source = asbuilt.step_at_threshold(study, folder, threshold)
         return _written(path, lambda: shutil.copyfile(source, path))
-    solid = threshold_solid.solid_at(study, t)
-    return _written(path, lambda: solid.exportStep(path))
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def result_solid(study, threshold=None):
-    """Adds (or refreshes) the study's ResultSolid: a Part::Feature holding the result as one
-    solid at `threshold` (None: the study's current Threshold, where the threshold slider left
-    it): at the last run's threshold the solid read from the result.step it wrote, at another
-    one the result shape there made a solid (threshold_solid.solid_at); in one undo step ("TopOpt
-    result as solid"). Returns the feature. Raises TopOptError if the study has no result or
-    its run wrote no STEP file (saying which setting to turn on), or if the shape is not one
+    """Adds (or refreshes) the study's ResultSolid: a Part::Feature holding the one solid read
+    from the study's result as STEP at `threshold` (None: the study's current Threshold, where
+    the threshold slider left it; asbuilt.step_at_threshold), in one undo step ("TopOpt result
+    as solid"). Returns the feature. Raises TopOptError if the study has no result or its run
+    wrote no STEP file (saying which setting to turn on), or if the file does not hold one
     valid solid; the document is then unchanged."""
-    from . import asbuilt, runner, threshold_solid
+    from . import asbuilt, runner
     from .study import is_study
     if not is_study(study):
         raise TopOptError("%r is not a TopOpt study: pass the object api.new_study returned" % (study,),
                           "InvalidParameter")
-    if study.Result is None:
-        raise TopOptError("the study has no result yet: run it first", "InvalidParameter")
-    t = threshold_solid.chosen(study, threshold)
-    shape = (asbuilt.read_step(asbuilt.step_path(study)) if threshold_solid.is_the_runs(study, t)
-             else threshold_solid.solid_at(study, t))
+    folder = tempfile.mkdtemp(prefix="topopt-step-")
+    try:
+        shape = asbuilt.read_step(asbuilt.step_at_threshold(study, folder, threshold))
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
     with runner.transaction(study.Document, "TopOpt result as solid"):
         feature = asbuilt.make_solid_feature(study, shape)
         quiet.recompute(study.Document)

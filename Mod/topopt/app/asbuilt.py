@@ -106,6 +106,42 @@ def step_path(study):
     return path
 
 
+def run_threshold(study):
+    """The threshold of the shape in the study's result.step (verification.json's step
+    section), or None when the run wrote no STEP or recorded no threshold."""
+    value = verification_report(study).get("step", {}).get("threshold")
+    return float(value) if isinstance(value, (int, float)) else None
+
+
+def step_at_threshold(study, folder, threshold=None, timeout=None):
+    """The path of a STEP file holding the study's result at `threshold` (None: the study's
+    current Threshold, what the threshold slider shows; threshold_solid.chosen): the run's
+    result.step at the run's threshold (threshold_solid.is_the_runs), else one the worker
+    writes into `folder` from the stored densities (extract_surface with "step", the shape the
+    slider shows). Raises TopOptError when the study has no result, the threshold is outside
+    (0, 1), or the shape cannot become a valid solid (saying what to change)."""
+    from . import threshold_solid
+    run_step = step_path(study)  # a run that wrote no STEP (WriteStep off) gets none at any threshold
+    threshold = threshold_solid.chosen(study, threshold)
+    if threshold_solid.is_the_runs(study, threshold):
+        return run_step
+    from . import checks, worker
+    if not study.Densities:
+        raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
+    nodes, tets, domain, densities = checks.stored_mesh(study)
+    result = worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
+                                                   "densities": densities},
+                        params={"threshold": threshold, "step": 1}, timeout=timeout)
+    data = result.get("files", {}).get(STEP)
+    if not data:
+        raise TopOptError("the result at threshold %.3f could not be written as a STEP solid: move the threshold "
+                          "slider and try again" % threshold, "InvalidShape")
+    path = os.path.join(folder, STEP)
+    with open(path, "wb") as f:
+        f.write(data)
+    return path
+
+
 def read_step(path):
     """The shape in the STEP file at `path` (Part.read: FreeCAD 0.20 and 1.x alike), checked
     to hold one valid solid. Raises TopOptError otherwise."""

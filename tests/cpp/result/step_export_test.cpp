@@ -42,10 +42,14 @@ int faces_on_plane_x(const TopoDS_Shape& shape, double x0) {
   return n;
 }
 
+/// The export without coarsening: every triangle of the surface becomes (part of) a face, so
+/// the solid's volume is the surface's exactly.
+const StepExportParams kFacets{.coarsen = {.tolerance = 0}};
+
 TEST(StepExport, OneValidSolidWithTheSurfacesVolumeAndMergedPlanarFaces) {
   const TriSurface s = bar_surface();
   const double volume = check_surface(s.V, s.F).volume;
-  const TopoDS_Shape solid = result_solid(s);
+  const TopoDS_Shape solid = result_solid(s, kFacets);
   const StepExportReport r = describe_solid(solid);
   EXPECT_TRUE(r.valid);
   EXPECT_EQ(r.solids, 1);
@@ -60,7 +64,7 @@ TEST(StepExport, OneValidSolidWithTheSurfacesVolumeAndMergedPlanarFaces) {
   for (long q = 0; q < s.tag.size(); ++q) free_form += s.tag[q] == 0;
   EXPECT_LE(r.faces, free_form + r.planar_faces);
   // without merging every triangle is a face
-  EXPECT_EQ(describe_solid(result_solid(s, {.unify = false})).faces, s.F.rows());
+  EXPECT_EQ(describe_solid(result_solid(s, {.unify = false, .coarsen = {.tolerance = 0}})).faces, s.F.rows());
 }
 
 TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
@@ -70,14 +74,14 @@ TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
   const double volume = check_surface(bar.V, bar.F).volume;
   const TriSurface two = testing::with_cube(bar, {20, 16, 1}, 3);  // clear of the bar
   EXPECT_EQ(result_bodies(two), 2);
-  StepExportReport r = describe_solid(result_solid(two));
+  StepExportReport r = describe_solid(result_solid(two, kFacets));
   EXPECT_TRUE(r.valid);
   EXPECT_EQ(r.solids, 2);
   EXPECT_NEAR(r.volume, volume + 27, 1e-6 * volume);
   // a closed void inside the first end block (x in [0, 6], y in [6, 14], z in [2, 8])
   const TriSurface hollow = testing::with_cube(bar, {2, 9, 4}, 2, true);
   EXPECT_EQ(result_bodies(hollow), 1);
-  r = describe_solid(result_solid(hollow));
+  r = describe_solid(result_solid(hollow, kFacets));
   EXPECT_TRUE(r.valid);
   EXPECT_EQ(r.solids, 1);
   EXPECT_NEAR(r.volume, volume - 8, 1e-6 * volume);
@@ -116,7 +120,7 @@ TEST(StepExport, AnOpenOrDegenerateSurfaceIsANamedError) {
   TriSurface flat = s;
   flat.V.row(flat.F(0, 2)) = (flat.V.row(flat.F(0, 0)) + flat.V.row(flat.F(0, 1))) / 2;
   try {
-    result_solid(flat);
+    result_solid(flat, kFacets);
     FAIL() << "a triangle without area became a face";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidShape);

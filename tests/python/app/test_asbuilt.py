@@ -1,6 +1,6 @@
 """The result back in CAD and verified, in FreeCADCmd: a run keeps result.step and the
 verification's files in the study; api.result_solid makes a Part solid from the STEP (one undo
-step), api.export_step writes it, both refuse cleanly (naming the setting) when the run wrote
+step), api.export_step writes it, both at the threshold the slider shows, both refuse cleanly (naming the setting) when the run wrote
 no STEP; the verification becomes a FEM mesh, a FEM result and a fields pipeline whose largest
 von Mises stress is verification.json's; a re-run without the files removes what they made."""
 import json
@@ -70,6 +70,25 @@ class ResultAsBuilt(unittest.TestCase):
         with self.assertRaises(TopOptError) as e:
             api.export_step(self.study, os.path.join(self.folder, "no", "such", "beam.step"))
         self.assertIn("does not exist", str(e.exception))
+
+    def test_step_and_solid_follow_the_threshold_slider(self):
+        from topopt.app import runner
+        run_threshold = self.study.Threshold
+        self.assertAlmostEqual(asbuilt.run_threshold(self.study), run_threshold)
+        run_volume = Part.read(asbuilt.step_path(self.study)).Volume
+        try:
+            runner.reextract(self.study, 0.7 if run_threshold < 0.6 else 0.3)
+            mesh_volume = self.study.Result.Mesh.Volume
+            shape = Part.read(api.export_step(self.study, os.path.join(self.folder, "moved.step")))
+            self.assertEqual(len(shape.Solids), 1)
+            self.assertTrue(shape.isValid())
+            # the shape the slider shows, not the run's
+            self.assertLess(abs(shape.Volume - mesh_volume) / mesh_volume, 0.005)
+            self.assertGreater(abs(shape.Volume - run_volume) / run_volume, 0.02)
+            solid = api.result_solid(self.study).Shape
+            self.assertLess(abs(solid.Volume - mesh_volume) / mesh_volume, 0.005)
+        finally:
+            runner.reextract(self.study, run_threshold)
 
     def test_verification_of_the_run_is_in_fem(self):
         report = json.loads(self.study.VerificationReport)

@@ -1,0 +1,226 @@
+// Edge collapses on the result's free-form region within a chordal tolerance (see step_coarsen.h).
+#include "result/step_coarsen.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "result/result_check.h"
+
+namespace topopt::result {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Tri = std::array<int, 3>;
+
+/// The median length of the free-form triangles' edges (0 when there are none).
+double median_free_edge(const TriSurface& s) {
+  std::vector<double> lengths;
+  for (long q = 0; q < s.F.rows(); ++q)
+    if (s.tag[q] == 0)
+      for (int k = 0; k < 3; ++k) lengths.push_back((s.V.row(s.F(q, k)) - s.V.row(s.F(q, (k + 1) % 3))).norm());
+  if (lengths.empty()) return 0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+/// The surface under collapse: triangles alive or removed, the triangles around each point,
+/// and for each triangle the removed points it now stands for (they must stay within the
+/// tolerance of it).
+class Collapser {
+ public:
+  Collapser(const TriSurface& s, const CoarsenParams& params, double tolerance)
+      : s_(s), params_(params), tolerance_(tolerance), around_(s.V.rows()) {
+    for (long q = 0; q < s.F.rows(); ++q) {
+      tri_.push_back({s.F(q, 0), s.F(q, 1), s.F(q, 2)});
+      for (int k = 0; k < 3; ++k) around_[s.F(q, k)].push_back(static_cast<int>(q));
+    }
+    alive_.assign(tri_.size(), true);
+    stands_for_.resize(tri_.size());
+  }
+
+  /// One sweep over the free-form edges, shortest first; returns the points removed.
+  long sweep() {
+    std::vector<std::pair<double, std::pair<int, int>>> edges;
+    for (size_t t = 0; t < tri_.size(); ++t)
+      if (alive_[t] && s_.tag[t] == 0)
+        for (int k = 0; k < 3; ++k) {
+          const int a = tri_[t][k], b = tri_[t][(k + 1) % 3];
+          edges.push_back({(point(a) - point(b)).norm(), {a, b}});
+        }
+    std::sort(edges.begin(), edges.end());
+    long removed = 0;
+    for (const auto& [length, ab] : edges)
+      removed += try_collapse(ab.second, ab.first) || try_collapse(ab.first, ab.second);
+    return removed;
+  }
+
+  /// The surface with the triangles alive.
+  TriSurface surface() const {
+    TriSurface out = s_;
+    const long n = std::count(alive_.begin(), alive_.end(), true);
+    out.F.resize(n, 3);
+    out.tag.resize(n);
+    long row = 0;
+    for (size_t t = 0; t < tri_.size(); ++t)
+      if (alive_[t]) {
+        out.F.row(row) << tri_[t][0], tri_[t][1], tri_[t][2];
+        out.tag[row++] = s_.tag[t];
+      }
+    return out;
+  }
+
+ private:
+  Vec3 point(int i) const { return s_.V.row(i).transpose(); }
+
+  /// True when point b may go: free to move and only free-form triangles around it.
+  bool removable(int b) const {
+    if (removed_point(b) || s_.lock[b] != 0 || (s_.point_face.size() && s_.point_face[b] != 0)) return false;
+    return std::all_of(around_[b].begin(), around_[b].end(), [&](int t) { return !alive_[t] || s_.tag[t] == 0; });
+  }
+  bool removed_point(int i) const {
+    return std::none_of(around_[i].begin(), around_[i].end(), [&](int t) { return alive_[t]; });
+  }
+
+  /// The points joined to i by an edge.
+  std::vector<int> neighbours(int i) const {
+    std::vector<int> out;
+    for (int t : around_[i])
+      if (alive_[t])
+        for (int v : tri_[t])
+          if (v != i) out.push_back(v);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  /// Link condition of the edge (a, b): exactly two triangles share it and the points joined
+  /// to both are their two opposite corners (so the collapse keeps the surface manifold).
+  bool link_condition(int a, int b, const std::vector<int>& gone) const {
+    if (gone.size() != 2) return false;
+    const std::vector<int> na = neighbours(a), nb = neighbours(b);
+    std::vector<int> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    return common.size() == 2;
+  }
+
+  /// Triangle t with point b replaced by a.
+  Tri moved(int t, int b, int a) const {
+    Tri out = tri_[t];
+    for (int& v : out)
+      if (v == b) v = a;
+    return out;
+  }
+
+  /// True when triangle `to` (t with b moved onto a) keeps its side and its shape.
+  bool shape_kept(int t, const Tri& to, double floor) const {
+    const Vec3 n0 = (point(tri_[t][1]) - point(tri_[t][0])).cross(point(tri_[t][2]) - point(tri_[t][0]));
+    const Vec3 n1 = (point(to[1]) - point(to[0])).cross(point(to[2]) - point(to[0]));
+    if (n1.norm() <= 1e-12 * std::max(1.0, n0.norm()) || n0.norm() == 0) return false;
+    if (n0.normalized().dot(n1.normalized()) < std::cos(params_.max_normal_turn)) return false;
+    return min_triangle_angle(s_.V, to[0], to[1], to[2]) >= floor;
+  }
+
+  /// The triangle among `kept` nearest to p, and its distance.
+  std::pair<int, double> nearest(const Vec3& p, const std::vector<std::pair<int, Tri>>& kept) const {
+    std::pair<int, double> best{-1, 1e300};
+    for (const auto& [t, tri] : kept) {
+      const double d = point_triangle_distance(p, point(tri[0]), point(tri[1]), point(tri[2]));
+      if (d < best.second) best = {t, d};
+    }
+    return best;
+  }
+
+  /// Removes b by joining it to a when every condition holds; returns whether it did.
+  bool try_collapse(int b, int a) {
+    if (!removable(b) || removed_point(a)) return false;
+    std::vector<int> gone;
+    std::vector<std::pair<int, Tri>> kept;
+    double floor = params_.min_angle;
+    for (int t : around_[b]) {
+      if (!alive_[t]) continue;
+      floor = std::min(floor, min_triangle_angle(s_.V, tri_[t][0], tri_[t][1], tri_[t][2]));
+      if (std::find(tri_[t].begin(), tri_[t].end(), a) != tri_[t].end())
+        gone.push_back(t);
+      else
+        kept.push_back({t, moved(t, b, a)});
+    }
+    // kept.size() < 2: b has three neighbours (a tetrahedron's corner would fold it flat)
+    if (!link_condition(a, b, gone) || kept.size() < 2) return false;
+    for (const auto& [t, to] : kept)
+      if (!shape_kept(t, to, floor)) return false;
+    std::vector<int> points{b};
+    for (int t : around_[b])
+      if (alive_[t]) points.insert(points.end(), stands_for_[t].begin(), stands_for_[t].end());
+    std::vector<int> home;
+    for (int p : points) {
+      const auto [t, d] = nearest(point(p), kept);
+      if (d > tolerance_) return false;
+      home.push_back(t);
+    }
+    commit(b, a, gone, kept, points, home);
+    return true;
+  }
+
+  void commit(int b, int a, const std::vector<int>& gone, const std::vector<std::pair<int, Tri>>& kept,
+              const std::vector<int>& points, const std::vector<int>& home) {
+    for (int t : around_[b])
+      if (alive_[t]) stands_for_[t].clear();
+    for (int t : gone) alive_[t] = false;
+    for (const auto& [t, to] : kept) tri_[t] = to, around_[a].push_back(t);
+    for (size_t k = 0; k < points.size(); ++k) stands_for_[home[k]].push_back(points[k]);
+    around_[b].clear();
+  }
+
+  const TriSurface& s_;
+  const CoarsenParams& params_;
+  const double tolerance_;
+  std::vector<Tri> tri_;
+  std::vector<bool> alive_;
+  std::vector<std::vector<int>> around_;
+  std::vector<std::vector<int>> stands_for_;
+};
+
+}  // namespace
+
+double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+    return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+  const double denom = 1 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+TriSurface coarsen_free_form(const TriSurface& s, const CoarsenParams& params, CoarsenReport* report) {
+  CoarsenReport r;
+  r.triangles_before = r.triangles_after = s.F.rows();
+  r.tolerance = params.tolerance * median_free_edge(s);
+  if (report) *report = r;
+  if (r.tolerance <= 0) return s;
+  Collapser collapser(s, params, r.tolerance);
+  for (int pass = 0; pass < params.passes; ++pass)
+    if (collapser.sweep() == 0) break;
+  TriSurface out = collapser.surface();
+  r.reverted = !check_result(out, 1).valid();
+  if (r.reverted) out = s;
+  r.triangles_after = out.F.rows();
+  if (report) *report = r;
+  return out;
+}
+
+}  // namespace topopt::result

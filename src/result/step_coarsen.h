@@ -1,0 +1,50 @@
+// Fewer facets for the result's CAD solid: the free-form region of the result surface (the
+// iso-surface, tag 0) coarsened by edge collapses within a chordal tolerance before it becomes
+// B-Rep faces (step_export.h), so that result.step holds fewer faces. Ω's kept faces and the
+// non-design solids' faces are never touched: a point is removed only when every triangle
+// around it is free-form and it is free to move (lock 0, not on a cut line), and no point is
+// ever moved, so every kept point is a point of the surface it came from.
+#pragma once
+#include "result/iso_surface.h"
+
+namespace topopt::result {
+
+struct CoarsenParams {
+  /// Chordal tolerance as a fraction of the median edge length of the free-form triangles:
+  /// no removed point lies farther than this from the coarsened surface (<= 0: nothing is
+  /// removed). The median edge is about the FE size, so 0.05 is well below it.
+  double tolerance = 0.05;
+  /// Largest turn (radians) of a triangle's normal that a collapse may cause.
+  double max_normal_turn = 0.5;
+  /// Smallest angle (degrees) of a triangle a collapse makes, unless the triangles it replaces
+  /// already had a smaller one (then that one is the floor).
+  double min_angle = 5.0;
+  int passes = 8;  ///< sweeps over the edges, shortest first; stops early when one removes nothing
+};
+
+/// What coarsen_free_form did.
+struct CoarsenReport {
+  long triangles_before = 0;  ///< triangles of the surface given
+  long triangles_after = 0;   ///< triangles of the surface returned
+  double tolerance = 0;       ///< the chordal tolerance used, mm
+  bool reverted = false;      ///< the coarsened surface crossed itself: the one given was returned
+  /// Set by result_solid: bodies whose merged faces OCCT's check refused, written as facets.
+  int unmerged_bodies = 0;
+};
+
+/// Distance (mm) from point p to the triangle (a, b, c) (all 3-vectors), by the region of
+/// the closest point (a corner, an edge or the inside).
+double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c);
+
+/// `s` (a closed, outward, self-intersection-free result surface) with points of its free-form
+/// region removed by edge collapses (the removed point joins a neighbour) while every removed
+/// point stays within the tolerance of the new surface, no normal turns past
+/// params.max_normal_turn, no new triangle is sharper than params.min_angle and the surface
+/// stays manifold (link condition). The result is checked by the product's exact result check
+/// (check_result); if it is not valid, the surface given is returned unchanged (report->reverted).
+/// s.V and the per-point arrays are kept as they are (removed points are simply unused);
+/// s.F and s.tag shrink.
+TriSurface coarsen_free_form(const TriSurface& s, const CoarsenParams& params = {}, CoarsenReport* report = nullptr);
+
+}  // namespace topopt::result
