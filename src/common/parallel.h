@@ -1,4 +1,5 @@
-// A minimal parallel loop over index ranges on std::threads (no OpenMP, no global pool).
+// A minimal parallel loop over index ranges on the process's persistent worker threads
+// (common/thread_pool.h; no OpenMP), and a work queue on std::threads for uneven tasks.
 #pragma once
 #include <sched.h>
 
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "common/progress.h"
+#include "common/thread_pool.h"
 
 namespace topopt {
 
@@ -33,8 +35,11 @@ inline int thread_count(int requested) {
   return hw == 0 ? 1 : static_cast<int>(hw);
 }
 
-/// Calls fn(begin, end) on `threads` contiguous chunks of [0, n) in parallel; runs inline
-/// when n is small or threads == 1. fn must only write to data owned by its range.
+/// Calls fn(begin, end) on `threads` contiguous chunks of [0, n) in parallel, on the calling
+/// thread and the workers of shared_pool (at most its workers + 1 chunks); runs fn(0, n) inline
+/// when n is small (fewer than 2 * min_chunk), threads == 1, or the pool is taken (another
+/// thread's loop, or a loop nested in a chunk). fn must only write to data owned by its range.
+/// The first exception a chunk throws is rethrown here.
 template <class Fn>
 void parallel_for(long n, int threads, Fn&& fn, long min_chunk = 2048) {
   threads = static_cast<int>(std::max<long>(1, std::min<long>(threads, (n + min_chunk - 1) / min_chunk)));
@@ -42,15 +47,19 @@ void parallel_for(long n, int threads, Fn&& fn, long min_chunk = 2048) {
     if (n > 0) fn(0L, n);
     return;
   }
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  long chunk = (n + threads - 1) / threads;
-  for (int t = 1; t < threads; ++t) {
-    long b = t * chunk, e = std::min(n, b + chunk);
-    if (b < e) pool.emplace_back([&fn, b, e] { fn(b, e); });
-  }
-  fn(0L, std::min(n, chunk));
-  for (auto& th : pool) th.join();
+  ThreadPool& pool = shared_pool(threads);
+  struct Job {
+    Fn& fn;
+    long n, chunk;
+  } job{fn, n, 0};
+  const int parts = std::min(threads, pool.workers() + 1);
+  job.chunk = (n + parts - 1) / parts;
+  auto part = [](void* context, int i) {
+    Job& j = *static_cast<Job*>(context);
+    const long b = i * j.chunk, e = std::min(j.n, b + j.chunk);
+    if (b < e) j.fn(b, e);
+  };
+  if (parts <= 1 || !pool.run_parts(parts, part, &job)) fn(0L, n);
 }
 
 /// Work queue: calls task(i, progress) for every i of `order` on `threads` threads, each taking

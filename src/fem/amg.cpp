@@ -219,7 +219,8 @@ struct SmoothedAggregationAmg::Impl {
   /// the matrix changed a little), else 15 from a fixed start.
   void estimate_lambda(Level& L, int steps = 15) const;
   void inverse_diagonal(Level& L) const;
-  void factor_coarsest();
+  /// Cholesky of the coarsest matrix; `numeric_only`: its pattern is the one factorised last.
+  void factor_coarsest(bool numeric_only = false);
   /// The tentative prolongator Pt from level matrix A (rows grouped into nodes by node_ptr,
   /// near-null modes `modes`, #rows by `modes_count`) to the next level, whose node offsets and
   /// modes it sets: strength graph, aggregation, modes orthonormalised per aggregate. Returns false if
@@ -263,7 +264,7 @@ void SmoothedAggregationAmg::Impl::estimate_lambda(Level& L, int steps) const {
   L.lambda = std::max(lambda, 1e-300);
 }
 
-void SmoothedAggregationAmg::Impl::factor_coarsest() {
+void SmoothedAggregationAmg::Impl::factor_coarsest(bool numeric_only) {
   // Sparse Cholesky of the coarsest matrix (its lower triangle).
   const CsrMatrix& Ac = *levels.back().A;
   std::vector<Eigen::Triplet<double, int>> trip;
@@ -277,7 +278,10 @@ void SmoothedAggregationAmg::Impl::factor_coarsest() {
   // orderings costs more than the fill it saves (measured on the rocker's 8.7 k coarse level).
   coarse.cholmod().nmethods = 1;
   coarse.cholmod().method[0].ordering = CHOLMOD_AMD;
-  coarse.compute(S);
+  if (numeric_only)
+    coarse.factorize(S);
+  else
+    coarse.compute(S);
   if (coarse.info() != Eigen::Success)
     throw Error(ErrorCode::NoSupport,
                 "the coarse multigrid matrix is not positive definite: the supports "
@@ -424,6 +428,21 @@ void SmoothedAggregationAmg::refresh_finest() {
     Impl::to_float(*m.levels[0].A, m.levels[0].Af);
   } else
     m.factor_coarsest();
+}
+
+void SmoothedAggregationAmg::refresh_galerkin() {
+  Impl& m = *impl_;
+  if (m.levels.empty()) throw Error(ErrorCode::Internal, "AMG: refresh before setup");
+  for (size_t l = 0; l + 1 < m.levels.size(); ++l) {
+    Level& L = m.levels[l];
+    m.inverse_diagonal(L);
+    m.estimate_lambda(L, 5);
+    Impl::to_float(*L.A, L.Af);
+    const CsrMatrix AP = multiply(*L.A, L.P, m.threads);
+    m.levels[l + 1].own = multiply(L.R, AP, m.threads);  // the next level's A points at it
+  }
+  m.inverse_diagonal(m.levels.back());
+  m.factor_coarsest(true);
 }
 
 void SmoothedAggregationAmg::apply(const double* r, double* z) const {

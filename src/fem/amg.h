@@ -69,6 +69,15 @@ class SmoothedAggregationAmg final : public Preconditioner {
   /// preconditioner; SIMP uses this between full setups while the iteration count stays low.
   void refresh_finest();
 
+  /// The finest matrix got new values (same pattern): recomputes every coarser matrix as the
+  /// Galerkin product R A P with the kept prolongators, level by level, with each level's
+  /// diagonal, eigenvalue bound and single-precision copy, and refactors the coarsest (numeric
+  /// only: its pattern is the setup's). Skips the aggregation and the prolongator smoothing of
+  /// a setup; the coarse correction stays exact for the new matrix on the old aggregates, so
+  /// the V-cycle stays close to a fresh setup's while SIMP's stiffness moves (the finest-only
+  /// refresh lets the coarse levels keep the old densities).
+  void refresh_galerkin();
+
   /// z = M⁻¹ r: one V-cycle from zero. r, z: n.
   void apply(const double* r, double* z) const;
   /// The same on vectors (the Preconditioner interface).

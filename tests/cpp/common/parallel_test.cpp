@@ -5,7 +5,11 @@
 #include <sched.h>
 #include <stdlib.h>
 
+#include <mutex>
+#include <set>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace topopt {
 namespace {
@@ -90,6 +94,65 @@ TEST(ParallelFor, CoversEveryIndexOnce) {
         for (long i = b; i < e; ++i) ++hits[i];
       },
       100);
+  for (int h : hits) ASSERT_EQ(h, 1);
+}
+
+TEST(ParallelFor, RunsOnTheSamePersistentThreadsEveryCall) {
+  // 200 loops at 2 threads: before, 200 new threads; now the caller and the pool's workers only
+  std::set<std::thread::id> seen;
+  std::mutex m;
+  for (int k = 0; k < 200; ++k)
+    parallel_for(
+        4, 2,
+        [&](long, long) {
+          std::lock_guard<std::mutex> lock(m);
+          seen.insert(std::this_thread::get_id());
+        },
+        1);
+  EXPECT_LE(static_cast<int>(seen.size()), shared_pool(2).workers() + 1);
+  EXPECT_GE(shared_pool(2).workers(), 1);
+  EXPECT_GE(seen.size(), 2u);  // the chunks did run on a second thread
+}
+
+TEST(ParallelFor, RethrowsAChunksException) {
+  EXPECT_THROW(parallel_for(
+                   1000, 2,
+                   [](long b, long) {
+                     if (b > 0) throw std::runtime_error("second chunk");
+                   },
+                   10),
+               std::runtime_error);
+  std::vector<int> hits(1000, 0);  // the pool still works afterwards
+  parallel_for(
+      1000, 2,
+      [&](long b, long e) {
+        for (long i = b; i < e; ++i) ++hits[i];
+      },
+      10);
+  for (int h : hits) ASSERT_EQ(h, 1);
+}
+
+TEST(ParallelFor, NestedAndConcurrentLoopsCoverEveryIndexOnce) {
+  // a loop inside a chunk, and two threads looping at once: the pool takes one job, the rest
+  // runs inline on its caller
+  std::vector<int> hits(4 * 1000, 0);
+  auto outer = [&](int base) {
+    parallel_for(
+        2, 2,
+        [&](long b, long e) {
+          for (long o = b; o < e; ++o)
+            parallel_for(
+                1000, 2,
+                [&](long ib, long ie) {
+                  for (long i = ib; i < ie; ++i) ++hits[(base + o) * 1000 + i];
+                },
+                10);
+        },
+        1);
+  };
+  std::thread other(outer, 2);
+  outer(0);
+  other.join();
   for (int h : hits) ASSERT_EQ(h, 1);
 }
 

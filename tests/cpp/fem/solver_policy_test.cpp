@@ -43,6 +43,19 @@ TEST(HierarchyReuse, KeptUntilTheIterationsGrowByHalf) {
   EXPECT_FALSE(r.keep(true));
 }
 
+TEST(HierarchyReuse, PatienceIsTheGrowthThatWouldRebuild) {
+  HierarchyReuse r(true);
+  r.set_up();
+  EXPECT_EQ(r.patience(5000), 5000);  // no baseline yet: the solver's own cap
+  r.record(12);
+  EXPECT_EQ(r.patience(5000), 22);  // 1.5 * 12 + 4
+  EXPECT_EQ(r.patience(15), 15);    // never above the solver's cap
+  r.record(22);                     // a solve that used all its patience does not count as grown
+  EXPECT_TRUE(r.keep(true));
+  r.set_up();
+  EXPECT_EQ(r.patience(5000), 5000);
+}
+
 TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
   HierarchyReuse r(false);
   r.set_up();
