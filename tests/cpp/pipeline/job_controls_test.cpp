@@ -110,7 +110,6 @@ TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
         std::string(e.what()).find("optimization.controls.overhang.base_face names Face9, but the part has only 6"),
         std::string::npos)
         << e.what();
-    }
   }
 }
 

@@ -81,7 +81,9 @@ TEST(KeepLoadedFaces, ABareLoadedFaceKeepsItsMaterialAndTheVerificationRuns) {
   // holds the whole 10 x 5 end face and the whole support face
   for (long t = 0; t < mesh.T.rows(); ++t)
     for (int k = 0; k < 4; ++k)
-      if (std::abs(mesh.V(mesh.T(t, k), 0) - 30) < 1e-9) EXPECT_EQ(r.simp.density[t], 1.0) << "tet " << t;
+      if (std::abs(mesh.V(mesh.T(t, k), 0) - 30) < 1e-9) {
+        EXPECT_EQ(r.simp.density[t], 1.0) << "tet " << t;
+      }
   EXPECT_NEAR(area_on(r.surface, 2), 50, 0.5);
   EXPECT_NEAR(area_on(r.surface, 1), 50, 0.5);
   result::VerificationProblem problem{job.material, job.supports, job.load_cases};
