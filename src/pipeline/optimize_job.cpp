@@ -136,21 +136,6 @@ double held_share(const TetMesh& mesh, const TetMesh& held) {
   return design > 0 ? layer / design : 0.0;
 }
 
-/// SIMP's volume fraction of the design tets left free beside a held layer that takes `share`
-/// of the design volume, so that the layer and the free design together keep the user's
-/// `fraction` of Ω. Throws when the layer alone reaches it.
-double fraction_beside_layer(double fraction, double share) {
-  if (share >= 0.95 * fraction) {
-    std::ostringstream m;
-    m << "the layer kept solid on the loaded and supported faces is " << 100 * share
-      << " % of the part's design volume, too close to \"optimization.volume_fraction\" (" << fraction
-      << "): raise the volume fraction, mesh finer (a thinner layer: smaller \"mesh.size\"), or set "
-         "\"optimization.keep_loaded_faces\": false";
-    throw Error(ErrorCode::InvalidParameter, m.str());
-  }
-  return (fraction - share) / (1 - share);
-}
-
 }  // namespace
 
 std::vector<int> loaded_faces(const Job& job) {
@@ -248,10 +233,6 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   const auto t0 = std::chrono::steady_clock::now();
   TetMesh held;  // keep_loaded_faces: the layer on loaded and supported faces non-design for SIMP
   const bool holding = set.keep_loaded_faces && hold_loaded_faces(mesh, job, progress, held);
-  // the layer is design material: it counts in the volume fraction (and the shape keeps it)
-  const double share = holding ? held_share(mesh, held) : 0.0;
-  if (holding && simp.responses.objective != simp::Objective::Mass)
-    simp.volume_fraction = fraction_beside_layer(set.simp.volume_fraction, share);
   r.simp =
       (runner ? runner : SimpRunner(simp::optimize))(holding ? held : mesh, job.material, supports, loads, weights,
                                                      simp, progress, on_iteration, fem::gravity_of(job.load_cases));
@@ -261,8 +242,9 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // the shape keeps the volume SIMP ended with (under a mass objective, what the limits left)
   const double simp_kept = simp.responses.objective == simp::Objective::Mass && !r.simp.history.empty()
                                ? r.simp.history.back().volume_fraction
-                               : simp.volume_fraction;
-  // ... of SIMP's design domain; with the held layer, the user's fraction of Ω's design volume
+                               : set.simp.volume_fraction;
+  // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
+  const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;
   r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold,
                              anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report);

@@ -18,13 +18,12 @@ namespace topopt::pipeline {
 namespace {
 
 /// A 30 x 10 x 5 mm box in 2 mm cells, all design, fixed at Face1 (x = 0), pulled down by
-/// 100 N on its bare end face Face2 (x = 30); 30 iterations at volume fraction 0.4 (the two
-/// held layers take 0.13 of it, SIMP shares the other 0.27 out).
+/// 100 N on its bare end face Face2 (x = 30); 30 iterations at volume fraction 0.3.
 Job bare_cantilever(bool keep) {
   Job job = parse_job(
       R"({"supports": [{"type": "fixed", "faces": ["Face1"]}],
           "load_cases": [{"name": "tip", "loads": [{"type": "force", "faces": ["Face2"], "vector": [0, -100, 0]}]}],
-          "optimization": {"volume_fraction": 0.4, "max_iterations": 30, "keep_loaded_faces": )" +
+          "optimization": {"volume_fraction": 0.3, "max_iterations": 30, "keep_loaded_faces": )" +
           std::string(keep ? "true" : "false") + "}}",
       "/tmp");
   return job;
@@ -109,29 +108,6 @@ TEST(KeepLoadedFaces, OffTheOptimisationIsFreeOnTheLoadedFace) {
     for (int k = 0; k < 4; ++k)
       if (std::abs(mesh.V(mesh.T(t, k), 0) - 30) < 1e-9) lowest = std::min(lowest, r.simp.density[t]);
   EXPECT_LT(lowest, 0.5);
-}
-
-TEST(KeepLoadedFaces, TheLayerCountsInTheVolumeFractionAndOneTooLargeIsRefused) {
-  const TetMesh mesh = bare_box();  // the two layers are 2 of the 15 cells along x: 0.133
-  Job job = bare_cantilever(true);
-  job.optimization.simp.max_iterations = 3;
-  const OptimizeResult r = optimize_job(job, mesh, Progress{});
-  double kept = 0;  // the result shape's volume (divergence theorem over its closed surface)
-  for (long q = 0; q < r.surface.F.rows(); ++q) {
-    const Eigen::Vector3d a = r.surface.V.row(r.surface.F(q, 0)), b = r.surface.V.row(r.surface.F(q, 1)),
-                          c = r.surface.V.row(r.surface.F(q, 2));
-    kept += a.dot(b.cross(c)) / 6;
-  }
-  EXPECT_NEAR(kept / 1500.0, 0.4, 0.02) << "the shape with its layers keeps the user's fraction";
-  job.optimization.simp.volume_fraction = 0.12;
-  try {
-    optimize_job(job, mesh, Progress{});
-    ADD_FAILURE() << "a layer of 0.133 accepted under a volume fraction of 0.12";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::InvalidParameter);
-    EXPECT_NE(std::string(e.what()).find("keep_loaded_faces"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("volume_fraction"), std::string::npos) << e.what();
-  }
 }
 
 }  // namespace
