@@ -52,6 +52,8 @@ def _describe(value):
         return ("shape", value.ShapeType, len(value.Faces), round(value.Volume, 6))
     if type(value).__name__ in ("Vector", "Placement", "Rotation", "Quantity"):
         return str(value)
+    if isinstance(value, float):  # a document keeps 16 significant digits of a float, not 17
+        return "%.15g" % value
     text = repr(value)
     if " at 0x" in text:  # a Python object (a proxy): its class, not its address
         return ("instance", type(value).__module__, type(value).__name__)
