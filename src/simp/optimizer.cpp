@@ -104,11 +104,13 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
 
 ComplianceProblem::~ComplianceProblem() = default;
 
-void ComplianceProblem::filtered(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde) const {
+ComplianceProblem::Stages ComplianceProblem::filtered(const VecXd& x) const {
+  Stages s;
   const VecXd z = controls_->apply(x);
-  rho_filtered = params_.sensitivity_filter ? z : filter_->apply(z);
-  rho_tilde = draw_ ? draw_->apply(rho_filtered) : rho_filtered;
-  if (overhang_) rho_tilde = overhang_->apply(rho_tilde);
+  s.filtered = params_.sensitivity_filter ? z : filter_->apply(z);
+  s.drawn = draw_ ? draw_->apply(s.filtered) : s.filtered;
+  s.tilde = overhang_ ? overhang_->apply(s.drawn) : s.drawn;
+  return s;
 }
 
 VecXd ComplianceProblem::project(const VecXd& rho_tilde, double eta) const {
@@ -124,25 +126,19 @@ int ComplianceProblem::num_variables() const { return controls_->num_variables()
 
 VecXd ComplianceProblem::design_field(const VecXd& x) const { return controls_->apply(x); }
 
-VecXd ComplianceProblem::physical(const VecXd& x) const {
-  VecXd rf, rt;
-  filtered(x, rf, rt);
-  return project(rt, eta_.intermediate);
-}
+VecXd ComplianceProblem::physical(const VecXd& x) const { return project(filtered(x).tilde, eta_.intermediate); }
 
 VecXd ComplianceProblem::physical_to_variables(const VecXd& x, const VecXd& d) const {
-  VecXd rf, rt;
-  filtered(x, rf, rt);
-  return chain(rf, rt, d, eta_.intermediate);
+  return chain(filtered(x), d, eta_.intermediate);
 }
 
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   const int num_design = static_cast<int>(design_.size());
-  filtered(x, rho_filtered_, rho_tilde_);
-  rho_bar_ = project(rho_tilde_, eta_.eroded);
+  stages_ = filtered(x);
+  rho_bar_ = project(stages_.tilde, eta_.eroded);
   if (robust_)  // the dilated volume's bound follows the intermediate design (Wang et al. 2011)
-    volume_scale_ = volume_of(project(rho_tilde_, eta_.intermediate)) /
-                    std::max(1e-300, volume_of(project(rho_tilde_, eta_.dilated)));
+    volume_scale_ = volume_of(project(stages_.tilde, eta_.intermediate)) /
+                    std::max(1e-300, volume_of(project(stages_.tilde, eta_.dilated)));
   // ---- FE analysis
   for (int i = 0; i < num_design; ++i) scale_[design_[i]] = params_.law.stiffness(rho_bar_[i]);
   fe_->set_scale(scale_);
@@ -162,18 +158,18 @@ double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
     c += weights_[k] * F.col(k).dot(U_.col(k));
     if (dc) dc_bar += weights_[k] * (load_derivative(2 * U_.col(k), k) - stiffness_derivative(U_.col(k), U_.col(k)));
   }
-  if (dc) *dc = chain(rho_filtered_, rho_tilde_, dc_bar, eta_.eroded);
+  if (dc) *dc = chain(stages_, dc_bar, eta_.eroded);
   return c;
 }
 
-VecXd ComplianceProblem::chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar, double eta) const {
+VecXd ComplianceProblem::chain(const Stages& s, VecXd d_bar, double eta) const {
   if (params_.projection.enabled) {
     Heaviside h = proj_;
     h.eta = eta;
-    for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= h.derivative(rho_tilde[i]);
+    for (long i = 0; i < d_bar.size(); ++i) d_bar[i] *= h.derivative(s.tilde[i]);
   }
-  if (overhang_) d_bar = overhang_->apply_transpose(draw_ ? draw_->apply(rho_filtered) : rho_filtered, d_bar);
-  if (draw_) d_bar = draw_->apply_transpose(rho_filtered, d_bar);
+  if (overhang_) d_bar = overhang_->apply_transpose(s.drawn, d_bar);
+  if (draw_) d_bar = draw_->apply_transpose(s.filtered, d_bar);
   return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
 }
 
@@ -204,10 +200,9 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
     return volume_weights_.dot(x);
   }
   // with a minimum member size: the dilated design's volume, scaled (volume_scale_)
-  VecXd rho_filtered, rho_tilde;
-  filtered(x, rho_filtered, rho_tilde);
-  if (dv) *dv = volume_scale_ * chain(rho_filtered, rho_tilde, vd_ / design_volume_, eta_.dilated);
-  return volume_scale_ * volume_of(project(rho_tilde, eta_.dilated));
+  const Stages s = filtered(x);
+  if (dv) *dv = volume_scale_ * chain(s, vd_ / design_volume_, eta_.dilated);
+  return volume_scale_ * volume_of(project(s.tilde, eta_.dilated));
 }
 
 double ComplianceProblem::grey_share(const VecXd& x) const {

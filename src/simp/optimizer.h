@@ -118,7 +118,7 @@ class ComplianceProblem {
   fem::Elasticity& elasticity() { return *fe_; }
   /// Chain rule: a sensitivity w.r.t. the physical densities ρ̄ (#D) of the last compliance()
   /// call's x turned into one w.r.t. the design variables x (#D), through projection and filter.
-  VecXd to_variables(const VecXd& d_bar) const { return chain(rho_filtered_, rho_tilde_, d_bar, eta_.eroded); }
+  VecXd to_variables(const VecXd& d_bar) const { return chain(stages_, d_bar, eta_.eroded); }
   /// #D: E'(ρ̄_i) a_iᵀ K0_i b_i for the densities of the last compliance() call; a, b: 3*#V
   /// (the stiffness term of an adjoint sensitivity, −this for λ = a, u = b).
   VecXd stiffness_derivative(const VecXd& a, const VecXd& b) const;
@@ -148,12 +148,17 @@ class ComplianceProblem {
   double volume_scale_ = 1;  // robust: V_intermediate / V_dilated at the last compliance() call
   Progress progress_;
   VecXd scale_;
-  Eigen::MatrixXd U_;   // displacements of the last compliance() call
-  VecXd rho_filtered_;  // #D: its filtered densities
-  VecXd rho_tilde_;     // #D: the same through the draw direction and overhang (rho_filtered_ without them)
-  VecXd rho_bar_;       // #D: its physical densities
-  VecXd chain(const VecXd& rho_filtered, const VecXd& rho_tilde, VecXd d_bar, double eta) const;
-  void filtered(const VecXd& x, VecXd& rho_filtered, VecXd& rho_tilde) const;
+  Eigen::MatrixXd U_;  // displacements of the last compliance() call
+  /// #D each: a design's densities after the density filter, after the draw direction (its
+  /// input without it) and after the overhang filter (the projection's input; its input
+  /// without it) — each stage's input is what its chain rule needs.
+  struct Stages {
+    VecXd filtered, drawn, tilde;
+  };
+  Stages stages_;  // of the last compliance() call
+  VecXd rho_bar_;  // #D: its physical densities
+  VecXd chain(const Stages& s, VecXd d_bar, double eta) const;
+  Stages filtered(const VecXd& x) const;
   VecXd project(const VecXd& rho_tilde, double eta) const;
   double volume_of(const VecXd& rho_bar) const { return vd_.dot(rho_bar) / design_volume_; }
 };
