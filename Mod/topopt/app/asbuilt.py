@@ -113,25 +113,19 @@ def run_threshold(study):
     return float(value) if isinstance(value, (int, float)) else None
 
 
-def step_at_threshold(study, folder, threshold=None, timeout=None):
+def step_at_threshold(study, folder, threshold=None):
     """The path of a STEP file holding the study's result at `threshold` (None: the study's
     current Threshold, what the threshold slider shows; threshold_solid.chosen): the run's
     result.step at the run's threshold (threshold_solid.is_the_runs), else one the worker
-    writes into `folder` from the stored densities (extract_surface with "step", the shape the
+    writes into `folder` from the stored densities (runner.extract_at with step, the shape the
     slider shows). Raises TopOptError when the study has no result, the threshold is outside
     (0, 1), or the shape cannot become a valid solid (saying what to change)."""
-    from . import threshold_solid
+    from . import runner, threshold_solid
     run_step = step_path(study)  # a run that wrote no STEP (WriteStep off) gets none at any threshold
     threshold = threshold_solid.chosen(study, threshold)
     if threshold_solid.is_the_runs(study, threshold):
         return run_step
-    from . import checks, worker
-    if not study.Densities:
-        raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
-    nodes, tets, domain, densities = checks.stored_mesh(study)
-    result = worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
-                                                   "densities": densities},
-                        params={"threshold": threshold, "step": 1}, timeout=timeout)
+    result = runner.extract_at(study, threshold, step=True)
     data = result.get("files", {}).get(STEP)
     if not data:
         raise TopOptError("the result at threshold %.3f could not be written as a STEP solid: move the threshold "

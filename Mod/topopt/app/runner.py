@@ -204,20 +204,21 @@ def run(study, on_progress=None, cancel=None, verbose=True):
     return feature
 
 
-def extract_at(study, threshold, cancel=None, stored=None):
+def extract_at(study, threshold, cancel=None, stored=None, step=False):
     """The result shape of the study's stored densities at `threshold` (in (0, 1)), extracted in
     the worker process; the document is not touched. stored: checks.stored_mesh(study) when
-    the caller has it. Returns the worker's answer (surface_points #P×3, surface_triangles
-    #Q×3, surface_tags #Q). cancel(): polled, True cancels. Raises TopOptError if the study
-    has no result, if what it stored is damaged, or if the worker fails or runs past
-    REEXTRACT_TIMEOUT seconds."""
+    the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]).
+    Returns the worker's answer (surface_points #P×3, surface_triangles #Q×3, surface_tags #Q,
+    files). cancel(): polled, True cancels. Raises TopOptError if the study has no result, if
+    what it stored is damaged, or if the worker fails or runs past REEXTRACT_TIMEOUT seconds."""
     if not study.Densities:
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
     threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
     nodes, tets, domain, densities = stored if stored is not None else checks.stored_mesh(study)
     return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
                                                  "densities": densities},
-                      params={"threshold": threshold}, cancel=cancel, timeout=REEXTRACT_TIMEOUT)
+                      params=dict({"threshold": threshold}, **({"step": 1} if step else {})), cancel=cancel,
+                      timeout=REEXTRACT_TIMEOUT)
 
 
 def reextract(study, threshold, cancel=None):
