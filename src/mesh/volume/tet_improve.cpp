@@ -409,7 +409,7 @@ std::vector<Tri> cavity_faces(const std::vector<Tet>& tets, const std::vector<in
 
 }  // namespace
 
-CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad) {
+CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad, const Vec3* start) {
   std::vector<Vec3>& P = s.P;
   std::sort(cavity.begin(), cavity.end());
   double old_worst = 1;
@@ -437,7 +437,7 @@ CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad) 
   // out of the cavity, so a star tet (f, x) is positive when x is inside); elsewhere -1 plus
   // the most negative height of x over a face (in units of the mean edge), which leads the
   // search into the cavity's kernel
-  P.push_back(centre);
+  P.push_back(start ? *start : centre);
   const int id = static_cast<int>(P.size()) - 1;
   auto star_score = [&]() {
     double w = 1, hmin = 0;
@@ -639,9 +639,85 @@ std::vector<std::pair<double, size_t>> tets_below(const std::vector<Vec3>& P, co
 
 namespace {
 
+/// The tet across face `face` (0..3, opposite that node) of tet c by the sweep's stars, or -1
+/// when none holds it (a face on the boundary of the tets).
+int across(const TetSweep& s, int c, int face) {
+  const int a = s.tets[c][kTetFace[face][0]], b = s.tets[c][kTetFace[face][1]], d = s.tets[c][kTetFace[face][2]];
+  for (int q : s.stars.row(a))
+    if (q != c && has(s.tets[q], b) && has(s.tets[q], d)) return q;
+  return -1;
+}
+
+/// Where a Steiner point may take sliver t out: its circumcentre (when within its longest
+/// edge of its centroid: a sliver's lies near its middle), and, for each face of t on the
+/// boundary of the tets, the point on the face's inward normal (towards t's fourth node) from
+/// the face's centroid at kSteinerHeight of its mean edge — a flat tet on the chords of a
+/// curved face is replaced by tets standing on its boundary faces.
+std::vector<Vec3> steiner_points(const TetSweep& s, int t) {
+  const Tet& v = s.tets[t];
+  const std::vector<Vec3>& P = s.P;
+  std::vector<Vec3> out;
+  const Vec3 centroid = (P[v[0]] + P[v[1]] + P[v[2]] + P[v[3]]) / 4;
+  const Vec3 u = P[v[1]] - P[v[0]], w = P[v[2]] - P[v[0]], z = P[v[3]] - P[v[0]];
+  const double det = 2 * u.dot(w.cross(z));
+  double longest = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (P[v[i]] - P[v[j]]).norm());
+  if (det != 0) {
+    const Vec3 c =
+        P[v[0]] + (u.squaredNorm() * w.cross(z) + w.squaredNorm() * z.cross(u) + z.squaredNorm() * u.cross(w)) / det;
+    if ((c - centroid).norm() <= longest) out.push_back(c);
+  }
+  for (int f = 0; f < 4; ++f) {
+    if (across(s, t, f) >= 0) continue;
+    const Vec3& a = P[v[kTetFace[f][0]]];
+    const Vec3& b = P[v[kTetFace[f][1]]];
+    const Vec3& c = P[v[kTetFace[f][2]]];
+    Vec3 n = (b - a).cross(c - a);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (n.dot(P[v[f]] - a) < 0) n = -n;
+    const double edge = ((a - b).norm() + (b - c).norm() + (c - a).norm()) / 3;
+    out.push_back((a + b + c) / 3 + kSteinerHeight * edge * n);
+  }
+  return out;
+}
+
+/// The conflict cavity of point x at tet t: t and the tets reached from it across faces
+/// whose circumsphere holds x strictly (insphere; the tets are positive), untouched ones
+/// only, at most kConflictTets of them (ascending).
+std::vector<int> conflict_cavity(const TetSweep& s, int t, const Vec3& x) {
+  std::vector<int> cavity{t};
+  for (size_t k = 0; k < cavity.size() && cavity.size() < kConflictTets; ++k)
+    for (int f = 0; f < 4 && cavity.size() < kConflictTets; ++f) {
+      const int q = across(s, cavity[k], f);
+      if (q < 0 || s.touched[q] || std::find(cavity.begin(), cavity.end(), q) != cavity.end()) continue;
+      const Tet& y = s.tets[q];
+      if (predicates::insphere(s.P[y[0]].data(), s.P[y[1]].data(), s.P[y[2]].data(), s.P[y[3]].data(), x.data()) > 0)
+        cavity.push_back(q);
+    }
+  std::sort(cavity.begin(), cavity.end());
+  return cavity;
+}
+
+/// The best refill of tet t (the highest gain in radius ratio below `bad`) among its
+/// candidate cavities, with `wide` also the wider ones and the conflict cavities of its
+/// Steiner points (each re-filled from a search started at its point); empty when none helps.
+CavityStar best_refill(TetSweep& s, int t, double bad, bool wide) {
+  CavityStar best;
+  auto consider = [&](std::vector<int> cavity, const Vec3* start) {
+    CavityStar star = plan_refill_cavity(s, std::move(cavity), bad, start);
+    if (!star.empty() && star.gain > best.gain) best = std::move(star);
+  };
+  for (std::vector<int>& c : candidate_cavities(s, t)) consider(std::move(c), nullptr);
+  if (!wide) return best;
+  for (std::vector<int>& c : wide_cavities(s, t)) consider(std::move(c), nullptr);
+  for (const Vec3& x : steiner_points(s, t)) consider(conflict_cavity(s, t, x), &x);
+  return best;
+}
+
 /// One sweep of cavity refills over the tets of `order` (worst first): each not yet touched
-/// and with no locked node gets the best refill (gain in radius ratio below `bad`) among its
-/// candidate cavities, and with `wide` the wider ones too. Returns the refills applied.
+/// and with no locked node gets its best refill (best_refill). Returns the refills applied.
 long refill_sweep(TetSweep& s, std::vector<Tet>& tets, const std::vector<std::pair<double, size_t>>& order, double bad,
                   bool wide) {
   long done = 0;
@@ -650,14 +726,7 @@ long refill_sweep(TetSweep& s, std::vector<Tet>& tets, const std::vector<std::pa
     bool skip = false;
     for (int x : tets[t]) skip |= s.locked[x] != 0;
     if (skip) continue;
-    std::vector<std::vector<int>> options = candidate_cavities(s, static_cast<int>(t));
-    if (wide)
-      for (std::vector<int>& c : wide_cavities(s, static_cast<int>(t))) options.push_back(std::move(c));
-    CavityStar best;
-    for (std::vector<int>& cavity : options) {
-      CavityStar star = plan_refill_cavity(s, std::move(cavity), bad);
-      if (!star.empty() && star.gain > best.gain) best = std::move(star);
-    }
+    const CavityStar best = best_refill(s, static_cast<int>(t), bad, wide);
     if (best.empty()) continue;
     apply(s, best);
     ++done;

@@ -134,14 +134,21 @@ struct CavityStar {
 /// (the star tiles the cavity exactly) and the star has the cavity's volume (a cavity holding a
 /// flat or inverted tet has overlapping faces: its star would cover part of it twice), the
 /// star's worst tet beats the cavity's and it has no more tets below kSliverShare × bad than
-/// the cavity had. P is as it was on return.
-CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad);
+/// the cavity had. P is as it was on return. start: where the search begins (default, null:
+/// the faces' centroid).
+CavityStar plan_refill_cavity(TetSweep& s, std::vector<int> cavity, double bad, const Eigen::Vector3d* start = nullptr);
 /// Makes star c: its point is appended to P, its cavity retired (and its nodes locked), its
 /// tets pending until the sweep ends.
 void apply(TetSweep& s, const CavityStar& c);
 
 /// A star may not leave more tets below this share of `bad` than its cavity had.
 constexpr double kSliverShare = 0.25;
+/// A Steiner point for a tet with a face on the boundary stands this share of the face's mean
+/// edge above it, on its inward normal (remove_tets_below).
+constexpr double kSteinerHeight = 0.6;
+/// A Steiner point's conflict cavity (the tets whose circumsphere holds it, grown from the
+/// sliver across faces) holds at most this many tets.
+constexpr size_t kConflictTets = 48;
 
 // ---- drivers
 
@@ -174,8 +181,11 @@ long perturb_sliver_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet
 
 /// The last pass at the tets still below `floor` (radius ratio; a flat tet has 0), worst first:
 /// each is taken out with the best of wider cavities than insert_points_at_slivers tries —
-/// those, the star of each of its nodes, the stars of both ends of each of its edges, and
-/// three layers of face neighbours — re-filled from one point (refill_cavity with
+/// those, the star of each of its nodes, the stars of both ends of each of its edges, three
+/// layers of face neighbours, and the conflict cavities (tets whose circumsphere holds the
+/// point, exact insphere) of its Steiner points: its circumcentre and, on each of its faces on
+/// the boundary, a point kSteinerHeight of the face's edge inside — re-filled from one point
+/// (refill_cavity, its search started at the Steiner point for those; with
 /// bad = floor / kSliverShare: no more tets below floor than the cavity had); up to `sweeps`
 /// sweeps while any cavity is re-filled, progress checked for cancellation between them.
 /// Returns the number of cavities re-filled.

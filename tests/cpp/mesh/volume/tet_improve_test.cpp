@@ -493,5 +493,28 @@ TEST(TetImprove, RemoveSliversTakesOutTheClassicBadTetsKeepingTheMeshValid) {
   EXPECT_EQ(Q, Q0);
 }
 
+TEST(TetImprove, RemoveTetsBelowTakesOutAFlatTetOnTheChordsOfACurvedFace) {
+  // a convex boundary bent along the ridge a-c: boundary triangles abc and acd, with b and d
+  // `drop` below the ridge; the tet abcd between them (both its faces on the boundary, all four
+  // nodes on the surface: the flat tet on a curved face's chords) is a sliver; the tets on its
+  // inner faces abd and bcd reach the apex e below. Every node is on the boundary and may not
+  // move: only a Steiner point inside (on the inward normal of a boundary face, or in a
+  // cavity) can take the sliver out, keeping the boundary, the volume and every tet positive.
+  for (const double drop : {0.02, 0.005, 1e-4}) {
+    Points P = {{0, 0, 0}, {1, 0, -drop}, {1, 1, 0}, {0, 1, -drop}, {0.5, 0.5, -0.8}};
+    std::vector<Tet> tets = {positive(P, {0, 1, 2, 3}), positive(P, {0, 1, 3, 4}), positive(P, {1, 2, 3, 4})};
+    const Points P0 = P;
+    const double v0 = volume(P, tets);
+    ASSERT_LT(worst(P, tets), 0.1) << drop;
+    const MatX3i boundary = boundary_triangles(rows_of(tets));
+    ASSERT_EQ(boundary.rows(), 6) << drop;
+    EXPECT_GE(remove_tets_below(P, tets, 0.1, 4), 1) << drop;
+    EXPECT_GE(worst(P, tets), 0.1) << drop;
+    for (size_t i = 0; i < P0.size(); ++i) EXPECT_EQ(P[i], P0[i]) << drop << ": a boundary node moved";
+    EXPECT_NEAR(volume(P, tets), v0, 1e-12) << drop;
+    expect_valid(P, tets, boundary, "ridge");
+  }
+}
+
 }  // namespace
 }  // namespace topopt::mesh
