@@ -177,6 +177,16 @@ TEST(SurfaceMesher, CornersOfNarrowFacesGetMatchingSegments) {
   EXPECT_GE(quality_of(mesh_at("examples/rocker.step", 0.5)).min_angle, 39.0);
 }
 
+/// The surface of `topo` made by ModelSurface's stages one by one (vertices, edges, faces).
+SurfaceMesh mesh_by_stages(const brep::TopologyIndex& topo, const SurfaceMeshParams& p) {
+  std::vector<std::array<double, 3>> nodes;
+  ModelSurface ms(topo, nodes, p);
+  ms.create_vertex_nodes();
+  ms.mesh_edges();
+  ms.mesh_faces();
+  return ms.result();
+}
+
 TEST(SurfaceMesher, ThinWallsAreRefinedFromTheirThickness) {
   // Plates thinner than two sizes: 1 mm at the default size (1.13 mm) and 3 mm at 2.5 mm. With
   // wall_layers = 2 the big faces' edges come down to about thickness / 2.5 (graded), and the
@@ -409,12 +419,7 @@ TEST(SurfaceMesher, AFaceNoWayCanFillInItsBudgetFailsNamed) {
   p.size = 0.5;
   p.threads = 1;
   p.face_cpu_seconds = 1e-9;
-  std::vector<std::array<double, 3>> nodes;
-  ModelSurface ms(topo, nodes, p);
-  ms.create_vertex_nodes();
-  ms.mesh_edges();
-  ms.mesh_faces();
-  const SurfaceMesh m = ms.result();
+  const SurfaceMesh m = mesh_by_stages(topo, p);
   ASSERT_GE(m.failed_faces.size(), 2u);  // at least the two 40 x 40 faces (some 14 000 triangles each)
   for (size_t k = 0; k < m.failed_faces.size(); ++k) {
     SCOPED_TRACE("face " + std::to_string(m.failed_faces[k]));
