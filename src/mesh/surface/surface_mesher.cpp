@@ -27,6 +27,7 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -35,6 +36,7 @@
 #include <unordered_set>
 
 #include "common/closed_surface.h"
+#include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/parallel.h"
 #include "mesh/core/predicates.h"
@@ -149,6 +151,13 @@ double point_segment_distance(const std::array<double, 2>& P, const std::array<d
   const double dx = B[0] - A[0], dy = B[1] - A[1], l2 = dx * dx + dy * dy;
   const double t = l2 > 0 ? std::clamp(((P[0] - A[0]) * dx + (P[1] - A[1]) * dy) / l2, 0.0, 1.0) : 0.0;
   return std::hypot(P[0] - A[0] - t * dx, P[1] - A[1] - t * dy);
+}
+
+/// Whether the segments A-B and C-D meet (cross or touch), by exact orientation tests.
+bool segments_meet(const std::array<double, 2>& A, const std::array<double, 2>& B, const std::array<double, 2>& C,
+                   const std::array<double, 2>& D) {
+  return predicates::orient2d(A.data(), B.data(), C.data()) * predicates::orient2d(A.data(), B.data(), D.data()) <= 0 &&
+         predicates::orient2d(C.data(), D.data(), A.data()) * predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
 }
 
 }  // namespace
@@ -759,10 +768,7 @@ void ModelSurface::mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, 
       const auto &si = L.segs[i], &sj = L.segs[j];
       if (si[0] == sj[0] || si[0] == sj[1] || si[1] == sj[0] || si[1] == sj[1]) continue;
       const auto &A = L.uv[si[0]], &B = L.uv[si[1]], &C = L.uv[sj[0]], &D = L.uv[sj[1]];
-      const bool cross =
-          predicates::orient2d(A.data(), B.data(), C.data()) * predicates::orient2d(A.data(), B.data(), D.data()) <=
-              0 &&
-          predicates::orient2d(C.data(), D.data(), A.data()) * predicates::orient2d(C.data(), D.data(), B.data()) <= 0;
+      const bool cross = segments_meet(A, B, C, D);
       const double d = cross ? 0.0
                              : std::min({point_segment_distance(A, C, D), point_segment_distance(B, C, D),
                                          point_segment_distance(C, A, B), point_segment_distance(D, A, B)});
@@ -903,38 +909,77 @@ void ModelSurface::set_face_mesh(int f, std::vector<std::array<int, 3>> tris) {
 
 void ModelSurface::alias_face(int f, int src, bool reversed) { face_alias_[f] = {src, reversed ? 1 : 0}; }
 
+double face_cpu_seconds(double triangles) { return 20.0 + std::max(0.0, triangles) / 2000.0; }
+
+namespace {
+
+/// `progress` whose cancelled() also answers yes once the calling thread has used `seconds`
+/// of CPU from now (<= 0: never); `expired` is set when that is why.
+Progress within_face_budget(const Progress& progress, double seconds, const std::shared_ptr<bool>& expired) {
+  if (seconds <= 0) return progress;
+  Progress timed = progress;
+  const double stop_at = thread_cpu_seconds() + seconds;
+  timed.cancelled = [progress, stop_at, expired] {
+    if (progress.cancelled && progress.cancelled()) return true;
+    *expired = *expired || thread_cpu_seconds() > stop_at;
+    return *expired;
+  };
+  return timed;
+}
+
+}  // namespace
+
+// The CPU seconds one way of filling face f may take: the given budget, or the automatic one
+// for the triangles its area asks for at its own size (equilateral triangles of that side).
+double ModelSurface::face_budget(int f) const {
+  if (params_.face_cpu_seconds != 0) return params_.face_cpu_seconds;
+  const double h = face_size_[f];
+  return face_cpu_seconds(h > 0 ? topo_.face_area[f] / (0.433 * h * h) : 0.0);
+}
+
 // Step 9 / 11 for one face: the front fills the face's loops in its scaled parameters,
 // honouring the constraint segments and nodes, then the triangles are improved on the
 // surface (constraint nodes and segments fixed). A face the front cannot fill is retried
-// (face_attempts); the error kept is the first attempt's, with the others' named.
+// (face_attempts), each way within the face's CPU budget (face_budget); the error kept is
+// the first attempt's, with the ways tried named.
 void ModelSurface::mesh_face(int f, const Progress& prog, FaceOut& out) const {
   const std::vector<FaceAttempt> attempts = face_attempts(f);
+  const double seconds = face_budget(f);
   std::string first_error, tried;
   for (const FaceAttempt& a : attempts) {
+    auto expired = std::make_shared<bool>(false);
     try {
-      mesh_face_once(f, a, prog, out);
+      mesh_face_once(f, a, within_face_budget(prog, seconds, expired), out);
       out.attempt = a.name;
       return;
     } catch (const Error& err) {
-      if (err.code() == ErrorCode::Cancelled) throw;
-      if (first_error.empty()) first_error = err.what();
-      tried += std::string(tried.empty() ? "" : ", ") + a.name;
+      if (err.code() == ErrorCode::Cancelled && !*expired) throw;
+      std::string why = err.what();
+      if (*expired) {
+        std::ostringstream s;
+        s << "the face's mesh did not close within its budget of " << std::ceil(seconds) << " s of computing";
+        why = s.str();
+      }
+      if (first_error.empty()) first_error = why;
+      tried += std::string(tried.empty() ? "" : ", ") + a.name + (*expired ? " (out of time)" : "");
     }
   }
-  out.error = first_error + " (tried: " + tried + ")";
+  out.error = first_error + " (tried: " + tried +
+              "); a larger size, or repairing the face in CAD (its trimming curves), may let it mesh";
 }
 
 // The ways a face is filled, in order (params.face_attempts picks some, for tests): its loops
 // as measured; with the gaps between their edges' ends closed; in isotropic parameters (the
 // mean of the two scales, for faces whose scaling varies much); in the unscaled parameters
-// with the gaps closed.
+// with the gaps closed; split in two along a parameter line through its middle, gaps closed.
 std::vector<ModelSurface::FaceAttempt> ModelSurface::face_attempts(int f) const {
   const FaceGeometry& g = geo_[f];
   const double iso = std::sqrt(g.su * g.sv);
   const std::vector<FaceAttempt> all{{"as measured", g, false},
                                      {"loop gaps closed", g, true},
                                      {"isotropic scaling", {iso, iso, g.kmax}, true},
-                                     {"unscaled parameters", {1, 1, g.kmax}, true}};
+                                     {"unscaled parameters", {1, 1, g.kmax}, true},
+                                     {"split along a parameter line", g, true, true}};
   if (params_.face_attempts.empty()) return all;
   std::vector<FaceAttempt> some;
   for (int k : params_.face_attempts)
@@ -947,6 +992,7 @@ std::vector<ModelSurface::FaceAttempt> ModelSurface::face_attempts(int f) const 
 void ModelSurface::mesh_face_once(int f, const FaceAttempt& a, const Progress& prog, FaceOut& out) const {
   FaceInput in = face_input(f, a.geo);
   if (a.close_gaps) close_loop_gaps(in);
+  if (a.split) add_split_line(f, in, face_size_[f]);
   const Loops& L = in.loops;
   FaceFrontInput front;
   front.P.resize(static_cast<long>(L.uv.size()), 2);
@@ -1009,6 +1055,92 @@ void ModelSurface::close_loop_gaps(FaceInput& in) {
   for (auto& sg : L.segs) sg = {to[sg[0]], to[sg[1]]};
   for (auto& sg : in.csegs) sg = {to[sg[0]], to[sg[1]]};
   for (int& i : in.isolated) i = to[i];
+}
+
+namespace {
+
+/// Where the line x[axis] = at crosses a loop segment: the other coordinate there, the segment
+/// and whether the face lies on the side of larger coordinates just past it.
+struct LineCrossing {
+  double t;
+  int seg;
+  bool inside_above;
+};
+
+/// The crossings of the line x[axis] = at with the segments of L (face to their left), in
+/// order along the line.
+std::vector<LineCrossing> line_crossings(const std::vector<std::array<double, 2>>& uv,
+                                         const std::vector<std::array<int, 2>>& segs, int axis, double at) {
+  const int other = 1 - axis;
+  std::vector<LineCrossing> out;
+  for (size_t k = 0; k < segs.size(); ++k) {
+    const auto &a = uv[segs[k][0]], &b = uv[segs[k][1]];
+    const double da = a[axis] - at, db = b[axis] - at;
+    if ((da < 0) == (db < 0)) continue;
+    // the face is left of a -> b: above the line (larger `other`) where the segment runs
+    // towards +axis for axis u, towards -axis for axis v
+    const bool forward = db > da;
+    out.push_back(
+        {a[other] + (b[other] - a[other]) * da / (da - db), static_cast<int>(k), axis == 0 ? forward : !forward});
+  }
+  std::sort(out.begin(), out.end(), [](const LineCrossing& x, const LineCrossing& y) { return x.t < y.t; });
+  return out;
+}
+
+/// Whether the segment a-b (local nodes) meets any segment of `segs` that does not end at a
+/// or b: exact orientation tests; touching counts as meeting.
+bool chord_meets(const std::vector<std::array<double, 2>>& uv, const std::vector<std::array<int, 2>>& segs, int a,
+                 int b) {
+  for (const auto& sg : segs) {
+    if (sg[0] == a || sg[0] == b || sg[1] == a || sg[1] == b) continue;
+    if (segments_meet(uv[a], uv[b], uv[sg[0]], uv[sg[1]])) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+// The retry that splits face f in two: the parameter line through the middle of the loops'
+// longer extent (in the face's scaled parameters), on its longest stretch inside the face,
+// from the boundary node nearest one end of that stretch to the one nearest the other, as a
+// chain of constraint segments of about length h. Its inner nodes are new nodes of the face
+// (global -1), kept in place like the loops' nodes, so both halves the front fills share the
+// one discretisation. Throws Error(MeshingFailed), naming the face, where no such chord lies
+// inside it.
+void ModelSurface::add_split_line(int f, FaceInput& in, double h) {
+  Loops& L = in.loops;
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const auto& sg : L.segs)
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], L.uv[sg[0]][k]), hi[k] = std::max(hi[k], L.uv[sg[0]][k]);
+  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
+  const double mid = 0.5 * (lo[axis] + hi[axis]);
+  const std::vector<LineCrossing> c = line_crossings(L.uv, L.segs, axis, mid);
+  int best = -1;
+  for (size_t k = 0; k + 1 < c.size(); ++k)
+    if (c[k].inside_above && !c[k + 1].inside_above && (best < 0 || c[k + 1].t - c[k].t > c[best + 1].t - c[best].t))
+      best = static_cast<int>(k);
+  auto nearer_end = [&](const LineCrossing& x) {  // the crossed segment's end nearer the line
+    const auto& sg = L.segs[x.seg];
+    return std::abs(L.uv[sg[0]][axis] - mid) <= std::abs(L.uv[sg[1]][axis] - mid) ? sg[0] : sg[1];
+  };
+  const int a = best < 0 ? -1 : nearer_end(c[best]), b = best < 0 ? -1 : nearer_end(c[best + 1]);
+  if (best < 0 || a == b || chord_meets(L.uv, L.segs, a, b) || chord_meets(L.uv, in.csegs, a, b))
+    throw Error(ErrorCode::MeshingFailed,
+                "face " + std::to_string(f + 1) + ": no parameter line through its middle splits it in two");
+  const double len = std::hypot(L.uv[b][0] - L.uv[a][0], L.uv[b][1] - L.uv[a][1]);
+  // two copies of one node (across a periodic face): the chord closes a loop on the surface,
+  // at least 3 pieces so that no two of its edges join the same two nodes
+  const int n = std::max(L.global[a] == L.global[b] ? 3 : 2, static_cast<int>(std::ceil(len / h)));
+  int prev = a;
+  for (int i = 1; i < n; ++i) {
+    const double t = static_cast<double>(i) / n;
+    L.uv.push_back({L.uv[a][0] + t * (L.uv[b][0] - L.uv[a][0]), L.uv[a][1] + t * (L.uv[b][1] - L.uv[a][1])});
+    L.global.push_back(-1);  // a node of this face alone, made when the face's mesh is taken
+    const int cur = static_cast<int>(L.uv.size()) - 1;
+    in.csegs.push_back({prev, cur});
+    prev = cur;
+  }
+  in.csegs.push_back({prev, b});
 }
 
 // Face f's loops in its scaled parameters, then its constraint segments and nodes in the same
@@ -1095,7 +1227,8 @@ void ModelSurface::improve_on_surface(int f, const FaceGeometry& g, const FaceIn
   for (long t = 0; t < r.T.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
       const int a = r.T(t, k), b = r.T(t, (k + 1) % 3), c = r.T(t, (k + 2) % 3);
-      if (a < nin && b < nin && global[a] == global[b]) locked.push_back({a, c}), locked.push_back({b, c});
+      if (a < nin && b < nin && global[a] >= 0 && global[a] == global[b])
+        locked.push_back({a, c}), locked.push_back({b, c});
     }
   optimize_on_surface(r.P, r.T, out.X, static_cast<int>(nin), eval, locked, params_.optimize_rounds);
   out.global = global;
@@ -1138,7 +1271,7 @@ void ModelSurface::take_face_mesh(int f, const FaceOut& fo) {
   if (fo.attempt != face_attempts(f).front().name) retried_.push_back({f + 1, fo.attempt});
   const long nin = static_cast<long>(fo.global.size());
   std::vector<int> to_global(fo.X.rows(), -1);
-  for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];
+  for (long i = 0; i < nin; ++i) to_global[i] = fo.global[i];  // -1: a split line's node, made below
   for (long t = 0; t < fo.T.rows(); ++t)
     for (int k = 0; k < 3; ++k) {
       const int i = fo.T(t, k);

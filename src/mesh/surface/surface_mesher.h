@@ -40,9 +40,17 @@ struct SurfaceMeshParams {
   FaceFrontParams front;    ///< the face engine's settings (its size is set per face)
   /// Which ways of filling a face are tried, in order, until one closes (empty: all): 0 its
   /// loops as measured, 1 with gaps between its edges' ends closed, 2 in isotropic
-  /// parameters, 3 in unscaled parameters (tests pick one to exercise it).
+  /// parameters, 3 in unscaled parameters, 4 split in two along a parameter line through its
+  /// middle (tests pick one to exercise it).
   std::vector<int> face_attempts;
+  /// CPU seconds each way of filling one face may take (its thread's clock); past it that way
+  /// stops and the next is tried. 0: automatic (face_cpu_seconds()), < 0: no limit.
+  double face_cpu_seconds = 0;
 };
+
+/// The automatic CPU budget (s) of one way of filling a face expected to take `triangles`
+/// triangles: 20 s, and 1 s more per 2 000 triangles (the front makes some 20 000 a second).
+double face_cpu_seconds(double triangles);
 
 struct SurfaceMesh {
   MatX3d V;                       ///< #V by 3 nodes; the first #vertices are the model's vertices, in order
@@ -222,11 +230,13 @@ class ModelSurface {
     std::string error;
     std::string attempt;  ///< the way of filling that closed the face (face_attempts)
   };
-  /// One way of filling a face: the parameter scaling and whether loop gaps are closed.
+  /// One way of filling a face: the parameter scaling, whether loop gaps are closed and
+  /// whether the face is split in two along a parameter line (add_split_line).
   struct FaceAttempt {
     const char* name;
     FaceGeometry geo;
     bool close_gaps = false;
+    bool split = false;
   };
 
   // construction: sizes of faces, edges and vertices
@@ -262,6 +272,8 @@ class ModelSurface {
   std::vector<FaceAttempt> face_attempts(int f) const;
   void mesh_face_once(int f, const FaceAttempt& a, const Progress& progress, FaceOut& out) const;
   static void close_loop_gaps(FaceInput& in);
+  static void add_split_line(int f, FaceInput& in, double h);
+  double face_budget(int f) const;
   FaceInput face_input(int f, const FaceGeometry& g) const;
   void improve_on_surface(int f, const FaceGeometry& g, const FaceInput& in, FaceFrontResult& r, FaceOut& out) const;
   void take_face_mesh(int f, const FaceOut& fo);

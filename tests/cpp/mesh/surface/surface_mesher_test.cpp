@@ -177,6 +177,16 @@ TEST(SurfaceMesher, CornersOfNarrowFacesGetMatchingSegments) {
   EXPECT_GE(quality_of(mesh_at("examples/rocker.step", 0.5)).min_angle, 39.0);
 }
 
+/// The surface of `topo` made by ModelSurface's stages one by one (vertices, edges, faces).
+SurfaceMesh mesh_by_stages(const brep::TopologyIndex& topo, const SurfaceMeshParams& p) {
+  std::vector<std::array<double, 3>> nodes;
+  ModelSurface ms(topo, nodes, p);
+  ms.create_vertex_nodes();
+  ms.mesh_edges();
+  ms.mesh_faces();
+  return ms.result();
+}
+
 TEST(SurfaceMesher, ThinWallsAreRefinedFromTheirThickness) {
   // Plates thinner than two sizes: 1 mm at the default size (1.13 mm) and 3 mm at 2.5 mm. With
   // wall_layers = 2 the big faces' edges come down to about thickness / 2.5 (graded), and the
@@ -307,6 +317,19 @@ TopoDS_Shape prism_with_short_edge() {
   return BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), gp_Vec(0, 0, 5)).Shape();
 }
 
+/// A B-spline plate 60 x 3 mm whose parameters both run over [0, 1] (one parameter stretched
+/// 20 times the other on the surface), extruded 2 mm down.
+TopoDS_Shape stretched_bspline_plate() {
+  TColgp_Array2OfPnt poles(1, 8, 1, 3);
+  for (int i = 1; i <= 8; ++i)
+    for (int j = 1; j <= 3; ++j) poles(i, j) = gp_Pnt(60.0 * (i - 1) / 7, 1.5 * (j - 1), 0.3 * std::sin(0.8 * i));
+  const Handle(Geom_BSplineSurface) s = GeomAPI_PointsToBSplineSurface(poles).Surface();
+  double u0, u1, v0, v1;
+  s->Bounds(u0, u1, v0, v1);
+  const TopoDS_Face top = BRepBuilderAPI_MakeFace(s, u0, u1, v0, v1, 1e-7);
+  return BRepPrimAPI_MakePrism(top, gp_Vec(0, 0, -2)).Shape();
+}
+
 /// Meshes `shape` with only the given ways of filling a face; returns the surface and its model.
 SurfaceMesh mesh_with_attempts(const brep::TopologyIndex& topo, double size, std::vector<int> attempts,
                                std::vector<std::pair<int, std::string>>* retried = nullptr) {
@@ -337,17 +360,19 @@ void expect_closed_with_volume(const brep::TopologyIndex& topo, const SurfaceMes
 }
 
 TEST(SurfaceMesher, EveryWayOfFillingAFaceMeshesTheFixtures) {
-  // A trimmed B-spline face with a hole, a cylinder's periodic face with its seam (and a
-  // torus's, periodic both ways), a face with a 0.02 mm edge: each way of filling a face alone
-  // (as measured, loop gaps closed, isotropic scaling, unscaled parameters) meshes each one.
+  // A trimmed B-spline face with a hole, a strongly stretched B-spline face (20:1), a
+  // cylinder's periodic face with its seam (and a torus's, periodic both ways), a face with a
+  // 0.02 mm edge: each way of filling a face alone (as measured, loop gaps closed, isotropic
+  // scaling, unscaled parameters, split along a parameter line) meshes each one.
   const std::vector<std::pair<std::string, TopoDS_Shape>> shapes{
       {"B-spline block with a hole", bspline_block_with_hole()},
+      {"stretched B-spline plate", stretched_bspline_plate()},
       {"cylinder", BRepPrimAPI_MakeCylinder(8, 20).Shape()},
       {"torus", BRepPrimAPI_MakeTorus(12, 4).Shape()},
       {"prism with a short edge", prism_with_short_edge()}};
   for (const auto& [name, shape] : shapes) {
     const brep::TopologyIndex topo = brep::index_topology(shape);
-    for (int attempt : {0, 1, 2, 3}) {
+    for (int attempt : {0, 1, 2, 3, 4}) {
       SCOPED_TRACE(name + ", attempt " + std::to_string(attempt));
       // closed; the volume within the faceting of 16 elements per turn (measured: up to 2.1 %
       // on the torus) or, in unscaled parameters (stretched triangles), up to 6.1 %
@@ -355,6 +380,53 @@ TEST(SurfaceMesher, EveryWayOfFillingAFaceMeshesTheFixtures) {
                                 attempt == 3 ? 0.07 : 0.03);
     }
   }
+}
+
+TEST(SurfaceMesher, TheSplitLineIsMeshedOnceForBothHalves) {
+  // A 40 x 10 x 10 box at size 2, its faces split along a parameter line: each face holds a
+  // chain of mesh edges from one side of its boundary to the other (the split line), and the
+  // surface stays closed with the box's volume.
+  const brep::TopologyIndex topo = brep::index_topology(BRepPrimAPI_MakeBox(40, 10, 10).Shape());
+  const SurfaceMesh split = mesh_with_attempts(topo, 2, {4});
+  expect_closed_with_volume(topo, split, 1e-9);
+  // on the 40 x 10 faces the line runs across the 40 mm side's middle: x = 20, from one long
+  // edge to the other, so 10 / 2 = 5 edges lie on it
+  for (int f = 1; f <= topo.num_faces(); ++f) {
+    int on_line = 0, triangles = 0;
+    double xlo = 1e300, xhi = -1e300;
+    for (long t = 0; t < split.F.rows(); ++t) {
+      if (split.face(t) != f) continue;
+      ++triangles;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d a = split.V.row(split.F(t, k)), b = split.V.row(split.F(t, (k + 1) % 3));
+        xlo = std::min(xlo, a.x()), xhi = std::max(xhi, a.x());
+        on_line += std::abs(a.x() - 20) < 1e-9 && std::abs(b.x() - 20) < 1e-9;
+      }
+    }
+    if (xhi - xlo < 39) continue;  // the 10 x 10 ends
+    SCOPED_TRACE("face " + std::to_string(f));
+    EXPECT_GT(triangles, 0);
+    EXPECT_GE(on_line, 2 * 5);  // each edge of the line in two triangles, one per half
+  }
+}
+
+TEST(SurfaceMesher, AFaceNoWayCanFillInItsBudgetFailsNamed) {
+  // Every way of filling a face given a budget of a nanosecond: the large faces of a box at a
+  // fine size (thousands of front steps) fail, each named with every way tried and the budget
+  // said, and the meshing ends.
+  const brep::TopologyIndex topo = brep::index_topology(BRepPrimAPI_MakeBox(40, 40, 10).Shape());
+  SurfaceMeshParams p;
+  p.size = 0.5;
+  p.threads = 1;
+  p.face_cpu_seconds = 1e-9;
+  const SurfaceMesh m = mesh_by_stages(topo, p);
+  ASSERT_GE(m.failed_faces.size(), 2u);  // at least the two 40 x 40 faces (some 14 000 triangles each)
+  for (size_t k = 0; k < m.failed_faces.size(); ++k) {
+    SCOPED_TRACE("face " + std::to_string(m.failed_faces[k]));
+    EXPECT_NE(m.reasons[k].find("budget"), std::string::npos) << m.reasons[k];
+    EXPECT_NE(m.reasons[k].find("split along a parameter line (out of time)"), std::string::npos) << m.reasons[k];
+  }
+  EXPECT_GT(face_cpu_seconds(1e6), face_cpu_seconds(1e3));
 }
 
 /// The face sizes of `shape` meshed at `size` (edges only: the sizes are known then).
