@@ -2,8 +2,9 @@
 """STEP benchmark (issue 19): the result's STEP before and after the compact export, per
 example, both from the same run and the same binary in one run of this script.
 
-For each example with a finished `topopt optimize` run (bench/result/run.py's jobs, or
-run.py --work's folders; JOB.json next to its output folder), `topopt result JOB.json
+For each example with a finished `topopt optimize` run (bench/result/run.py's jobs in its
+--work folder: EXAMPLE_SETTING.json next to the output folder EXAMPLE_SETTING, SETTING given by
+--run, default "after"), `topopt result JOB.json
 --threshold T` at the run's threshold (history.json), one thread:
 - before: `--coarsen 0 --pcurves`, the export as it was (every triangle a planar face,
   coplanar faces merged, the edges' 2D curves written);
@@ -12,8 +13,8 @@ Each STEP is read back by OCCT in FreeCAD (`Part.read`, BRepCheck through isVali
 faces, validity and volume against the STL's. Sizes, faces, the export's CPU and wall seconds
 (the child that builds and writes the solid) and the machine's load are printed as Markdown.
 
-usage: bench/result/step.py [--build build] [--work /tmp/topopt-bench-result] [--only rocker,...]
-                            [--settings before,after] [--no-reread]
+usage: bench/result/step.py [--build build] [--work /tmp/topopt-bench-result] [--run after]
+                            [--only rocker,...] [--settings before,after] [--no-reread]
 --no-reread skips FreeCAD's re-read (minutes per file on a loaded machine): the export's own
 BRepCheck in the child is what "valid" then says.
 """
@@ -62,6 +63,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=os.path.join(benchlib.ROOT, "build"))
     ap.add_argument("--work", default="/tmp/topopt-bench-result")
+    ap.add_argument("--run", default="after", help="the setting of run.py whose runs to export (default: after)")
     ap.add_argument("--only", default="cantilever,rocker,bracket,mount")
     ap.add_argument("--settings", default="before,after")
     ap.add_argument("--no-reread", action="store_true")
@@ -71,7 +73,11 @@ def main():
           "export CPU s | export wall s |")
     print("|---|---|---|---|---|---|---|---|")
     for name in a.only.split(","):
-        job = os.path.join(a.work, name + ".json")
+        job = os.path.join(a.work, "%s_%s.json" % (name, a.run))
+        if not os.path.exists(job):
+            print("| %s | no run: %s is missing (run bench/result/run.py --settings %s first) |||||||"
+                  % (name, job, a.run))
+            continue
         run_dir = json.load(open(job))["output"]["directory"]
         threshold = json.load(open(os.path.join(run_dir, "history.json")))["threshold"]
         for setting in a.settings.split(","):

@@ -39,6 +39,7 @@
 #include <filesystem>
 #include <gp_Pln.hxx>
 #include <map>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -218,7 +219,46 @@ TopoDS_Shape merged(const TopoDS_Solid& body, const StepExportParams& params, in
   return body;
 }
 
+/// What a piece of the surface is made of, from its triangles' tags (iso_surface.h): the
+/// design region (free-form or Ω's faces) and the non-design solids it holds, e.g. "the design
+/// with non-design solids 1, 2" or "non-design solid 3 alone".
+std::string piece_makeup(const TriSurface& s, const std::vector<long>& triangles) {
+  bool design = false;
+  std::set<int> nondesign;
+  for (long q : triangles) {
+    if (s.tag[q] >= 0) design = true;
+    if (s.tag[q] < 0) nondesign.insert(-s.tag[q]);
+  }
+  std::ostringstream o;
+  o << (design ? "the design" : "");
+  if (!nondesign.empty()) o << (design ? " with " : "") << "non-design solid" << (nondesign.size() > 1 ? "s " : " ");
+  for (auto it = nondesign.begin(); it != nondesign.end(); ++it) o << (it == nondesign.begin() ? "" : ", ") << *it;
+  if (!design && nondesign.size() == 1) o << " alone";
+  return o.str();
+}
+
 }  // namespace
+
+std::vector<std::string> body_descriptions(const TriSurface& s) {
+  const SurfacePieces pieces = surface_pieces(s);
+  std::vector<std::string> out;
+  for (size_t k = 0; k < pieces.triangles.size(); ++k) {
+    if (pieces.volume[k] <= 0) continue;  // a closed void inside a body
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (long q : pieces.triangles[k])
+      for (int c = 0; c < 3; ++c) {
+        lo = lo.cwiseMin(s.V.row(s.F(q, c)).transpose());
+        hi = hi.cwiseMax(s.V.row(s.F(q, c)).transpose());
+      }
+    const Eigen::Vector3d centre = (lo + hi) / 2;
+    std::ostringstream o;
+    o.precision(4);
+    o << "body " << out.size() + 1 << ": " << pieces.volume[k] << " mm³ around (" << centre.x() << ", " << centre.y()
+      << ", " << centre.z() << "), " << piece_makeup(s, pieces.triangles[k]);
+    out.push_back(o.str());
+  }
+  return out;
+}
 
 int result_bodies(const TriSurface& s) {
   const SurfacePieces pieces = surface_pieces(s);
@@ -302,6 +342,17 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
                                    const Progress& progress) {
+  const std::vector<std::string> parts = body_descriptions(s);
+  if (parts.size() > 1) {
+    std::string named;
+    for (const std::string& b : parts) named += (named.empty() ? "" : "; ") + b;
+    progress.warn("result.step holds " + std::to_string(parts.size()) +
+                  " separate solids in one compound, because the design does not join them (as made they are "
+                  "separate parts): " +
+                  named +
+                  ". For one part, join them in the design: raise \"optimization.volume_fraction\", or load or "
+                  "support them so that the design has to carry them");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const double children_cpu0 = children_cpu_seconds();
   const pid_t caller = getpid();

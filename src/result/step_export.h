@@ -7,6 +7,7 @@
 // edges into one. The free-form region stays a shell of planar facets.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "common/progress.h"
 #include "result/iso_surface.h"
@@ -62,6 +63,13 @@ TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = 
 /// positive volume (a piece of negative volume is a closed void inside a body).
 int result_bodies(const TriSurface& s);
 
+/// The bodies of the result surface `s` (result_bodies), one line each in the order of their
+/// first triangle: volume (mm³, closed voids not subtracted), the centre of its bounding box
+/// and what it is made of (the design region, which non-design solids), e.g. "body 2: 27 mm³
+/// around (21.5, 17.5, 2.5), non-design solid 2 alone". Names the parts of a result the
+/// design does not join (a non-design solid held by its own support), in the user's terms.
+std::vector<std::string> body_descriptions(const TriSurface& s);
+
 /// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer) and
 /// measures its volume; seconds and bytes are left 0.
 StepExportReport describe_solid(const TopoDS_Shape& shape);
@@ -77,6 +85,9 @@ std::string solid_faults(const TopoDS_Shape& shape, int limit = 5);
 /// export, never the caller. Returns the report of the solid written. Throws Error(Timeout)
 /// past the budget, Error(Crashed) when OCCT ends the child, Error(InvalidShape) when the
 /// shape is not valid or not one solid per body (result_bodies), Error(Io) when the file cannot be written.
+/// A result of several bodies is written as one compound of solids (a STEP reader shows several
+/// solids), with a warning through progress naming each body (body_descriptions): the design
+/// does not join them, so as made they are separate parts.
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params = {},
                                    const Progress& progress = {});
 

@@ -42,6 +42,14 @@ int faces_on_plane_x(const TopoDS_Shape& shape, double x0) {
   return n;
 }
 
+/// The shape OCCT's STEP reader makes of the file at `path` (null when it cannot read it).
+TopoDS_Shape read_step(const std::string& path) {
+  STEPControl_Reader reader;
+  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return {};
+  reader.TransferRoots();
+  return reader.OneShape();
+}
+
 /// The export without coarsening: every triangle of the surface becomes (part of) a face, so
 /// the solid's volume is the surface's exactly.
 const StepExportParams kFacets{.coarsen = {.tolerance = 0}};
@@ -87,21 +95,55 @@ TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
   EXPECT_NEAR(r.volume, volume - 8, 1e-6 * volume);
 }
 
+TEST(StepExport, SeparateBodiesAreOneCompoundOfSolidsWithAWarningNamingEach) {
+  // The bracket's and the mount's results hold non-design solids the design does not join (held
+  // by their own supports): as made they are separate parts, so the STEP cannot honestly be one
+  // solid. What is checked: the file holds them as one compound of valid solids, one per body,
+  // and the user is told which bodies they are (volume, place, what they are made of).
+  const TriSurface bar = bar_surface();
+  const TriSurface two = testing::with_cube(bar, {20, 16, 1}, 3);  // a 3 mm cube clear of the bar
+  const std::vector<std::string> named = body_descriptions(two);
+  ASSERT_EQ(named.size(), 2u);
+  EXPECT_NE(named[0].find("the design with non-design solids"), std::string::npos) << named[0];
+  EXPECT_NE(named[1].find("body 2: 27 mm³ around (21.5, 17.5, 2.5)"), std::string::npos) << named[1];
+  std::vector<std::string> warnings;
+  Progress progress;
+  progress.log = [&](LogLevel level, const std::string& m) {
+    if (level == LogLevel::Warning) warnings.push_back(m);
+  };
+  const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_two.step").string();
+  const StepExportReport written = write_result_step(path, two, kFacets, progress);
+  EXPECT_TRUE(written.valid);
+  EXPECT_EQ(written.solids, 2);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2 separate solids in one compound"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find(named[1]), std::string::npos) << warnings[0];
+  const TopoDS_Shape shape = read_step(path);
+  ASSERT_FALSE(shape.IsNull());
+  const StepExportReport back = describe_solid(shape);
+  EXPECT_TRUE(back.valid);
+  EXPECT_EQ(back.solids, 2);
+  // one body: no warning
+  warnings.clear();
+  write_result_step(path, bar, kFacets, progress);
+  EXPECT_TRUE(warnings.empty());
+  std::filesystem::remove(path);
+}
+
 TEST(StepExport, TheStepFileReadsBackAsOneValidSolidOfTheSameVolume) {
   const TriSurface s = bar_surface();
   const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_test.step").string();
   const StepExportReport written = write_result_step(path, s);
   EXPECT_GT(written.bytes, 0);
-  STEPControl_Reader reader;
-  ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
-  reader.TransferRoots();
-  const StepExportReport back = describe_solid(reader.OneShape());
+  const TopoDS_Shape shape = read_step(path);
+  ASSERT_FALSE(shape.IsNull());
+  const StepExportReport back = describe_solid(shape);
   EXPECT_TRUE(back.valid);
   EXPECT_EQ(back.solids, 1);
   EXPECT_EQ(back.faces, written.faces);
   const double stl_volume = check_surface(s.V, s.F).volume;
   EXPECT_NEAR(back.volume, stl_volume, 0.005 * stl_volume);
-  EXPECT_EQ(faces_on_plane_x(reader.OneShape(), 0), 1);
+  EXPECT_EQ(faces_on_plane_x(shape, 0), 1);
   std::filesystem::remove(path);
 }
 
