@@ -148,6 +148,12 @@ OutputSettings parse_output(const json& section, const std::string& base_dir) {
   return o;
 }
 
+/// The "result" section: how the result surface is made; only its resolution for now.
+void parse_result(const json& section, OptimizeSettings& o) {
+  const Fields f(section, "result", {"resolution"}, "{\"resolution\": 2}");
+  o.smooth.resolution = f.integer("resolution", o.smooth.resolution, 1, 2);
+}
+
 /// A list section: each element parsed by `one(element, index)`.
 template <class T, class One>
 std::vector<T> parse_list(const Fields& top, const std::string& key, One one) {
@@ -181,8 +187,8 @@ void parse_face_name(const std::string& name, std::vector<int>& faces, std::vect
 
 Job parse_job(const std::string& text, const std::string& base_dir) {
   const json doc = io::parse_json_text(text, "job file");
-  const Fields top(doc, "",
-                   {"part", "nondesign", "mesh", "material", "supports", "load_cases", "optimization", "output"});
+  const Fields top(
+      doc, "", {"part", "nondesign", "mesh", "material", "supports", "load_cases", "optimization", "result", "output"});
   Job job;
   job.base_dir = base_dir;
   job.part = resolve(top.text("part", ""), base_dir);
@@ -199,6 +205,7 @@ Job parse_job(const std::string& text, const std::string& base_dir) {
       top.bad("load_cases[" + std::to_string(i) + "].name",
               "repeats the name \"" + job.load_cases[i].name + "\": give each load case its own");
   job.optimization = parse_optimization(top.has("optimization") ? top.at("optimization") : json::object());
+  parse_result(top.has("result") ? top.at("result") : json::object(), job.optimization);
   job.output = parse_output(top.has("output") ? top.at("output") : json::object(), base_dir);
   return job;
 }

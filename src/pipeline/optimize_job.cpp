@@ -14,6 +14,7 @@
 #include "io/vtu.h"
 #include "pipeline/output_files.h"
 #include "pipeline/problem_checks.h"
+#include "result/iso_surface_refine.h"
 #include "simp/density_filter.h"
 
 namespace topopt::pipeline {
@@ -199,8 +200,15 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   result::HygieneReport found;
   const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
   for (const std::string& w : found.warnings) progress.warn(w);
-  result::TriSurface s = result::extract_iso_surface(mesh, result::node_densities(mesh, cleaned), t,
-                                                     smooth.remesh ? smooth.crossing_margin : 0.0);
+  const double margin = smooth.remesh ? smooth.crossing_margin : 0.0;
+  const VecXd nd = result::node_densities(mesh, cleaned);
+  result::TriSurface s;
+  if (smooth.resolution > 1) {
+    const result::RefinedField fine = result::refine_near_level(mesh, nd, t);
+    s = result::extract_iso_surface(fine.mesh, fine.node_density, t, margin);
+  } else {
+    s = result::extract_iso_surface(mesh, nd, t, margin);
+  }
   const result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth);
   refuse_invalid(finished.check, t, smooth.repair, progress);
   if (surface_report) *surface_report = finished;

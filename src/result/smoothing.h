@@ -21,6 +21,9 @@ struct SmoothParams {
   /// With remesh: crossings kept this share of an edge away from its nodes when the surface is
   /// cut (extract_iso_surface's margin; slivers from crossings next to nodes never appear).
   double crossing_margin = 0.2;
+  /// The resolution the surface is cut at (job key "result.resolution"): 1 on the FE mesh, 2 on
+  /// the FE mesh with the design tets near the level split once (iso_surface_refine.h).
+  int resolution = 1;
 };
 
 /// Smooths s.V in place. Vertices with lock 2 do not move; with lock 1 they move only

@@ -178,6 +178,15 @@ TEST(Job, DuplicatedKeysAreErrors) {
                  ErrorCode::InvalidParameter, {"'vector' appears twice in 'load_cases[0].loads[0]'"});
 }
 
+TEST(Job, ResultResolutionIsOneOrTwoAndNamedWhenWrong) {
+  EXPECT_EQ(parse_job(R"({"result": {"resolution": 2}})", "/d").optimization.smooth.resolution, 2);
+  EXPECT_EQ(parse_job(R"({"result": {"resolution": 1}})", "/d").optimization.smooth.resolution, 1);
+  expect_message(R"({"result": {"resolution": 3}})", ErrorCode::InvalidParameter,
+                 {"'result.resolution' must be a whole number from 1 to 2, not 3"});
+  expect_message(R"({"result": {"resolution": 1.5}})", ErrorCode::InvalidParameter, {"'result.resolution'"});
+  expect_message(R"({"result": {"resolutoin": 2}})", ErrorCode::InvalidParameter, {"resolutoin"});
+}
+
 TEST(Job, IntegersAreWholeAndNumbersFinite) {
   expect_message(R"({"optimization": {"max_iterations": 2.5}})", ErrorCode::InvalidParameter,
                  {"'optimization.max_iterations' must be a whole number from 1 to 10000, not 2.5"});
