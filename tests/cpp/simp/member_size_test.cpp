@@ -1,9 +1,9 @@
 // Minimum and maximum member size (src/simp/controls/member_size.h): the filter radius a size
 // asks for against a closed form, the robust formulation's and the local volume constraint's
 // sensitivities against finite differences, and the maximum size measured on the optimised
-// design (member_measure.h), with a run without the control that breaks it. The minimum size
-// has no such test yet: on the 1.25 mm beam the measure found a 0.44 mm member in the free and
-// in the robust design alike (docs/optimization.md).
+// design (member_measure.h), with a run without the control that breaks it; the minimum size
+// measured on the cleaned crisp design against the free design's (its bound is below the set
+// size: docs/optimization.md says why).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +14,8 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "mesh/core/structured_box.h"
+#include "result/design_hygiene.h"
+#include "result/iso_surface.h"
 #include "simp/controls/member_measure.h"
 #include "simp/controls/member_size.h"
 #include "simp/density_filter.h"
@@ -56,6 +58,61 @@ VecXd random_field(long n, unsigned seed) {
   VecXd x(n);
   for (long i = 0; i < n; ++i) x[i] = u(rng);
   return x;
+}
+
+/// The crisp design as the user gets it (#T, 0/1): design hygiene at the threshold 0.5 (pieces
+/// that carry no load removed, closed voids filled), then the tets whose node densities
+/// average 0.5 or more (the tets the result surface is cut from).
+VecXd crisp_after_hygiene(const Cantilever& b, const VecXd& density) {
+  std::vector<char> anchors(b.mesh.V.rows(), 0);
+  for (int dof : b.supports.dofs) anchors[dof / 3] |= result::kAnchorSupport;
+  for (long i = 0; i < b.loads.rows(); ++i)
+    if (b.loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] |= result::kAnchorLoad;
+  result::HygieneReport report;
+  const VecXd cleaned = result::clean_design(b.mesh, density, 0.5, anchors, {}, report);
+  const std::vector<char> solid = result::crisp_tets(b.mesh, result::node_densities(b.mesh, cleaned), 0.5);
+  VecXd crisp(static_cast<long>(solid.size()));
+  for (size_t t = 0; t < solid.size(); ++t) crisp[static_cast<long>(t)] = solid[t];
+  return crisp;
+}
+
+/// Share of the solid design tets (domain 0) whose local thickness is below `size` (mm).
+double share_thinner(const TetMesh& mesh, const VecXd& crisp, const MemberMeasure& m, double size) {
+  long solid = 0, thin = 0;
+  for (long t = 0; t < crisp.size(); ++t)
+    if (crisp[t] > 0.5 && mesh.domain[t] == 0) ++solid, thin += m.thickness[t] < size;
+  return solid ? static_cast<double>(thin) / solid : 0.0;
+}
+
+TEST(MemberSize, MinimumSizeThickensTheCleanedResult) {
+  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm) with
+  // β run to its end (32), against the free design with a 2 mm filter
+  Cantilever b({24, 8, 8});
+  SimpParams p = run_params();
+  const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  p.controls.member.min_size = 4;
+  p.max_iterations = 120;
+  const SimpResult robust = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  MemberMeasureParams mp;
+  mp.reach = b.cell() / 2;
+  const VecXd free_crisp = crisp_after_hygiene(b, free_run.density),
+              robust_crisp = crisp_after_hygiene(b, robust.density);
+  const MemberMeasure free_m = measure_members(b.mesh, free_crisp, mp),
+                      robust_m = measure_members(b.mesh, robust_crisp, mp);
+  const double free_thin = share_thinner(b.mesh, free_crisp, free_m, 2.0),
+               robust_thin = share_thinner(b.mesh, robust_crisp, robust_m, 2.0);
+  std::cout << "smallest member after hygiene: free " << free_m.smallest_member << " mm (" << 100 * free_thin
+            << " % of its solid tets thinner than 2 mm), min size 4 mm: " << robust_m.smallest_member << " mm ("
+            << 100 * robust_thin << " %), beta " << robust.history.back().beta << ", grey "
+            << robust.history.back().grey << "\n";
+  EXPECT_EQ(robust.history.back().beta, 32) << "the continuation should reach its end";
+  EXPECT_LE(robust.history.back().grey, 0.03);
+  // the target, the set size to the mesh size (2.75 mm), is not reached: 1.875 mm
+  // measured, at tets in the bottom layer of cells along the part's face (docs/optimization.md)
+  EXPECT_GE(robust_m.smallest_member, 1.5);
+  EXPECT_LT(free_m.smallest_member, 1.0) << "the free design should hold a thinner member";
+  EXPECT_LE(robust_thin, 0.02);
+  EXPECT_GE(free_thin, 0.3);
 }
 
 TEST(MemberSize, RatioMatchesTheHelmholtzFiltersClosedForm) {
