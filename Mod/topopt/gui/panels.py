@@ -73,6 +73,9 @@ def _bindings():
     volume.setToolTip("Share of the design domain's volume to keep")
     size = _spin(0.0, 1e4, 0.5, 2, " mm", "automatic")
     iterations = _int_spin(1, 10000)
+    keep = QtGui.QCheckBox()
+    keep.setToolTip("Keep the material under every supported and loaded face (one element layer stays solid); "
+                    "off: the optimisation may remove it, and the verification then stops naming the face")
     return [
         _Binding("VolumeFraction", volume, lambda w: w.value(), lambda w, v: w.setValue(float(v)),
                  volume.valueChanged),
@@ -82,11 +85,13 @@ def _bindings():
         _Binding("Mesher", mesher, lambda w: w.currentText(), lambda w, v: w.setCurrentText(str(v)),
                  mesher.currentIndexChanged),
         _Binding("WallLayers", layers, lambda w: w.value(), lambda w, v: w.setValue(int(v)), layers.valueChanged),
+        _Binding("KeepLoadedFaces", keep, lambda w: w.isChecked(), lambda w, v: w.setChecked(bool(v)), keep.toggled),
     ]
 
 
 _LABELS = {"VolumeFraction": "Volume fraction", "MaxIterations": "Iterations (max)", "MeshSize": "Mesh size",
-           "Mesher": "Mesher", "WallLayers": "Thin-wall layers"}
+           "Mesher": "Mesher", "WallLayers": "Thin-wall layers",
+           "KeepLoadedFaces": "Keep loaded faces"}
 
 
 class _StudyObserver:
@@ -140,6 +145,7 @@ class StudyPanel:
         self.controls = ControlsBox(self.study)
         self.responses = ResponsesBox(self.study)
         layout.addWidget(self.controls.box)
+        layout.addWidget(self.controls.process.box)
         layout.addWidget(self.responses.box)
         layout.addWidget(self._run_box())
         layout.addWidget(self._result_box())
