@@ -8,26 +8,14 @@ import json
 import os
 import unittest
 
-import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from app.helpers import box_study
+from gui_helpers import BoxPanelCase, scroll_to, select, settle
 from topopt.app import api, runner
 from topopt.gui import panels
 
 SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
-
-
-def settle(n=20):
-    for _ in range(n):
-        QtGui.QApplication.processEvents()
-
-
-def select(obj, *subs):
-    FreeCADGui.Selection.clearSelection()
-    for sub in subs:
-        FreeCADGui.Selection.addSelection(obj, sub)
 
 
 def shoot_panel(panel, name):
@@ -37,12 +25,7 @@ def shoot_panel(panel, name):
     mw = FreeCADGui.getMainWindow()
     mw.resize(1280, 960)
     settle()
-    area = panel.form.parent()
-    while area is not None and not isinstance(area, QtGui.QScrollArea):
-        area = area.parent()
-    if area is not None:
-        area.ensureWidgetVisible(panel.controls.process.box)
-    settle()
+    scroll_to(panel, panel.controls.process.box)
     mw.grab().save(os.path.join(SHOTS, name))
     form = panel.form
     form.resize(form.width(), form.sizeHint().height())
@@ -63,24 +46,8 @@ def outside_their_parents(form):
     return out
 
 
-class ManufacturingPanel(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        FreeCAD.ConfigSet("TopOptNoDialogs", "1")  # errors go to the report view only
-        FreeCADGui.getMainWindow().show()
-        FreeCADGui.activateWorkbench("TopOptWorkbench")
-        settle()
-
-    def setUp(self):
-        self.doc, self.study = box_study("PanelProcess")
-        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
-        self.panel = panels.open_study_panel(self.study)
-        settle()
-
-    def tearDown(self):
-        if self.panel.is_open():
-            self.panel.reject()
-        FreeCAD.closeDocument(self.doc.Name)
+class ManufacturingPanel(BoxPanelCase):
+    DOCUMENT = "PanelProcess"
 
     def set_every_entry(self):
         p, part = self.panel.controls.process, self.study.Part
