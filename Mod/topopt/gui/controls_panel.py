@@ -309,25 +309,35 @@ class ProcessBox:
         layout.addRow("Max member size", self.max_member)
 
     def split(self):
+        """True for split casting (two dies, a parting plane), False for one-sided."""
         return self.draw_kind.currentText() == "split"
 
     def pick_draw(self):
+        """The draw direction from the first selected planar face (normal) or straight edge;
+        turns the draw direction on. Raises TopOptError naming what was picked otherwise."""
         obj, sub = _picked("a planar face or a straight edge")[0]
         self.draw_dir.set(picking.direction_of(obj, sub))
         self.draw_on.setChecked(True)
 
     def pick_parting_point(self):
+        """The parting plane's point from the first selected vertex (or a face's or edge's
+        centre); makes the draw direction a split one. Raises TopOptError when nothing fits."""
         obj, sub = _picked("a vertex, an edge or a face")[0]
         self.parting_point.set(picking.point_of(obj, sub))
         self.draw_kind.setCurrentText("split")
         self.draw_on.setChecked(True)
 
     def pick_build(self):
+        """The build direction from the first selected planar face (normal) or straight edge;
+        turns the overhang limit on. Raises TopOptError naming what was picked otherwise."""
         obj, sub = _picked("a planar face or a straight edge")[0]
         self.build_dir.set(picking.direction_of(obj, sub))
         self.overhang_on.setChecked(True)
 
     def pick_base_face(self):
+        """The base plate's face ("FaceN") from the first selected face of the study's part;
+        turns the overhang limit on. Raises TopOptError for anything else (another object, an
+        edge): the base face is left as it was."""
         obj, sub = _picked("the part's face on the base plate")[0]
         self._show_base_face(picking.part_face(self.study.Part, obj, sub))
         self.overhang_on.setChecked(True)
