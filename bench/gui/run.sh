@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs bench/gui/verify_cost.py in FreeCADCmd with this tree's built workbench (build/workbench)
+# Runs bench/gui/verify_cost.py (or bench/gui/$TOPOPT_BENCH.py) in FreeCADCmd with this tree's built workbench (build/workbench)
 # (or TOPOPT_WB) installed into a private FreeCAD user home.  bench/gui/run.sh [iterations]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -9,4 +9,5 @@ mkdir -p "$home/Mod"
 ln -s "${TOPOPT_WB:-$root/build/workbench/TopOpt}" "$home/Mod/TopOpt"
 export FREECAD_USER_HOME="$home" OMP_NUM_THREADS=1
 export TOPOPT_SHARED_DATA="${TOPOPT_SHARED_DATA:-$root/../shared/data}"
-freecadcmd -c "import sys; sys.argv = ['verify_cost', '${1:-0}']; exec(open('$root/bench/gui/verify_cost.py').read())"
+script="$root/bench/gui/${TOPOPT_BENCH:-verify_cost}.py"
+freecadcmd -c "import sys; sys.path.insert(0, '$root/bench/gui'); sys.argv = ['$script', '${1:-0}']; exec(open('$script').read())"

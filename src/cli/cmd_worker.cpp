@@ -5,6 +5,7 @@
 #include <unistd.h>
 #include <Standard_Failure.hxx>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -26,6 +27,7 @@
 #include "pipeline/job.h"
 #include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
+#include "pipeline/output_files.h"
 #include "pipeline/result_files.h"
 #include "pipeline/run_job.h"
 #include "pipeline/solve_job.h"
@@ -44,7 +46,9 @@ const char* kUsage =
     "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
     "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
-    "     DIR/result.step, the shape as one CAD solid), \"output\": DIR}\n"
+    "     DIR/result.step, the shape as one CAD solid; optimize: result_first: 1 writes result.json\n"
+    "     and prints {\"stage\": \"result\"} before the verification, result.json again after it),\n"
+    "     \"output\": DIR}\n"
     "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
     "  progress {\"stage\", \"fraction\", \"message\"}, iterations {\"iteration\", \"compliance\",\n"
     "  \"volume\", \"change\", \"seconds\"}, {\"warning\"}, and last {\"done\": true} or {\"error\":\n"
@@ -240,6 +244,44 @@ void put_result_files(json& result, const fs::path& dir, const pipeline::Job& jo
   for (const std::string& path : files.written) result["files"].push_back(fs::path(path).filename().string());
 }
 
+void write_result(const fs::path& dir, const json& result);
+
+/// verification.json in `dir` as a json object ({} when there is none).
+json read_report(const fs::path& dir) {
+  std::ifstream f(dir / "verification.json");
+  return f ? json::parse(f, nullptr, false) : json::object();
+}
+
+/// Result first, verification after (params "result_first": 1, with output.verification): the
+/// result files but the verification (result.step as asked), then result.json and the progress
+/// line {"stage": "result"} (the workbench shows the result there), then the verification; the
+/// verification.json of both parts is merged (the step's report and failures kept) and
+/// result.json written again at the end with every file.
+void put_result_files_first(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
+                            std::vector<std::string>& warnings, WorkerChannel& ch, const Progress& progress) {
+  pipeline::Job shape = job, verification = job;
+  shape.output.verification = false;
+  verification.output.step = false;
+  put_result_files(result, dir, shape, run, progress);
+  json files = result["files"];
+  result["warnings"] = warnings;
+  write_result(dir, result);
+  ch.progress("result", -1, "the result is ready: verifying it");
+  const json first = read_report(dir);
+  put_result_files(result, dir, verification, run, progress);
+  json report = read_report(dir);
+  if (first.is_object() && report.is_object()) {
+    if (first.contains("step")) report["step"] = first["step"];
+    const json failed = first.value("failed", json::object());  // named: items() refers to it
+    for (const auto& [key, value] : failed.items()) report["failed"][key] = value;
+    pipeline::write_replacing((dir / "verification.json").string(),
+                              [&](const std::string& p) { std::ofstream(p) << report.dump(2) << "\n"; });
+  }
+  for (const auto& name : result["files"])
+    if (std::find(files.begin(), files.end(), name) == files.end()) files.push_back(name);
+  result["files"] = files;
+}
+
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
   const pipeline::Job job = job_of(r);
@@ -266,7 +308,10 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
   put_tet_mesh(result, r.output, run.mesh);
   put_array(result, r.output, "densities", o.simp.density);
   put_result_surface(result, r.output, o.surface);
-  put_result_files(result, r.output, job, run, progress);
+  if (job.output.verification && param(r, "result_first", 0) != 0)
+    put_result_files_first(result, r.output, job, run, warnings, ch, progress);
+  else
+    put_result_files(result, r.output, job, run, progress);
   result["warnings"] = warnings;  // with those of the last iterate's analysis and the result files
   return result;
 }

@@ -82,6 +82,13 @@ def _force(study, c, label):
     return {"type": "force", "faces": face_names(study, c.References, label), "vector": [force * x for x in d]}
 
 
+def _pressure(study, c, label):
+    """FEM's pressure (MPa; a float in FreeCAD 0.20, a quantity in 1.x), negative when
+    Reversed (a pull)."""
+    p = units.prop(c, "Pressure", "MPa")
+    return {"type": "pressure", "faces": face_names(study, c.References, label), "value": -p if c.Reversed else p}
+
+
 def constraint_to_job(study, c):
     """(kind, item) for one constraint object: kind is "support" or "load". Values are read
     whether FreeCAD stores them as floats (0.20) or quantities (1.x)."""
@@ -97,9 +104,7 @@ def constraint_to_job(study, c):
     if t == "Fem::ConstraintForce":
         return "load", _force(study, c, label)
     if t == "Fem::ConstraintPressure":
-        p = units.prop(c, "Pressure", "MPa")
-        return "load", {"type": "pressure", "faces": face_names(study, c.References, label),
-                        "value": -p if c.Reversed else p}
+        return "load", _pressure(study, c, label)
     if t == "Fem::ConstraintSelfWeight" or proxy_type == "Fem::ConstraintSelfWeight":
         return "load", {"type": "gravity", "vector": units.gravity(c)}
     raise errors.TopOptError("%s (%s) is not a support or load TopOpt knows: use fixed, displacement, "
@@ -131,7 +136,8 @@ def study_to_job(study):
         "supports": supports,
         "load_cases": [{"name": "loads", "weight": 1.0, "loads": loads}],
         "optimization": {"volume_fraction": n["VolumeFraction"], "penalty": n["Penalty"], "filter": study.Filter,
-                         "update": study.Update, "max_iterations": n["MaxIterations"]},
+                         "update": study.Update, "max_iterations": n["MaxIterations"],
+                         "keep_loaded_faces": bool(getattr(study, "KeepLoadedFaces", True))},
     }
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]

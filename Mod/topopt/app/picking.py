@@ -71,3 +71,23 @@ def direction_of(obj, sub=""):
         return axis_of(obj, sub)[1]
     raise TopOptError("%s gives no direction: pick a planar face (its normal) or a straight edge" % what,
                       "InvalidParameter")
+
+
+def point_of(obj, sub=""):
+    """A point from a picked vertex (its position), or the centre of a picked face or edge (its
+    centre of mass): e.g. a parting plane's point."""
+    element, what = _element(obj, sub)
+    if element.ShapeType == "Vertex":
+        return _vec(element.Point)
+    if element.ShapeType in ("Face", "Edge"):
+        return _vec(element.CenterOfMass)
+    raise TopOptError("%s gives no point: pick a vertex, an edge or a face" % what, "InvalidParameter")
+
+
+def part_face(part, obj, sub):
+    """The job's name ("Face5") of a picked face of `part` (the study's part), for a base
+    plate; any other pick is refused naming what was picked."""
+    if obj != part or not sub.startswith("Face"):
+        raise TopOptError("%s of %s is not a face of the part %s: pick the part's face that stands on the "
+                          "base plate" % (sub or "the whole", obj.Label, part.Label), "FaceNotFound")
+    return sub

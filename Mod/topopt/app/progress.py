@@ -17,6 +17,7 @@ TITLES = {
     "solve": "analysing the last iterate",
     "write": "writing the results",
     "step": "writing the result as a STEP solid",
+    "result": "result ready, verifying it",
     "verification": "verifying the result solid (meshing and analysing it)",
     "document": "updating the document",
 }
@@ -25,7 +26,7 @@ TITLES = {
 SPANS = {
     "optimize": {"read": (0.0, 0.02), "brep": (0.02, 0.06), "mesh": (0.06, 0.40), "simp": (0.40, 0.90),
                  "surface": (0.90, 0.93), "solve": (0.93, 0.95), "write": (0.95, 0.96),
-                 "step": (0.96, 0.97), "verification": (0.97, 1.0)},
+                 "step": (0.96, 0.97), "result": (0.97, 0.97), "verification": (0.97, 1.0)},
     "mesh": {"read": (0.0, 0.03), "brep": (0.03, 0.10), "mesh": (0.10, 0.95), "write": (0.95, 1.0)},
     "extract_surface": {"read": (0.0, 0.1), "surface": (0.1, 0.9), "write": (0.9, 1.0)},
     "info": {"read": (0.0, 0.2), "brep": (0.2, 1.0), "mesh": (0.2, 1.0)},

@@ -57,7 +57,7 @@ def transaction(doc, name):
     doc.commitTransaction()
 
 
-def execute(prepared, on_progress=None, cancel=None):
+def execute(prepared, on_progress=None, cancel=None, on_result=None):
     """Runs mesh → SIMP → surface → the last iterate's analysis in the worker process.
     on_progress(record) gets a dict per stage ({"stage", "fraction", "message"}) and iteration
     ({"iteration", "compliance", "volume", "change", "seconds"}) in the calling thread; it
@@ -66,10 +66,17 @@ def execute(prepared, on_progress=None, cancel=None):
     gone silent). Returns the result dict: nodes, tets, domain, boundary_triangles,
     boundary_faces, boundary_nondesign_faces, densities, displacement (#V x 3, mm) and
     von_mises (#T, MPa) of the last iterate, history, threshold, surface_points,
-    surface_triangles, surface_tags, status, seconds, warnings. Raises TopOptError (see
-    worker.run)."""
+    surface_triangles, surface_tags, status, seconds, warnings, files. on_result(result):
+    result first, verification after: when the job verifies its result (the study's Verify),
+    called in the calling thread with the result dict as soon as the shape (and result.step)
+    is written, before the verification; the dict returned at the end then adds the
+    verification's files (apply_verification), and a cancel after on_result stops the
+    verification only. Without verification on_result is never called. Raises TopOptError
+    (see worker.run)."""
+    first = on_result is not None and bool(prepared.job.get("output", {}).get("verification"))
     return worker.run("optimize", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
-                      on_progress=on_progress, cancel=cancel)
+                      on_progress=on_progress, cancel=cancel, params={"result_first": 1} if first else None,
+                      on_result=on_result if first else None)
 
 
 def store_mesh(study, nodes, tets, domain):
@@ -155,6 +162,18 @@ def apply(study, result):
     quiet.recompute(doc)
     results.style_result(feature)
     return feature
+
+
+def apply_verification(study, result):
+    """After a result-first run (execute's on_result, then apply): keeps the run's final files
+    (result["files"]: result.step, verification.json with the verification's figures,
+    verification.vtu) in the study and makes its verification objects (FEM mesh, result,
+    fields). Callers wrap it in an undo transaction. Returns the verification's FEM result
+    object, or None when the verification failed (verification.json says why)."""
+    asbuilt.store_files(study, result.get("files", {}))
+    res = asbuilt.update_verification(study)
+    quiet.recompute(study.Document)
+    return res
 
 
 def where_results_are(study):

@@ -147,6 +147,11 @@ class Study:
                             "Update scheme: optimality criteria or MMA")
             obj.Update = ["oc", "mma"]
         _add(obj, "App::PropertyInteger", "MaxIterations", "Optimization", "Iteration cap", 80)
+        _add(obj, "App::PropertyBool", "KeepLoadedFaces", "Optimization",
+             "Keep the material under every supported and loaded face: the design elements touching those "
+             "faces stay solid (one element layer, outside the volume fraction), so the result keeps every "
+             "face a load or support acts on. Off: the optimisation may remove it (the verification then "
+             "stops, naming the face it lost)", True)
         _add(obj, "App::PropertyString", "GeometryControls", "Optimization",
              "Geometry controls as the job's \"controls\" object in JSON (symmetry planes, cyclic, "
              "patterns, extrusion; docs/optimization.md); empty = none. Set with api.set_controls", "")

@@ -191,9 +191,11 @@ def _hand_over(record, on_progress):
                       % (answer, type(answer).__name__), "InvalidParameter")
 
 
-def _follow(worker, on_progress, cancel, timeout):
+def _follow(worker, on_progress, cancel, timeout, on_result=None):
     """Reads the worker's lines until its last one; returns that final record (None if the
-    worker ended without one) and where it was. Raises TopOptError on cancel or timeout."""
+    worker ended without one) and where it was. on_result(): called when the worker says its
+    result is ready ({"stage": "result"}) before it goes on. Raises TopOptError on cancel or
+    timeout."""
     where = _Progress()
     deadline = time.monotonic() + timeout if timeout else None
     final = None
@@ -208,6 +210,8 @@ def _follow(worker, on_progress, cancel, timeout):
                 final = record
                 continue
             where.update(record)
+            if record.get("stage") == "result" and on_result is not None:
+                on_result()
             if _hand_over(record, on_progress):
                 raise TopOptError("cancelled while %s" % where.activity(), "Cancelled")
         if ended and not more:
@@ -235,7 +239,7 @@ def _load(out):
 
 
 def run(operation, job=None, part=None, nondesign=None, arrays=None, params=None, on_progress=None,
-        cancel=None, timeout=None):
+        cancel=None, timeout=None, on_result=None):
     """Runs one operation of the core in the worker process and returns its results.
 
     operation: "optimize", "mesh" (need `job`, a job dict, and `part`), "info", "surface_mesh"
@@ -245,6 +249,10 @@ def run(operation, job=None, part=None, nondesign=None, arrays=None, params=None
     dict ({"stage", "fraction", "message"} or {"iteration", "compliance", "volume", "change",
     "seconds"}) in the calling thread; it returns True to cancel, False or None to go on.
     cancel(): polled ten to twenty times a second; True cancels. timeout: seconds, None for no limit.
+    on_result(result): with params {"result_first": 1} to "optimize" (and the job's
+    output.verification on), called in the calling thread with the result as it stands before
+    the verification (the dict below, without the verification's files) while the worker goes
+    on to verify it; a cancel after that stops the verification only (the caller has the result).
 
     Returns a dict: the operation's scalars (result.json) and its arrays (numpy).
     Raises TopOptError: the core's own errors with their codes; "WorkerCrashed" (naming the
@@ -255,7 +263,8 @@ def run(operation, job=None, part=None, nondesign=None, arrays=None, params=None
     try:
         worker = _Worker(_write_request(folder, operation, job, part, nondesign, arrays, params), folder)
         try:
-            final, where = _follow(worker, on_progress, cancel, timeout)
+            early = (lambda: on_result(_load(os.path.join(folder, "out")))) if on_result is not None else None
+            final, where = _follow(worker, on_progress, cancel, timeout, early)
             worker.wait_exit(10.0)  # its last line is out; let it close down by itself
         finally:
             status = worker.end()

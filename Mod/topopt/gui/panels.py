@@ -73,6 +73,9 @@ def _bindings():
     volume.setToolTip("Share of the design domain's volume to keep")
     size = _spin(0.0, 1e4, 0.5, 2, " mm", "automatic")
     iterations = _int_spin(1, 10000)
+    keep = QtGui.QCheckBox()
+    keep.setToolTip("Keep the material under every supported and loaded face (one element layer stays solid); "
+                    "off: the optimisation may remove it, and the verification then stops naming the face")
     return [
         _Binding("VolumeFraction", volume, lambda w: w.value(), lambda w, v: w.setValue(float(v)),
                  volume.valueChanged),
@@ -82,11 +85,13 @@ def _bindings():
         _Binding("Mesher", mesher, lambda w: w.currentText(), lambda w, v: w.setCurrentText(str(v)),
                  mesher.currentIndexChanged),
         _Binding("WallLayers", layers, lambda w: w.value(), lambda w, v: w.setValue(int(v)), layers.valueChanged),
+        _Binding("KeepLoadedFaces", keep, lambda w: w.isChecked(), lambda w, v: w.setChecked(bool(v)), keep.toggled),
     ]
 
 
 _LABELS = {"VolumeFraction": "Volume fraction", "MaxIterations": "Iterations (max)", "MeshSize": "Mesh size",
-           "Mesher": "Mesher", "WallLayers": "Thin-wall layers"}
+           "Mesher": "Mesher", "WallLayers": "Thin-wall layers",
+           "KeepLoadedFaces": "Keep loaded faces"}
 
 
 class _StudyObserver:
@@ -112,6 +117,8 @@ class StudyPanel:
         self.messages = queue.Queue()
         self.cancel_requested = False
         self.tracker = None
+        self.verifying = False  # the result is shown; the worker still verifies it
+        self.verify_started = 0.0
         self.status_bar = None
         self.writing = False
         self.closed = False
@@ -140,6 +147,7 @@ class StudyPanel:
         self.controls = ControlsBox(self.study)
         self.responses = ResponsesBox(self.study)
         layout.addWidget(self.controls.box)
+        layout.addWidget(self.controls.process.box)
         layout.addWidget(self.responses.box)
         layout.addWidget(self._run_box())
         layout.addWidget(self._result_box())
@@ -176,6 +184,11 @@ class StudyPanel:
         self.status = QtGui.QLabel(self.study.Status or "")
         self.status.setWordWrap(True)  # an error says what to try: all of it must show
         layout.addWidget(self.status)
+        self.verify_status = QtGui.QLabel(_verification_text(self.study))
+        self.verify_status.setWordWrap(True)
+        self.verify_status.setToolTip("The verification of the result solid (the study's Verify): it runs after "
+                                      "the result is shown; Stop during it stops the verification only")
+        layout.addWidget(self.verify_status)
         self.plot = HistoryPlot()
         self.plot.set_history(self.study.ComplianceHistory, self.study.VolumeHistory)
         layout.addWidget(self.plot)
@@ -302,8 +315,12 @@ class StudyPanel:
         def on_progress(record):
             self.messages.put(("progress", record))
             return self.cancel_requested
+
+        def on_result(result):  # result first, the verification after (the study's Verify)
+            self.messages.put(("result", (result, self.tracker.clock())))  # when the worker said so
         try:
-            self.messages.put(("done", runner.execute(prepared, on_progress, lambda: self.cancel_requested)))
+            self.messages.put(("done", runner.execute(prepared, on_progress, lambda: self.cancel_requested,
+                                                      on_result)))
         except TopOptError as e:
             self.messages.put(("error", e))
         except Exception as e:  # never let a worker exception vanish
@@ -311,7 +328,7 @@ class StudyPanel:
 
     def request_cancel(self):
         self.cancel_requested = True
-        self.status.setText("stopping…")
+        (self.verify_status if self.verifying else self.status).setText("stopping…")
 
     def poll(self):
         while True:
@@ -321,6 +338,8 @@ class StudyPanel:
                 return
             if kind == "progress":
                 self._show_progress(payload)
+            elif kind == "result":
+                self._show_result_first(*payload)
             else:
                 self._finish(kind, payload)
                 return
@@ -329,15 +348,20 @@ class StudyPanel:
         self.tracker.update(record)
         if "iteration" in record:
             self.plot.add(record["compliance"], record["volume"])
+        self.status_bar.show(self.tracker.fraction, self.tracker.label)
+        if self.verifying:  # the result is shown: the verification has its own line
+            self.verify_status.setText("verification: %s" % self.tracker.label)
+            return
         self.progress.setValue(self.tracker.percent())
         self.status.setText(self.tracker.label)
-        self.status_bar.show(self.tracker.fraction, self.tracker.label)
 
     def _finish(self, kind, payload):
         self.timer.stop()
         self.thread = None
         self.tracker.finish()
-        if kind == "done":
+        if self.verifying:
+            self._finish_verification(kind, payload)
+        elif kind == "done":
             self._apply(payload)
         elif payload.code == "Cancelled" and self.cancel_requested:
             self.status.setText("stopped (%s); the document is as it was" % payload)
@@ -357,7 +381,7 @@ class StudyPanel:
                     runner.apply(self.study, result)
         except TopOptError as e:
             report_error(e)
-            return
+            return False
         seconds = self.tracker.clock() - self.tracker.started
         runner.report_run(self.study, result, self.tracker, seconds)
         self.progress.setValue(100)
@@ -365,6 +389,54 @@ class StudyPanel:
         self.status_bar.done("%s: %s in %.0f s" % (self.study.Label, self.study.Status, seconds))
         self.volume_data = None
         self._show_result_state()
+        return True
+
+    def _show_result_first(self, result, ready):
+        """The result is written and the worker goes on to verify it: the result is applied and
+        shown now (its own undo step), the study is usable again (settings, threshold), and
+        Stop now stops the verification only. ready: the tracker's clock when the worker
+        said the result was written (the verification's start)."""
+        if not self._apply(result):  # the document refused the result: no verification of it either
+            self.request_cancel()
+            return
+        self.verifying = True
+        self.verify_started = ready
+        self._set_running(False)
+        self.run_button.setEnabled(False)  # one worker at a time: Run again after the verification
+        self.cancel_button.setEnabled(True)
+        self.cancel_button.setText("Stop verification")
+        self.verify_status.setText("verification: meshing and analysing the result solid…")
+        self._begin_edit()
+
+    def _finish_verification(self, kind, payload):
+        """The verification after the shown result ended: its files and FEM objects kept (an
+        undo step, "TopOpt verification"), or stopped or failed, the result staying."""
+        self.verifying = False
+        self.cancel_button.setText("Stop")
+        seconds = self.tracker.clock() - self.verify_started
+        label = self.study.Label
+        if kind == "done":
+            self._commit()
+            try:
+                with runner.transaction(self.doc, "TopOpt verification"):
+                    runner.apply_verification(self.study, payload)
+            except TopOptError as e:
+                self.verify_status.setText("verification failed: %s; the result stays" % e)
+                report_error(e)
+                return
+            from topopt.app import asbuilt
+            lines = ["TopOpt: verification of %s in %.0f s" % (label, seconds)] + asbuilt.summary_lines(self.study)
+            FreeCAD.Console.PrintMessage("\n".join(lines) + "\n")
+            self.verify_status.setText(_verification_text(self.study, seconds))
+            self.status_bar.done("%s: verified in %.0f s" % (label, seconds))
+        elif payload.code == "Cancelled" and self.cancel_requested:
+            self.verify_status.setText("verification stopped; the result stays")
+            self.status_bar.done("verification stopped")
+            FreeCAD.Console.PrintMessage("TopOpt: verification of %s stopped; the result stays\n" % label)
+        else:
+            self.verify_status.setText("verification failed: %s; the result stays" % payload)
+            self.status_bar.done("verification failed")
+            report_error(payload)
 
     def wait(self, seconds=600.0):
         """Blocks (processing events) until the run ends; for scripted GUI tests."""
@@ -387,7 +459,7 @@ class StudyPanel:
     def _show_result_state(self):
         """The slider at the shown result's threshold (the run's, or where the slider left it)."""
         data = self._stored()
-        self.threshold.setEnabled(data is not None and self.thread is None)
+        self.threshold.setEnabled(data is not None and (self.thread is None or self.verifying))
         t = float(self.study.Threshold)
         if data is not None and not 0 < t < 1:  # a document of an older version
             t = results.volume_threshold(data[0], data[1], data[2], data[3], float(self.study.VolumeFraction))
@@ -461,6 +533,20 @@ class StudyPanel:
         if self.thread is not None:
             self.request_cancel()
             self.wait(30)
+
+
+def _verification_text(study, seconds=None):
+    """The verification's line: its figures, why it failed, or nothing when none ran."""
+    from topopt.app import asbuilt
+    report = asbuilt.verification_report(study)
+    took = " in %.0f s" % seconds if seconds is not None else ""
+    if "compliance_as_built" in report:
+        return "verified%s: as-built compliance %.4g N·mm (%.3f × the crisp design's), max von Mises %.4g MPa" % (
+            took, report["compliance_as_built"], report.get("ratio", 0.0), report.get("max_von_mises", 0.0))
+    failed = report.get("failed", {}).get("verification")
+    if failed:
+        return "verification failed: %s" % failed.get("message", "")
+    return ""
 
 
 def _close_application_transaction(abort):

@@ -149,6 +149,61 @@ class ForceDirections(unittest.TestCase):
         self.assertNotIn("threshold", before["optimization"])
 
 
+class ConstraintValues(unittest.TestCase):
+    """FEM's constraints as FreeCAD 0.20 stores them (floats in N, MPa, mm) and as 1.x does
+    (quantities), read by the job into the same supports and loads."""
+
+    def setUp(self):
+        self.doc, self.study = box_study("ConstraintValues")
+        self.part = self.study.Part
+
+    def tearDown(self):
+        FreeCAD.closeDocument(self.doc.Name)
+
+    def quantity_constraint(self, props):
+        """A FreeCAD 1.x-like constraint: quantity properties on Face2 of the part."""
+        obj = fake_object(self.doc, props)
+        obj.addProperty("App::PropertyLinkSubList", "References", "Test", "")
+        obj.References = [(self.part, "Face2")]
+        return obj
+
+    def test_force_pressure_and_components_read_alike(self):
+        from topopt.app import job as jobmod
+        force = ObjectsFem.makeConstraintForce(self.doc, "F")
+        force.References = [(self.part, "Face2")]
+        force.Force = 1500.0  # FreeCAD 0.20: N as a float
+        directions.set_vector_direction(force, (0, 0, -1))
+        self.doc.recompute()
+        new_force = self.quantity_constraint([("App::PropertyForce", "Force", "1.5 kN"),
+                                              ("App::PropertyVector", "TopOptDirection", FreeCAD.Vector(0, 0, -1))])
+        old_item, new_item = jobmod._force(self.study, force, "F"), jobmod._force(self.study, new_force, "F")
+        self.assertEqual((old_item["type"], old_item["faces"]), (new_item["type"], new_item["faces"]))
+        for a, b, expected in zip(old_item["vector"], new_item["vector"], (0.0, 0.0, -1500.0)):
+            self.assertAlmostEqual(a, expected, places=9)
+            self.assertAlmostEqual(b, expected, places=9)
+        pressure = ObjectsFem.makeConstraintPressure(self.doc, "P")
+        pressure.References = [(self.part, "Face2")]
+        pressure.Pressure, pressure.Reversed = 2.0, True  # MPa as a float, pulling
+        new_pressure = self.quantity_constraint([("App::PropertyPressure", "Pressure", "2000 kPa"),
+                                                 ("App::PropertyBool", "Reversed", True)])
+        self.assertEqual(jobmod._pressure(self.study, pressure, "P"), jobmod._pressure(self.study, new_pressure, "P"))
+        self.assertEqual(jobmod._pressure(self.study, new_pressure, "P")["value"], -2.0)
+        fixed = ObjectsFem.makeConstraintDisplacement(self.doc, "D")
+        fixed.References = [(self.part, "Face2")]
+        fixed.xFix, fixed.xFree, fixed.yFree, fixed.zFree = True, False, True, True
+        props = [("App::PropertyBool", a + kind, a == "x" if kind == "Fix" else a != "x")
+                 for a in "xyz" for kind in ("Fix", "Free")]
+        new_fixed = self.quantity_constraint(props + [("App::PropertyDistance", a + "Displacement", "0 mm")
+                                                      for a in "xyz"])
+        self.assertEqual(jobmod._components(self.study, fixed, "D"), jobmod._components(self.study, new_fixed, "D"))
+        self.assertEqual(jobmod._components(self.study, new_fixed, "D")["fix"], ["x"])
+        new_fixed.yFree = False
+        new_fixed.yDisplacement = FreeCAD.Units.Quantity("0.5 mm")  # a prescribed move: refused, named
+        with self.assertRaises(TopOptError) as e:
+            jobmod._components(self.study, new_fixed, "'D'")
+        self.assertIn("'D' prescribes a non-zero displacement", str(e.exception))
+
+
 class StudyUnits(unittest.TestCase):
     def setUp(self):
         self.doc, self.study = box_study("StudyUnits")

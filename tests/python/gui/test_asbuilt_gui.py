@@ -13,16 +13,12 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from app.helpers import box_study, top_loaded_box_study
+from gui_helpers import BoxPanelCase, open_workbench, select, settle
+from app.helpers import top_loaded_box_study
 from topopt.app import api
 from topopt.gui import panels
 
 SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
-
-
-def settle(n=20):
-    for _ in range(n):
-        QtGui.QApplication.processEvents()
 
 
 def screenshot(name, fit=True):
@@ -41,30 +37,8 @@ def screenshot(name, fit=True):
     return window, view
 
 
-def select(obj, *subs):
-    FreeCADGui.Selection.clearSelection()
-    for sub in subs:
-        FreeCADGui.Selection.addSelection(obj, sub)
-
-
-class Panel(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        FreeCAD.ConfigSet("TopOptNoDialogs", "1")  # errors go to the report view only
-        FreeCADGui.getMainWindow().show()
-        FreeCADGui.activateWorkbench("TopOptWorkbench")
-        settle()
-
-    def setUp(self):
-        self.doc, self.study = box_study("PanelControls")
-        FreeCADGui.ActiveDocument.ActiveView.viewIsometric()
-        self.panel = panels.open_study_panel(self.study)
-        settle()
-
-    def tearDown(self):
-        if self.panel.is_open():
-            self.panel.reject()
-        FreeCAD.closeDocument(self.doc.Name)
+class Panel(BoxPanelCase):
+    DOCUMENT = "PanelControls"
 
     def test_values_set_in_the_panel_reach_the_study_and_its_job(self):
         p, part = self.panel, self.study.Part
@@ -144,9 +118,7 @@ class Panel(unittest.TestCase):
 class ResultAsCad(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        FreeCAD.ConfigSet("TopOptNoDialogs", "1")
-        FreeCADGui.getMainWindow().show()
-        FreeCADGui.activateWorkbench("TopOptWorkbench")
+        open_workbench()
         cls.doc, cls.study = top_loaded_box_study("ResultAsCad")
         api.run(cls.study, verbose=False)
         settle()
