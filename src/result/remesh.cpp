@@ -61,8 +61,6 @@ class Remesher {
   bool planar(int tag) const {
     return tag > 0 && tag < static_cast<int>(s_.face_plane.size()) && s_.face_plane[tag].head<3>().norm() > 0;
   }
-  /// Triangles the remesher may change: the free-form region, and Ω's planar faces if allowed.
-  bool workable(int t) const { return m_.tag(t) == 0 || (p_.planar_faces && planar(m_.tag(t))); }
 
   /// Flips the best edge of t if that helps, else collapses its shortest edge. 1 if changed.
   int improve(int t) {
@@ -180,18 +178,25 @@ class Remesher {
     return false;
   }
 
-  /// Flips edge ab when its two triangles share a tag and lie nearly in one plane (on the
-  /// free-form region: bent less than flat_dihedral; on a planar Ω face: its plane; on any other
-  /// face: one plane to kCoplanar), and the flip raises their smallest angle. Flips move no point.
+  /// The cosine of the largest bend of an edge between two triangles of tag `tag` that a flip
+  /// may turn: flat_dihedral on the free-form region, curved_dihedral on a curved Ω face (its four
+  /// points stay on the face, the new triangles are chords of it as the old ones were), 90 on a
+  /// planar Ω face (its triangles lie in its plane), and one plane to kCoplanar on the
+  /// non-design solids' faces (a tag names a solid, not a face: the flip must not cut an edge).
+  double flip_min_cos(int tag) const {
+    if (tag == 0) return std::cos(p_.flat_dihedral * M_PI / 180);
+    if (tag > 0 && p_.planar_faces) return planar(tag) ? 0 : std::cos(p_.curved_dihedral * M_PI / 180);
+    return 1 - kCoplanar;
+  }
+
+  /// Flips edge ab when its two triangles share a tag and bend less than flip_min_cos allows, and the
+  /// flip raises their smallest angle. Flips move no point.
   bool flip(int a, int b) {
     EditableSurface::Flip f;
     if (!m_.flip_of(a, b, f)) return false;
     const Eigen::Vector3d n1 = normal_of(s_.V, m_.tri(f.t1)), n2 = normal_of(s_.V, m_.tri(f.t2));
     if (n1.norm() == 0 || n2.norm() == 0) return false;
-    // elsewhere (non-design faces, curved Ω faces) only within one plane: the surface stays put
-    if (!workable(f.t1) && n1.normalized().dot(n2.normalized()) < 1 - kCoplanar) return false;
-    if (m_.tag(f.t1) == 0 && n1.normalized().dot(n2.normalized()) < std::cos(p_.flat_dihedral * M_PI / 180))
-      return false;
+    if (n1.normalized().dot(n2.normalized()) < flip_min_cos(m_.tag(f.t1))) return false;
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
     if (normal_of(s_.V, f.u).dot(m) <= 0 || normal_of(s_.V, f.w).dot(m) <= 0) return false;
     if (std::min(angle_of(f.u), angle_of(f.w)) <= std::min(angle(f.t1), angle(f.t2)) + 1e-9) return false;
