@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "result/editable_surface.h"
 #include "result/result_check.h"
 
 namespace topopt::result {
@@ -24,35 +25,24 @@ Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
 /// The surface as editable triangles with each point's triangles.
 class Remesher {
  public:
-  Remesher(TriSurface& s, const RemeshParams& p) : s_(s), p_(p), alive_(s.F.rows(), 1), star_(s.V.rows()) {
-    tris_.resize(s.F.rows());
-    for (long t = 0; t < s.F.rows(); ++t) {
-      tris_[t] = {s.F(t, 0), s.F(t, 1), s.F(t, 2)};
-      for (int k = 0; k < 3; ++k) star_[s.F(t, k)].push_back(static_cast<int>(t));
-    }
-    tags_.assign(s.tag.data(), s.tag.data() + s.tag.size());
-  }
+  Remesher(TriSurface& s, const RemeshParams& p) : s_(s), p_(p), m_(s.F, s.tag, s.V.rows()) {}
 
   /// Sweeps until a sweep changes nothing or params.passes sweeps ran.
   void run() {
     for (int pass = 0; pass < p_.passes; ++pass) {
       long changes = 0;
-      for (size_t t = 0; t < tris_.size(); ++t)
-        if (alive_[t] && angle(static_cast<int>(t)) < p_.target_angle) changes += improve(static_cast<int>(t));
+      for (int t = 0; t < m_.triangles(); ++t)
+        if (m_.alive(t) && angle(t) < p_.target_angle) changes += improve(t);
       if (changes == 0) break;
     }
   }
 
   /// Writes the live triangles and the used points back into s.
   RemeshReport finish() {
-    std::vector<int> new_index(s_.V.rows(), -1);
-    for (size_t t = 0; t < tris_.size(); ++t)
-      if (alive_[t])
-        for (int v : tris_[t])
-          if (new_index[v] < 0) new_index[v] = 0;
-    for (int i = 0; i < static_cast<int>(new_index.size()); ++i)
-      if (new_index[i] == 0)
-        new_index[i] = static_cast<int>(report_.kept_points.size()), report_.kept_points.push_back(i);
+    const std::vector<char> used = m_.used_points();
+    std::vector<int> new_index(used.size(), -1);
+    for (int i = 0; i < static_cast<int>(used.size()); ++i)
+      if (used[i]) new_index[i] = static_cast<int>(report_.kept_points.size()), report_.kept_points.push_back(i);
     const long np = static_cast<long>(report_.kept_points.size());
     MatX3d V(np, 3);
     VecXi lock(np), point_face(np);
@@ -60,58 +50,30 @@ class Remesher {
       const int old = report_.kept_points[i];
       V.row(i) = s_.V.row(old), lock[i] = s_.lock[old], point_face[i] = s_.point_face.size() ? s_.point_face[old] : 0;
     }
-    std::vector<Tri> live;
-    std::vector<int> tags;
-    for (size_t t = 0; t < tris_.size(); ++t)
-      if (alive_[t])
-        live.push_back({new_index[tris_[t][0]], new_index[tris_[t][1]], new_index[tris_[t][2]]}),
-            tags.push_back(tags_[t]);
-    s_.F.resize(static_cast<long>(live.size()), 3);
-    for (size_t t = 0; t < live.size(); ++t) s_.F.row(t) << live[t][0], live[t][1], live[t][2];
-    s_.tag = Eigen::Map<VecXi>(tags.data(), static_cast<long>(tags.size()));
+    m_.live(s_.F, s_.tag, &new_index);
     s_.V = V, s_.lock = lock, s_.point_face = point_face;
     return report_;
   }
 
  private:
-  double angle(int t) const { return min_triangle_angle(s_.V, tris_[t][0], tris_[t][1], tris_[t][2]); }
+  double angle(int t) const { return angle_of(m_.tri(t)); }
   double angle_of(const Tri& t) const { return min_triangle_angle(s_.V, t[0], t[1], t[2]); }
   bool planar(int tag) const {
     return tag > 0 && tag < static_cast<int>(s_.face_plane.size()) && s_.face_plane[tag].head<3>().norm() > 0;
-  }
-  /// Triangles the remesher may change: the free-form region, and Ω's planar faces if allowed.
-  bool workable(int t) const { return tags_[t] == 0 || (p_.planar_faces && planar(tags_[t])); }
-
-  /// The live triangles with both a and b.
-  std::vector<int> edge_triangles(int a, int b) const {
-    std::vector<int> out;
-    for (int t : star_[a])
-      if (alive_[t] && std::count(tris_[t].begin(), tris_[t].end(), b)) out.push_back(t);
-    return out;
-  }
-  std::vector<int> neighbours(int a) const {
-    std::vector<int> out;
-    for (int t : star_[a])
-      if (alive_[t])
-        for (int v : tris_[t])
-          if (v != a) out.push_back(v);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
   }
 
   /// Flips the best edge of t if that helps, else collapses its shortest edge. 1 if changed.
   int improve(int t) {
     std::array<int, 3> order = {0, 1, 2};  // edges k: (t[k], t[k+1]), longest first
-    auto len = [&](int k) { return (s_.V.row(tris_[t][k]) - s_.V.row(tris_[t][(k + 1) % 3])).squaredNorm(); };
+    auto len = [&](int k) { return (s_.V.row(m_.tri(t)[k]) - s_.V.row(m_.tri(t)[(k + 1) % 3])).squaredNorm(); };
     std::sort(order.begin(), order.end(), [&](int x, int y) { return len(x) > len(y); });
     for (int k : order)
-      if (flip(tris_[t][k], tris_[t][(k + 1) % 3])) return 1;
+      if (flip(m_.tri(t)[k], m_.tri(t)[(k + 1) % 3])) return 1;
     for (int i = 2; i >= 0; --i) {
-      const int a = tris_[t][order[i]], b = tris_[t][(order[i] + 1) % 3];
+      const int a = m_.tri(t)[order[i]], b = m_.tri(t)[(order[i] + 1) % 3];
       if (collapse(a, b) || collapse(b, a)) return 1;
     }
-    for (int v : tris_[t])
+    for (int v : m_.tri(t))
       if (relocate(v)) return 1;
     return 0;
   }
@@ -122,11 +84,10 @@ class Remesher {
   int face_interior(int v) const {
     if (s_.lock[v] != 1 || !p_.planar_faces || (s_.point_face.size() && s_.point_face[v] != 0)) return 0;
     int f = 0;
-    for (int t : star_[v])
-      if (alive_[t]) {
-        if (f != 0 && tags_[t] != f) return 0;
-        f = tags_[t];
-      }
+    for (int t : m_.star(v)) {
+      if (f != 0 && m_.tag(t) != f) return 0;
+      f = m_.tag(t);
+    }
     return planar(f) ? f : 0;
   }
 
@@ -136,17 +97,17 @@ class Remesher {
     if (s_.lock[v] != 1 || !p_.planar_faces || s_.point_face.size() == 0) return 0;
     const int f = s_.point_face[v];
     if (!planar(f)) return 0;
-    for (int t : star_[v])
-      if (alive_[t] && tags_[t] != 0 && tags_[t] != f) return 0;
+    for (int t : m_.star(v))
+      if (m_.tag(t) != 0 && m_.tag(t) != f) return 0;
     return f;
   }
 
   /// v's neighbours along the cut line of face f: edges with a triangle of f and one free-form.
   std::vector<int> line_neighbours(int v, int f) const {
     std::vector<int> out;
-    for (int w : neighbours(v)) {
-      const std::vector<int> e = edge_triangles(v, w);
-      if (e.size() == 2 && ((tags_[e[0]] == 0 && tags_[e[1]] == f) || (tags_[e[0]] == f && tags_[e[1]] == 0)))
+    for (int w : m_.neighbours(v)) {
+      const std::vector<int> e = m_.edge_triangles(v, w);
+      if (e.size() == 2 && ((m_.tag(e[0]) == 0 && m_.tag(e[1]) == f) || (m_.tag(e[0]) == f && m_.tag(e[1]) == 0)))
         out.push_back(w);
     }
     return out;
@@ -161,7 +122,7 @@ class Remesher {
     face = face_interior(v);
     std::vector<int> nb;
     if (s_.lock[v] == 0 || face != 0) {
-      nb = neighbours(v);
+      nb = m_.neighbours(v);
       if (nb.size() < 3) return false;
     } else {
       face = cut_line_face(v);
@@ -174,8 +135,8 @@ class Remesher {
     mean /= static_cast<double>(nb.size());
     n.setZero();
     if (face != 0) n = s_.face_plane[face].head<3>();
-    for (int t : star_[v])
-      if (face == 0 && alive_[t]) n += normal_of(s_.V, tris_[t]);
+    for (int t : m_.star(v))
+      if (face == 0) n += normal_of(s_.V, m_.tri(t));
     if (n.norm() == 0) return false;
     n.normalize();
     return true;
@@ -189,25 +150,22 @@ class Remesher {
     int face = 0;
     if (!relocation_target(v, mean, n, face)) return false;
     double worst_before = 180;
-    for (int t : star_[v])
-      if (alive_[t]) worst_before = std::min(worst_before, angle(t));
+    for (int t : m_.star(v)) worst_before = std::min(worst_before, angle(t));
     const Eigen::Vector3d p0 = s_.V.row(v).transpose();
     Eigen::Vector3d step = mean - p0;
     step -= step.dot(n) * n;
     const double cos_turn = std::cos(p_.max_normal_turn * M_PI / 180);
     for (double share : {1.0, 0.5}) {
       std::vector<Eigen::Vector3d> normals;
-      for (int t : star_[v])
-        if (alive_[t]) normals.push_back(normal_of(s_.V, tris_[t]));
+      for (int t : m_.star(v)) normals.push_back(normal_of(s_.V, m_.tri(t)));
       Eigen::Vector3d p = p0 + share * step;
       if (face != 0) p -= (n.dot(p) - s_.face_plane[face][3]) * n;  // on the plane to rounding
       s_.V.row(v) = p.transpose();
       double worst_after = 180;
       bool turned = false;
       size_t k = 0;
-      for (int t : star_[v]) {
-        if (!alive_[t]) continue;
-        const Eigen::Vector3d n1 = normal_of(s_.V, tris_[t]), n0 = normals[k++];
+      for (int t : m_.star(v)) {
+        const Eigen::Vector3d n1 = normal_of(s_.V, m_.tri(t)), n0 = normals[k++];
         turned |= n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn;
         worst_after = std::min(worst_after, angle(t));
       }
@@ -220,45 +178,32 @@ class Remesher {
     return false;
   }
 
-  /// Flips edge ab when its two triangles share a tag and lie nearly in one plane (on the
-  /// free-form region: bent less than flat_dihedral; on a planar Ω face: its plane; on any other
-  /// face: one plane to kCoplanar), and the flip raises their smallest angle. Flips move no point.
+  /// The cosine of the largest bend of an edge between two triangles of tag `tag` that a flip
+  /// may turn: flat_dihedral on the free-form region, curved_dihedral on a curved Ω face (its four
+  /// points stay on the face, the new triangles are chords of it as the old ones were), 90 on a
+  /// planar Ω face (its triangles lie in its plane), and one plane to kCoplanar on the
+  /// non-design solids' faces (a tag names a solid, not a face: the flip must not cut an edge).
+  double flip_min_cos(int tag) const {
+    if (tag == 0) return std::cos(p_.flat_dihedral * M_PI / 180);
+    if (tag > 0 && p_.planar_faces) return planar(tag) ? 0 : std::cos(p_.curved_dihedral * M_PI / 180);
+    return 1 - kCoplanar;
+  }
+
+  /// Flips edge ab when its two triangles share a tag and bend less than flip_min_cos allows, and the
+  /// flip raises their smallest angle. Flips move no point.
   bool flip(int a, int b) {
-    const std::vector<int> e = edge_triangles(a, b);
-    if (e.size() != 2 || tags_[e[0]] != tags_[e[1]]) return false;
-    int t1 = e[0], t2 = e[1];
-    // t1 holds the directed edge a -> b
-    auto has_ab = [&](int t) {
-      for (int k = 0; k < 3; ++k)
-        if (tris_[t][k] == a && tris_[t][(k + 1) % 3] == b) return true;
-      return false;
-    };
-    if (!has_ab(t1)) std::swap(t1, t2);
-    if (!has_ab(t1)) return false;
-    const int c = third(t1, a, b), d = third(t2, a, b);
-    if (c == d || edge_triangles(c, d).size() > 0) return false;
-    const Eigen::Vector3d n1 = normal_of(s_.V, tris_[t1]), n2 = normal_of(s_.V, tris_[t2]);
+    EditableSurface::Flip f;
+    if (!m_.flip_of(a, b, f)) return false;
+    const Eigen::Vector3d n1 = normal_of(s_.V, m_.tri(f.t1)), n2 = normal_of(s_.V, m_.tri(f.t2));
     if (n1.norm() == 0 || n2.norm() == 0) return false;
-    // elsewhere (non-design faces, curved Ω faces) only within one plane: the surface stays put
-    if (!workable(t1) && n1.normalized().dot(n2.normalized()) < 1 - kCoplanar) return false;
-    if (tags_[t1] == 0 && n1.normalized().dot(n2.normalized()) < std::cos(p_.flat_dihedral * M_PI / 180)) return false;
-    const Tri u = {a, d, c}, w = {d, b, c};
+    if (n1.normalized().dot(n2.normalized()) < flip_min_cos(m_.tag(f.t1))) return false;
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
-    if (normal_of(s_.V, u).dot(m) <= 0 || normal_of(s_.V, w).dot(m) <= 0) return false;
-    if (std::min(angle_of(u), angle_of(w)) <= std::min(angle_of(tris_[t1]), angle_of(tris_[t2])) + 1e-9) return false;
-    tris_[t1] = u, tris_[t2] = w;
-    star_[d].push_back(t1), star_[c].push_back(t2);
-    drop(b, t1), drop(a, t2);
+    if (normal_of(s_.V, f.u).dot(m) <= 0 || normal_of(s_.V, f.w).dot(m) <= 0) return false;
+    if (std::min(angle_of(f.u), angle_of(f.w)) <= std::min(angle(f.t1), angle(f.t2)) + 1e-9) return false;
+    m_.flip(a, b, f);
     ++report_.flips;
     return true;
   }
-
-  int third(int t, int a, int b) const {
-    for (int v : tris_[t])
-      if (v != a && v != b) return v;
-    return -1;
-  }
-  void drop(int v, int t) { star_[v].erase(std::remove(star_[v].begin(), star_[v].end(), t), star_[v].end()); }
 
   /// Whether v may be removed by a collapse into a neighbour without any point moving, the face it
   /// lies inside staying where it is: every triangle around v has one tag f != 0, and either v is
@@ -270,15 +215,14 @@ class Remesher {
     if (!p_.planar_faces || s_.lock[v] == 0 || (s_.point_face.size() && s_.point_face[v] != 0)) return false;
     int f = 0;
     Eigen::Vector3d n0 = Eigen::Vector3d::Zero();
-    for (int t : star_[v]) {
-      if (!alive_[t]) continue;
-      const Eigen::Vector3d n = normal_of(s_.V, tris_[t]);
-      if (f == 0) f = tags_[t], n0 = n.normalized();
-      if (tags_[t] != f || f == 0 || n.norm() == 0) return false;
+    for (int t : m_.star(v)) {
+      const Eigen::Vector3d n = normal_of(s_.V, m_.tri(t));
+      if (f == 0) f = m_.tag(t), n0 = n.normalized();
+      if (m_.tag(t) != f || f == 0 || n.norm() == 0) return false;
       if (s_.lock[v] == 2 && n.normalized().dot(n0) < 1 - kCoplanar) return false;
     }
     if (s_.lock[v] == 2)  // not on the border of a non-design solid's footprint on an Ω face
-      for (int w : neighbours(v))
+      for (int w : m_.neighbours(v))
         if (s_.lock[w] != 2) return false;
     return f != 0 && (s_.lock[v] == 2 || f > 0);
   }
@@ -292,54 +236,39 @@ class Remesher {
     if (s_.lock[v] != 1 || !p_.planar_faces) return false;
     const int f = s_.point_face.size() ? s_.point_face[v] : 0;
     if (f <= 0) return false;
-    const std::vector<int> e = edge_triangles(u, v);
+    const std::vector<int> e = m_.edge_triangles(u, v);
     if (e.size() != 2) return false;
-    const bool along = (tags_[e[0]] == 0 && tags_[e[1]] == f) || (tags_[e[0]] == f && tags_[e[1]] == 0);
+    const bool along = (m_.tag(e[0]) == 0 && m_.tag(e[1]) == f) || (m_.tag(e[0]) == f && m_.tag(e[1]) == 0);
     // v's triangles all on the free-form region or on face f
-    for (int t : star_[v])
-      if (alive_[t] && tags_[t] != 0 && tags_[t] != f) return false;
+    for (int t : m_.star(v))
+      if (m_.tag(t) != 0 && m_.tag(t) != f) return false;
     return along;
   }
 
   /// Collapses v into u when may_go and the result keeps the surface manifold and no worse.
   bool collapse(int v, int u) {
-    if (!may_go(v, u)) return false;
-    const std::vector<int> shared = edge_triangles(u, v);
-    if (shared.size() != 2) return false;
-    // link condition: u and v share exactly the two opposite points
-    std::vector<int> nu = neighbours(u), nv = neighbours(v), common;
-    std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
-    if (common.size() != 2) return false;
+    if (!may_go(v, u) || !m_.link_condition(u, v)) return false;
+    const std::vector<int> shared = m_.edge_triangles(u, v);
     double worst_before = 180, worst_after = 180;
     const double cos_turn = std::cos(p_.max_normal_turn * M_PI / 180);
-    for (int t : star_[v]) {
-      if (!alive_[t]) continue;
+    for (int t : m_.star(v)) {
       worst_before = std::min(worst_before, angle(t));
       if (std::count(shared.begin(), shared.end(), t)) continue;
-      Tri moved = tris_[t];
+      Tri moved = m_.tri(t);
       std::replace(moved.begin(), moved.end(), v, u);
-      const Eigen::Vector3d n0 = normal_of(s_.V, tris_[t]), n1 = normal_of(s_.V, moved);
+      const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(t)), n1 = normal_of(s_.V, moved);
       if (n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn) return false;
       worst_after = std::min(worst_after, angle_of(moved));
     }
     if (worst_after <= worst_before) return false;
-    for (int t : shared) {
-      alive_[t] = 0;
-      for (int w : tris_[t]) drop(w, t);
-    }
-    for (int t : star_[v])
-      if (alive_[t]) std::replace(tris_[t].begin(), tris_[t].end(), v, u), star_[u].push_back(t);
-    star_[v].clear();
+    m_.collapse(v, u);
     ++report_.collapses;
     return true;
   }
 
   TriSurface& s_;
   const RemeshParams& p_;
-  std::vector<Tri> tris_;
-  std::vector<int> tags_;
-  std::vector<char> alive_;
-  std::vector<std::vector<int>> star_;
+  EditableSurface m_;
   RemeshReport report_;
 };
 

@@ -1,8 +1,8 @@
 // Well-shaped triangles on the result surface: marching tetrahedra leaves needles and caps
 // where the level passes close to a mesh node. Edge collapses and edge flips on the
-// free-form region (and on Ω's planar faces, within their plane; flips within one plane on the
-// other faces) remove them; no point of a non-design solid moves and no point of Ω's faces
-// leaves its face's plane.
+// free-form region (and on Ω's planar faces, within their plane; flips on Ω's curved faces
+// between triangles bent a little; flips within one plane on the non-design faces) remove
+// them; no point of a non-design solid moves and no point of Ω's faces leaves its face.
 #pragma once
 #include <vector>
 
@@ -11,8 +11,11 @@
 namespace topopt::result {
 
 struct RemeshParams {
-  double target_angle = 15;     ///< triangles whose smallest angle is below this (degrees) are worked on
-  double flat_dihedral = 25;    ///< a flip on the free-form region only across edges bent less than this (degrees)
+  double target_angle = 15;   ///< triangles whose smallest angle is below this (degrees) are worked on
+  double flat_dihedral = 25;  ///< a flip on the free-form region only across edges bent less than this (degrees)
+  /// a flip on a curved Ω face (all four points on the face's surface) only across edges bent
+  /// less than this (degrees): the two new triangles are chords of the face as the old ones were
+  double curved_dihedral = 25;
   double max_normal_turn = 30;  ///< a collapse may turn no triangle's normal by more than this (degrees)
   int passes = 20;              ///< sweeps over the surface at most (each stops the work when nothing changed)
   bool planar_faces = true;     ///< also flip and collapse on Ω's planar faces (points stay in their plane)
@@ -26,8 +29,9 @@ struct RemeshReport {
 
 /// Removes the badly shaped triangles of s where it can: flips an edge when that raises the
 /// smallest angle of its two triangles (on the free-form region across edges bent less than
-/// flat_dihedral; on Ω's planar faces within the plane; on the non-design solids' and Ω's other
-/// faces only between triangles in one plane, so no point moves); collapses a short edge into one
+/// flat_dihedral; on Ω's planar faces within the plane; on Ω's curved faces across edges bent
+/// less than curved_dihedral, the four points staying on the face; on the non-design solids'
+/// faces only between triangles in one plane; no flip moves a point); collapses a short edge into one
 /// of its points when the point that goes is free (lock 0), lies inside an Ω face (every triangle
 /// around it on that face; on a curved face the points that stay keep their places), lies inside one
 /// plane of a non-design solid's faces with non-design neighbours only (the FE mesh's own boundary

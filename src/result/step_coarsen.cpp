@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "result/editable_surface.h"
 #include "result/result_check.h"
 
 namespace topopt::result {
@@ -26,28 +27,21 @@ double median_free_edge(const TriSurface& s) {
   return lengths[lengths.size() / 2];
 }
 
-/// The surface under collapse: triangles alive or removed, the triangles around each point,
-/// and for each triangle the removed points it now stands for (they must stay within the
-/// tolerance of it).
+/// The surface under collapse (an EditableSurface: triangles alive or removed, the triangles
+/// around each point) and for each triangle the removed points it now stands for (they must
+/// stay within the tolerance of it).
 class Collapser {
  public:
   Collapser(const TriSurface& s, const CoarsenParams& params, double tolerance)
-      : s_(s), params_(params), tolerance_(tolerance), around_(s.V.rows()) {
-    for (long q = 0; q < s.F.rows(); ++q) {
-      tri_.push_back({s.F(q, 0), s.F(q, 1), s.F(q, 2)});
-      for (int k = 0; k < 3; ++k) around_[s.F(q, k)].push_back(static_cast<int>(q));
-    }
-    alive_.assign(tri_.size(), true);
-    stands_for_.resize(tri_.size());
-  }
+      : s_(s), params_(params), tolerance_(tolerance), m_(s.F, s.tag, s.V.rows()), stands_for_(s.F.rows()) {}
 
   /// One sweep over the free-form edges, shortest first; returns the points removed.
   long sweep() {
     std::vector<std::pair<double, std::pair<int, int>>> edges;
-    for (size_t t = 0; t < tri_.size(); ++t)
-      if (alive_[t] && s_.tag[t] == 0)
+    for (int t = 0; t < m_.triangles(); ++t)
+      if (m_.alive(t) && m_.tag(t) == 0)
         for (int k = 0; k < 3; ++k) {
-          const int a = tri_[t][k], b = tri_[t][(k + 1) % 3];
+          const int a = m_.tri(t)[k], b = m_.tri(t)[(k + 1) % 3];
           edges.push_back({(point(a) - point(b)).norm(), {a, b}});
         }
     std::sort(edges.begin(), edges.end());
@@ -60,15 +54,7 @@ class Collapser {
   /// The surface with the triangles alive.
   TriSurface surface() const {
     TriSurface out = s_;
-    const long n = std::count(alive_.begin(), alive_.end(), true);
-    out.F.resize(n, 3);
-    out.tag.resize(n);
-    long row = 0;
-    for (size_t t = 0; t < tri_.size(); ++t)
-      if (alive_[t]) {
-        out.F.row(row) << tri_[t][0], tri_[t][1], tri_[t][2];
-        out.tag[row++] = s_.tag[t];
-      }
+    m_.live(out.F, out.tag);
     return out;
   }
 
@@ -78,37 +64,13 @@ class Collapser {
   /// True when point b may go: free to move and only free-form triangles around it.
   bool removable(int b) const {
     if (removed_point(b) || s_.lock[b] != 0 || (s_.point_face.size() && s_.point_face[b] != 0)) return false;
-    return std::all_of(around_[b].begin(), around_[b].end(), [&](int t) { return !alive_[t] || s_.tag[t] == 0; });
+    return std::all_of(m_.star(b).begin(), m_.star(b).end(), [&](int t) { return m_.tag(t) == 0; });
   }
-  bool removed_point(int i) const {
-    return std::none_of(around_[i].begin(), around_[i].end(), [&](int t) { return alive_[t]; });
-  }
-
-  /// The points joined to i by an edge.
-  std::vector<int> neighbours(int i) const {
-    std::vector<int> out;
-    for (int t : around_[i])
-      if (alive_[t])
-        for (int v : tri_[t])
-          if (v != i) out.push_back(v);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-  }
-
-  /// Link condition of the edge (a, b): exactly two triangles share it and the points joined
-  /// to both are their two opposite corners (so the collapse keeps the surface manifold).
-  bool link_condition(int a, int b, const std::vector<int>& gone) const {
-    if (gone.size() != 2) return false;
-    const std::vector<int> na = neighbours(a), nb = neighbours(b);
-    std::vector<int> common;
-    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    return common.size() == 2;
-  }
+  bool removed_point(int i) const { return m_.star(i).empty(); }
 
   /// Triangle t with point b replaced by a.
   Tri moved(int t, int b, int a) const {
-    Tri out = tri_[t];
+    Tri out = m_.tri(t);
     for (int& v : out)
       if (v == b) v = a;
     return out;
@@ -116,7 +78,8 @@ class Collapser {
 
   /// True when triangle `to` (t with b moved onto a) keeps its side and its shape.
   bool shape_kept(int t, const Tri& to, double floor) const {
-    const Vec3 n0 = (point(tri_[t][1]) - point(tri_[t][0])).cross(point(tri_[t][2]) - point(tri_[t][0]));
+    const Tri& from = m_.tri(t);
+    const Vec3 n0 = (point(from[1]) - point(from[0])).cross(point(from[2]) - point(from[0]));
     const Vec3 n1 = (point(to[1]) - point(to[0])).cross(point(to[2]) - point(to[0]));
     if (n1.norm() <= 1e-12 * std::max(1.0, n0.norm()) || n0.norm() == 0) return false;
     if (n0.normalized().dot(n1.normalized()) < std::cos(params_.max_normal_turn)) return false;
@@ -136,50 +99,40 @@ class Collapser {
   /// Removes b by joining it to a when every condition holds; returns whether it did.
   bool try_collapse(int b, int a) {
     if (!removable(b) || removed_point(a)) return false;
-    std::vector<int> gone;
     std::vector<std::pair<int, Tri>> kept;
     double floor = params_.min_angle;
-    for (int t : around_[b]) {
-      if (!alive_[t]) continue;
-      floor = std::min(floor, min_triangle_angle(s_.V, tri_[t][0], tri_[t][1], tri_[t][2]));
-      if (std::find(tri_[t].begin(), tri_[t].end(), a) != tri_[t].end())
-        gone.push_back(t);
-      else
-        kept.push_back({t, moved(t, b, a)});
+    for (int t : m_.star(b)) {
+      floor = std::min(floor, min_triangle_angle(s_.V, m_.tri(t)[0], m_.tri(t)[1], m_.tri(t)[2]));
+      if (std::find(m_.tri(t).begin(), m_.tri(t).end(), a) == m_.tri(t).end()) kept.push_back({t, moved(t, b, a)});
     }
     // kept.size() < 2: b has three neighbours (a tetrahedron's corner would fold it flat)
-    if (!link_condition(a, b, gone) || kept.size() < 2) return false;
+    if (!m_.link_condition(a, b) || kept.size() < 2) return false;
     for (const auto& [t, to] : kept)
       if (!shape_kept(t, to, floor)) return false;
     std::vector<int> points{b};
-    for (int t : around_[b])
-      if (alive_[t]) points.insert(points.end(), stands_for_[t].begin(), stands_for_[t].end());
+    for (int t : m_.star(b)) points.insert(points.end(), stands_for_[t].begin(), stands_for_[t].end());
     std::vector<int> home;
     for (int p : points) {
       const auto [t, d] = nearest(point(p), kept);
       if (d > tolerance_) return false;
       home.push_back(t);
     }
-    commit(b, a, gone, kept, points, home);
+    commit(b, a, points, home);
     return true;
   }
 
-  void commit(int b, int a, const std::vector<int>& gone, const std::vector<std::pair<int, Tri>>& kept,
-              const std::vector<int>& points, const std::vector<int>& home) {
-    for (int t : around_[b])
-      if (alive_[t]) stands_for_[t].clear();
-    for (int t : gone) alive_[t] = false;
-    for (const auto& [t, to] : kept) tri_[t] = to, around_[a].push_back(t);
+  /// Joins b to a and hands the points b's triangles stood for (and b) to their nearest kept
+  /// triangles `home`.
+  void commit(int b, int a, const std::vector<int>& points, const std::vector<int>& home) {
+    for (int t : m_.star(b)) stands_for_[t].clear();
+    m_.collapse(b, a);
     for (size_t k = 0; k < points.size(); ++k) stands_for_[home[k]].push_back(points[k]);
-    around_[b].clear();
   }
 
   const TriSurface& s_;
   const CoarsenParams& params_;
   const double tolerance_;
-  std::vector<Tri> tri_;
-  std::vector<bool> alive_;
-  std::vector<std::vector<int>> around_;
+  EditableSurface m_;
   std::vector<std::vector<int>> stands_for_;
 };
 
