@@ -337,16 +337,16 @@ void Elasticity::Impl::assemble() {
     parallel_for(
         static_cast<long>(list.size()), threads,
         [&](long b, long e) {
-          double Ke[144];
+          double Ke[kPairs];  // the upper triangle, in kLocalPairs' order
           for (long k = b; k < e; ++k) {
             int t = list[k];
-            element_stiffness(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
+            element_stiffness_upper(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
             const int* s = &slot[kPairs * static_cast<long>(t)];
             for (int p = 0; p < kPairs; ++p)
               if (s[p] >= 0) {
                 // a diagonal block pair (i,j) and (j,i) of different dofs map to one lower slot only
                 // once, because the 78 pairs are the element's upper triangle
-                val[s[p]] += Ke[kLocalPairs[p].i * 12 + kLocalPairs[p].j];
+                val[s[p]] += Ke[p];
               }
           }
         },

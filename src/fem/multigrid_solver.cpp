@@ -97,7 +97,13 @@ void MultigridSolver::update(const Progress& progress) {
   }
   refill();
   kept_ = reuse_.keep(built_);
-  if (kept_) {
+  if (kept_ && reuse_.refresh_coarse_on_update()) {
+    // a recent solve found the kept coarse levels stale: recompute them now (R A P on the kept
+    // aggregates) rather than lose the patience's iterations on them first
+    amg_.refresh_galerkin();
+    kept_ = false;
+    progress.info("multigrid kept, coarse matrices recomputed " + watch.lap());
+  } else if (kept_) {
     // SIMP's next matrix: keep the hierarchy, refresh the finest smoother only (a solve that
     // finds the coarse levels stale recomputes them, see solve()).
     amg_.refresh_finest();
@@ -168,6 +174,7 @@ void MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const 
       progress.info("multigrid CG slow with the kept hierarchy (" + std::to_string(r.iterations) +
                     " iterations); coarse matrices recomputed");
       amg_.refresh_galerkin();
+      reuse_.cut();
       kept_ = false;
       rebuilt = true;
       const int cut = r.iterations;

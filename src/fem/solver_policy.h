@@ -52,7 +52,24 @@ class HierarchyReuse {
   void set_up() {
     grown_ = false;
     baseline_ = -1;
+    refresh_ = 0;
   }
+
+  /// A solve on the kept hierarchy was cut short (patience reached) and finished on recomputed
+  /// coarse levels: the designs are changing fast, so the next kRefreshAfterCut kept matrices
+  /// get their coarse levels recomputed before their solve instead of losing `patience`
+  /// iterations each on stale ones first.
+  void cut() { refresh_ = kRefreshAfterCut; }
+
+  /// A kept hierarchy for a new matrix: recompute its coarse levels now (not only the finest
+  /// smoother)? Yes within kRefreshAfterCut matrices of the last cut. Counts down.
+  bool refresh_coarse_on_update() {
+    if (refresh_ == 0) return false;
+    --refresh_;
+    return true;
+  }
+
+  static constexpr int kRefreshAfterCut = 2;
 
   /// Records a solve's CG iterations (its worst load case).
   void record(int iterations) {
@@ -76,6 +93,7 @@ class HierarchyReuse {
   bool allowed_;
   bool grown_ = false;
   int baseline_ = -1;  // iterations of the first solve after the last setup
+  int refresh_ = 0;    // kept matrices still to get their coarse levels recomputed up front
 };
 
 }  // namespace topopt::fem

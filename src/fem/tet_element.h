@@ -47,6 +47,27 @@ inline void element_stiffness(const double* g, double vol, double lambda, double
     }
 }
 
+/// The upper triangle of element_stiffness: the 78 entries K_IJ with I <= J, row by row (I = 0,
+/// J = 0..11, then I = 1, J = 1..11, ...), each computed as element_stiffness computes it (the
+/// same values to the bit) without the 66 entries below the diagonal that assembly never reads.
+/// g: 4 by 3 gradients (row-major); K: 78 values.
+inline void element_stiffness_upper(const double* g, double vol, double lambda, double mu, double* K) {
+  double dot[4][4];
+  for (int a = 0; a < 4; ++a)
+    for (int b = a; b < 4; ++b)
+      dot[a][b] = g[3 * a] * g[3 * b] + g[3 * a + 1] * g[3 * b + 1] + g[3 * a + 2] * g[3 * b + 2];
+  int k = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) {
+      const double* ga = g + 3 * a;
+      for (int b = a; b < 4; ++b) {
+        const double* gb = g + 3 * b;
+        for (int j = b == a ? i : 0; j < 3; ++j)
+          K[k++] = vol * (lambda * ga[i] * gb[j] + mu * ga[j] * gb[i] + (i == j ? mu * dot[a][b] : 0.0));
+      }
+    }
+}
+
 /// The strain ε = sym(∇u) of a linear tet with gradients g (4 by 3, row-major) under the
 /// corner displacements u (12: 3a + component), ∇u = Σ_a u_a ⊗ g_a.
 inline Eigen::Matrix3d element_strain(const double* g, const double* u) {

@@ -56,6 +56,19 @@ TEST(HierarchyReuse, PatienceIsTheGrowthThatWouldRebuild) {
   EXPECT_EQ(r.patience(5000), 5000);
 }
 
+TEST(HierarchyReuse, CoarseLevelsRecomputedUpFrontForTwoMatricesAfterACut) {
+  HierarchyReuse r(true);
+  r.set_up();
+  r.record(12);
+  EXPECT_FALSE(r.refresh_coarse_on_update());  // no cut yet: the finest level only
+  r.cut();
+  for (int k = 0; k < HierarchyReuse::kRefreshAfterCut; ++k) EXPECT_TRUE(r.refresh_coarse_on_update()) << k;
+  EXPECT_FALSE(r.refresh_coarse_on_update());  // then the finest only again, until the next cut
+  r.cut();
+  r.set_up();  // a new hierarchy fits its matrix: nothing to recompute
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+}
+
 TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
   HierarchyReuse r(false);
   r.set_up();
