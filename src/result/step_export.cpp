@@ -350,8 +350,8 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
                   " separate solids in one compound, because the design does not join them (as made they are "
                   "separate parts): " +
                   named +
-                  ". For one part, join them in the design: raise \"optimization.volume_fraction\", or load or "
-                  "support them so that the design has to carry them");
+                  ". For one part the design must carry load between them: a load on one body and a support on "
+                  "another makes it join them, and a larger \"optimization.volume_fraction\" may");
   }
   const auto t0 = std::chrono::steady_clock::now();
   const double children_cpu0 = children_cpu_seconds();
