@@ -173,11 +173,11 @@ void parse_draw_direction(const Fields& controls, simp::DrawDirection& d) {
 }
 
 /// "controls"."overhang": {"direction": [x, y, z], "angle": degrees, "base_face": "FaceN",
-/// "cell": mm, "exponent", "xi0", "smoothness"} (docs/optimization.md).
+/// "margin": degrees, "cell": mm, "exponent", "xi0", "smoothness"} (docs/optimization.md).
 void parse_overhang(const Fields& controls, simp::OverhangControl& o) {
   if (!controls.has("overhang")) return;
   const Fields f(controls.at("overhang"), controls.name("overhang"),
-                 {"direction", "angle", "base_face", "cell", "exponent", "xi0", "smoothness"},
+                 {"direction", "angle", "margin", "base_face", "cell", "exponent", "xi0", "smoothness"},
                  "{\"direction\": [0, 0, 1], \"angle\": 45, \"base_face\": \"Face5\"}");
   o.enabled = true;
   o.direction = vector3(f, "direction");
@@ -186,6 +186,11 @@ void parse_overhang(const Fields& controls, simp::OverhangControl& o) {
     f.bad("angle",
           "must lie in [10, 80] degrees: the smallest angle to the base plate that prints without "
           "supports (45 is usual)");
+  o.margin = f.number("margin", o.margin);
+  if (!(o.margin >= 0 && o.margin <= 20 && o.angle + o.margin <= 85))
+    f.bad("margin",
+          "must lie in [0, 20] degrees with angle + margin <= 85: the filter prints for angle + margin so that "
+          "walls at the limit stay printable (5 is the default)");
   if (f.has("base_face")) {
     std::vector<int> faces, nondesign;
     if (!f.at("base_face").is_string()) f.bad("base_face", "must be a face name such as \"Face5\"");

@@ -58,6 +58,10 @@ struct OverhangControl {
   /// degrees in [10, 80]: the smallest angle between a downward-facing surface and the base
   /// plate that prints without supports (45 for most metal and polymer processes)
   double angle = 45;
+  /// degrees in [0, 20]: the filter prints for angle + margin (its layers are
+  /// cell·tan(angle + margin) apart), so that walls the optimiser settles at the filter's limit
+  /// and the result surface's facets scattered around them stay steeper than `angle`
+  double margin = 5;
   /// Ω's face (FreeCAD's FaceN number) the part stands on: flat, facing against `direction`.
   /// 0: the base plate touches the lowest point of Ω along `direction`.
   int base_face = 0;

@@ -31,6 +31,11 @@ const OverhangControl& checked(const OverhangControl& p) {
     bad("angle",
         "must lie in [10, 80] degrees (the smallest self-supporting angle to the base plate; default 45), not " +
             std::to_string(p.angle));
+  if (!(p.margin >= 0 && p.margin <= 20 && p.angle + p.margin <= 85))
+    bad("margin",
+        "must lie in [0, 20] degrees with angle + margin <= 85 (the filter prints for angle + margin; "
+        "default 5), not " +
+            std::to_string(p.margin) + " with angle " + std::to_string(p.angle));
   if (!(p.xi0 > 0 && p.xi0 < 1)) bad("xi0", "must lie in (0, 1) (default 0.5), not " + std::to_string(p.xi0));
   const double q = p.exponent + std::log(kSupports) / std::log(p.xi0);
   if (!(q >= 1))
@@ -101,10 +106,11 @@ OverhangFilter::OverhangFilter(const TetMesh& mesh, const std::vector<int>& desi
   build_lattice(mesh, design, cell);
   std::ostringstream log;
   log << "overhang: build direction (" << d_.x() << ", " << d_.y() << ", " << d_.z() << "), " << params_.angle
-      << " deg, base plate at " << plate_ << " mm"
+      << " deg (filtered at " << params_.angle + params_.margin << "), base plate at " << plate_ << " mm"
       << (params_.base_face ? " (Face" + std::to_string(params_.base_face) + ")" : "") << ", lattice "
       << lattice_->nodes_along(0) << " x " << lattice_->nodes_along(1) << " x " << lattice_->nodes_along(2)
-      << " nodes, " << cell << " mm across, layers " << cell * std::tan(params_.angle * kPi / 180) << " mm";
+      << " nodes, " << cell << " mm across, layers " << cell * std::tan((params_.angle + params_.margin) * kPi / 180)
+      << " mm";
   summary_ = log.str();
 }
 
@@ -113,7 +119,7 @@ void OverhangFilter::build_lattice(const TetMesh& mesh, const std::vector<int>& 
   cross_section_basis(d_, u, v);
   Eigen::Matrix3d frame;
   frame << u.transpose(), v.transpose(), d_.transpose();
-  const Eigen::Vector3d spacing(cell, cell, cell * std::tan(params_.angle * kPi / 180));
+  const Eigen::Vector3d spacing(cell, cell, cell * std::tan((params_.angle + params_.margin) * kPi / 180));
   const Eigen::MatrixX3d points = mesh.V * frame.transpose();  // #V by 3: (u, v, s)
   const Eigen::Vector3d lo = points.colwise().minCoeff().transpose(), hi = points.colwise().maxCoeff().transpose();
   // a layer of nodes on the plate; layers 0 … base_layers_−1 at or below it

@@ -4,8 +4,9 @@
 // lattice whose layers are normal to the build direction (lattice_transfer.h) → printed
 // densities layer by layer from the base plate, ξ = smin(ρ, smax(ξ of the supporting nodes in
 // the layer below)) → back to the elements. The supports of a node are the node below it and
-// that node's four neighbours in its layer; layers are cell·tan(angle) apart, so material may
-// stand out by one cell per layer: a slope of `angle` from the plate. Nodes more than a quarter
+// that node's four neighbours in its layer; layers are cell·tan(angle + margin) apart, so
+// material may stand out by one cell per layer: a slope of angle + margin from the plate (the
+// margin keeps the result surface's facets of a wall at the filter's limit above `angle`). Nodes more than a quarter
 // inside the non-design solids are printed material whatever lies below them (they are kept)
 // and support what stands on them fully. Sits after the density
 // filter (and the draw direction), before the projection; the chain rule is the adjoint of the

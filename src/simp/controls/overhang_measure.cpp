@@ -6,21 +6,24 @@
 
 namespace topopt::simp {
 
-OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d, double angle, double plate,
-                             double plate_tolerance) {
+OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d,
+                             const OverhangMeasureParams& params, const VecXi* tag) {
   const Eigen::Vector3d up = d.normalized();
-  const double cos_limit = std::cos(angle * 3.14159265358979323846 / 180);
+  const double limit = std::max(0.0, params.angle - params.tolerance);
+  const double cos_limit = std::cos(limit * 3.14159265358979323846 / 180);
+  const double plate = params.plate, eps = params.plate_tolerance;
   OverhangShare out;
   for (long f = 0; f < F.rows(); ++f) {
+    if (tag && (*tag)[f] != 0) continue;  // Ω's or a non-design solid's face: the given shape
     const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
     const Eigen::Vector3d n = (b - a).cross(c - a);
     const double area = n.norm() / 2;
     if (!(area > 0) || n.dot(up) >= 0) continue;
     const double lowest = std::min({a.dot(up), b.dot(up), c.dot(up)}),
                  highest = std::max({a.dot(up), b.dot(up), c.dot(up)});
-    if (lowest >= plate - plate_tolerance && highest <= plate + plate_tolerance) continue;  // on the plate
+    if (lowest >= plate - eps && highest <= plate + eps) continue;  // on the plate
     out.downward_area += area;
-    if (-n.dot(up) > cos_limit * 2 * area) out.overhang_area += area;  // angle(n, -d) < angle
+    if (-n.dot(up) > cos_limit * 2 * area) out.overhang_area += area;  // angle(n, -d) < limit
   }
   return out;
 }

@@ -13,13 +13,24 @@ struct OverhangShare {
   double share() const { return downward_area > 0 ? overhang_area / downward_area : 0.0; }
 };
 
+/// How overhang_share judges a surface.
+struct OverhangMeasureParams {
+  double angle = 45;              ///< degrees: the smallest self-supporting angle to the plate
+  double plate = 0;               ///< mm: the base plate's height along the build direction
+  double plate_tolerance = 1e-6;  ///< mm: a triangle with every corner this close to the plate rests on it
+  /// degrees >= 0: a triangle counts as an overhang only when it rises less than angle − tolerance
+  /// from the plate (facets of a wall at the limit scatter by a few degrees around its slope)
+  double tolerance = 0;
+};
+
 /// V: #P by 3 points, F: #Q by 3 triangles oriented outwards (a closed surface); d: the build
-/// direction (non-zero); angle: degrees, the smallest self-supporting angle to the plate;
-/// plate: the base plate's height along d/|d| (mm). A triangle faces down when its normal n
-/// has n·d < 0; it is an overhang when the angle between n and −d is below `angle` (a plane
-/// rising less than `angle` from the plate). Triangles lying on the plate (every corner within
-/// plate_tolerance mm of it) rest on it and count neither way.
-OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d, double angle, double plate,
-                             double plate_tolerance = 1e-6);
+/// direction (non-zero); params: the angle, plate and tolerances; tag: nullptr (every triangle
+/// counts) or #Q tags of result::TriSurface, of which only the design's own surface (tag 0)
+/// counts — Ω's faces and the non-design solids' faces are the part's given shape. A triangle
+/// faces down when its normal n has n·d < 0; it is an overhang when the angle between n and
+/// −d is below angle − tolerance (a plane rising less than that from the plate). Triangles
+/// lying on the plate (every corner within plate_tolerance of it) count neither way.
+OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d,
+                             const OverhangMeasureParams& params, const VecXi* tag = nullptr);
 
 }  // namespace topopt::simp

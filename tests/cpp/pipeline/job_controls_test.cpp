@@ -72,7 +72,7 @@ TEST(JobControls, MistakesNameTheKeyAndWhatToGive) {
 
 TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
   const Job job = parse_job(with_controls(R"({"overhang": {"direction": [1, 0, 0], "angle": 50, "base_face": "Face1",
-                                                           "cell": 2}})"),
+                                                           "cell": 2, "margin": 8}})"),
                             "/tmp");
   const simp::OverhangControl& o = job.optimization.simp.controls.overhang;
   EXPECT_TRUE(o.enabled);
@@ -81,10 +81,14 @@ TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
   EXPECT_EQ(o.angle, 50);
   EXPECT_EQ(o.base_face, 1);
   EXPECT_EQ(o.cell, 2);
+  EXPECT_EQ(o.margin, 8);
   const simp::OverhangControl plain =
       parse_job(with_controls(R"({"overhang": {"direction": [0, 0, 1]}})"), "/tmp").optimization.simp.controls.overhang;
   EXPECT_EQ(plain.angle, 45);
   EXPECT_EQ(plain.base_face, 0);
+  EXPECT_EQ(plain.margin, simp::OverhangControl{}.margin);
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angle": 80, "margin": 10}})",
+                 {"'optimization.controls.overhang.margin'", "angle + margin <= 85"});
   EXPECT_FALSE(parse_job("{}", "/tmp").optimization.simp.controls.overhang.enabled);
   expect_refused(R"({"overhang": {"angle": 45}})", {"'optimization.controls.overhang.direction'"});
   expect_refused(R"({"overhang": {"direction": [0, 0, 0]}})",

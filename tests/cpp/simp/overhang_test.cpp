@@ -14,6 +14,8 @@
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
 #include "mesh/core/structured_box.h"
+#include "pipeline/optimize_job.h"
+#include "result/design_hygiene.h"
 #include "result/iso_surface.h"
 #include "simp/controls/column_grid.h"
 #include "simp/controls/design_map.h"
@@ -51,13 +53,25 @@ VecXd field(const TetMesh& m, const std::vector<int>& design, Inside inside) {
   return r;
 }
 
+/// The control without a margin: the filter prints for `angle` itself (the stencil's tests).
 OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double angle = 45) {
   OverhangControl c;
   c.enabled = true;
   c.direction = d;
   c.angle = angle;
+  c.margin = 0;
   return c;
 }
+
+/// The property test's settings and bound. NOT the target (<= 1 % with the control):
+/// measured on the result surface the user gets, facets within 3 degrees of the limit not
+/// counted, β at its end (130-144 iterations): 7.7 % with a margin of 10°, 14.7 % with 5° (the
+/// default), 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang"). The test
+/// holds what is reached, with the margin of 10°.
+constexpr int kBeamIterations = 200;
+constexpr double kBeamTolerance = 3;
+constexpr double kBeamMargin = 10;
+constexpr double kBeamShareBound = 0.1;
 
 TEST(Overhang, SmoothMinAndMaxBoundTheExactOnes) {
   double da, db, dx[5];
@@ -152,7 +166,15 @@ TEST(Overhang, PrintsWhatIsSupportedAndDropsWhatIsNot) {
     if (c(i, 0) > 3 + 2 * c(i, 2) + 1.5) {
       EXPECT_LE(printed63[i], 0.01) << "grown at " << c.row(i);
     }
-  // 60° from the plate: layers tan 60° = 1.73 mm, the 45° wall is too flat now and is cut
+  // 60° from the plate: layers tan 60° = 1.73 mm, the 45° wall is too flat now and is cut; the
+  // same lattice with 45° and a margin of 15°
+  OverhangControl with_margin = control();
+  with_margin.margin = 15;
+  EXPECT_EQ((OverhangFilter(m, design, with_margin, 1.0).apply(lean45) -
+             OverhangFilter(m, design, control(Eigen::Vector3d::UnitZ(), 60), 1.0).apply(lean45))
+                .cwiseAbs()
+                .maxCoeff(),
+            0.0);
   const OverhangFilter steep(m, design, control(Eigen::Vector3d::UnitZ(), 60), 1.0);
   const VecXd printed45_at60 = steep.apply(lean45);
   double cut = 0, out = 0;
@@ -217,6 +239,11 @@ TEST(Overhang, BadSettingsNameWhatToFix) {
   c = control();
   c.exponent = 2;
   EXPECT_NE(message(c).find("controls.overhang.exponent must exceed"), std::string::npos) << message(c);
+  c = control({0, 0, 1}, 70);
+  c.margin = 20;  // 90 degrees: no slope left
+  EXPECT_NE(message(c).find("controls.overhang.margin must lie in [0, 20] degrees with angle + margin <= 85"),
+            std::string::npos)
+      << message(c);
   c = control();
   c.base_face = 5;
   EXPECT_EQ(message(c), "no error");
@@ -245,53 +272,101 @@ TEST(Overhang, GradientsMatchFiniteDifferences) {
   check_filter_gradient(OverhangFilter(m, design, control({0.3, -0.2, 1}, 35), 0.8), design.size(), 2);
   OverhangControl c = control({1, 0, 0});
   c.base_face = 1;
+  c.margin = 5;
   check_filter_gradient(OverhangFilter(m, design, c, 1.7), design.size(), 3);
 }
 
-/// The share of the crisp design's (ρ̄ >= 0.5 on the node densities) downward-facing surface
-/// flatter than `angle` for the build direction d from the plate at `plate`.
-OverhangShare crisp_overhang(const TetMesh& m, const VecXd& density, const Eigen::Vector3d& d, double angle,
-                             double plate) {
-  const result::TriSurface s = result::extract_iso_surface(m, result::node_densities(m, density), 0.5);
-  return overhang_share(s.V, s.F, d, angle, plate, 1e-6);
-}
+/// The test beam: a cantilever 30 × 10 × 10 mm (3888 tets) fixed at x = 0, a non-design pad at
+/// x = 28 … 30 loaded down (−z) and sideways (−y), printed lying (+z) from z = −5.
+struct Beam {
+  TetMesh mesh;
+  fem::Supports supports;
+  Eigen::MatrixXd loads;
+  std::vector<char> anchors;  ///< #V: the nodes where supports and loads act (the product's hygiene)
+};
 
-TEST(Overhang, CantileverHasLessOverhangWithTheControl) {
-  // a cantilever 30 × 10 × 10 mm fixed at x = 0, a pad at x = 30 loaded down (−z) and sideways
-  // (−y), printed lying (+z) from z = −5. NOT the target (≤ 1 % with the control): measured
-  // 12.9 % with it against 33 % free at 60 iterations (15.8 % at 150 iterations, grey 4 %); most
-  // of what is left lies within 25° of the critical angle (0.5 % flatter than 20° from the plate,
-  // 15 % free). The test holds what is reached: the share well below the free design's.
+Beam test_beam() {
   mesh::StructuredBoxParams box;
   box.origin = {0, -5, -5};
   box.size = {30, 10, 10};
   box.cells = {18, 6, 6};
   box.nondesign = {{28, -5, -5, 30, 5, 5}};
-  const TetMesh m = mesh::structured_box_mesh(box);
-  const fem::Supports supports = fem::make_supports(m, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
-  fem::Material mat;
+  Beam b;
+  b.mesh = mesh::structured_box_mesh(box);
+  b.supports = fem::make_supports(b.mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
   fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -30, -100}, 0, {}};
-  const Eigen::MatrixXd loads = fem::make_loads(m, mat, {fem::LoadCase{"a", {pull}, 1}});
+  b.loads = fem::make_loads(b.mesh, fem::Material{}, {fem::LoadCase{"a", {pull}, 1}});
+  b.anchors.assign(b.mesh.V.rows(), 0);
+  for (int dof : b.supports.dofs) b.anchors[dof / 3] |= result::kAnchorSupport;
+  for (long i = 0; i < b.loads.rows(); ++i)
+    if (b.loads(i, 0) != 0) b.anchors[i / 3] |= result::kAnchorLoad;
+  return b;
+}
+
+/// The share of the design's own surface (tag 0: not Ω's faces, not the pad's) on the result
+/// surface the user gets (pipeline::result_surface with the product's defaults: the threshold
+/// that keeps the volume fraction, hygiene, smoothing, remeshing), built along +z from z = −5;
+/// a facet counts when it rises less than angle − tolerance from the plate.
+OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, double angle,
+                               double tolerance) {
+  const result::TriSurface s =
+      pipeline::result_surface(b.mesh, density, -1, volume_fraction, result::SmoothParams{}, nullptr, b.anchors);
+  OverhangMeasureParams m;
+  m.angle = angle;
+  m.plate = -5;
+  m.tolerance = tolerance;
+  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag);
+}
+
+TEST(Overhang, MeasureCountsTheDesignsOwnSurfaceOnly) {
+  // two triangles facing down: a flat one (an overhang) and one at 40° from the plate (an
+  // overhang at 45°, not with a tolerance of 6°); a flat one tagged as Ω's face is not counted
+  MatX3d V(9, 3);
+  const double t = std::tan(40 * M_PI / 180);
+  V << 0, 0, 1, 0, 1, 1, 1, 0, 1,     // flat, facing down
+      0, 0, 2, 0, 1, 2, 1, 0, 2 + t,  // rising 40° along x, facing down
+      0, 0, 3, 0, 1, 3, 1, 0, 3;      // flat, Ω's face
+  MatX3i F(3, 3);
+  F << 0, 1, 2, 3, 4, 5, 6, 7, 8;
+  VecXi tag(3);
+  tag << 0, 0, 4;
+  OverhangMeasureParams p;
+  const OverhangShare all = overhang_share(V, F, Eigen::Vector3d::UnitZ(), p);
+  const OverhangShare own = overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag);
+  const double a_flat = 0.5, a_40 = 0.5 / std::cos(40 * M_PI / 180);
+  EXPECT_NEAR(all.downward_area, 2 * a_flat + a_40, 1e-12);
+  EXPECT_NEAR(own.downward_area, a_flat + a_40, 1e-12);
+  EXPECT_NEAR(own.share(), 1.0, 1e-12);
+  p.tolerance = 6;
+  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).share(), a_flat / (a_flat + a_40), 1e-12);
+  p.plate = 1;  // the flat triangle at z = 1 rests on the plate now
+  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).downward_area, a_40, 1e-12);
+}
+
+TEST(Overhang, BeamHasLessOverhangWithTheControl) {
+  // measured on the result surface the user gets (product_overhang), β to its end (32)
+  const Beam b = test_beam();
   SimpParams p;
   p.volume_fraction = 0.3;
   p.filter.radius = 2.5;
-  p.max_iterations = 60;
-  const SimpResult free_run = optimize(m, mat, supports, loads, {}, p);
-  p.controls.overhang = control();
+  p.max_iterations = kBeamIterations;
+  const SimpResult free_run = optimize(b.mesh, fem::Material{}, b.supports, b.loads, {}, p);
+  p.controls.overhang = OverhangControl{};
+  p.controls.overhang.enabled = true;
+  p.controls.overhang.margin = kBeamMargin;
   p.controls.overhang.cell = 10.0 / 6;
-  const SimpResult printed = optimize(m, mat, supports, loads, {}, p);
-  const OverhangShare with = crisp_overhang(m, printed.density, Eigen::Vector3d::UnitZ(), 45, -5);
-  const OverhangShare without = crisp_overhang(m, free_run.density, Eigen::Vector3d::UnitZ(), 45, -5);
+  const SimpResult printed = optimize(b.mesh, fem::Material{}, b.supports, b.loads, {}, p);
+  const OverhangShare with = product_overhang(b, printed.density, 0.3, 45, kBeamTolerance);
+  const OverhangShare without = product_overhang(b, free_run.density, 0.3, 45, kBeamTolerance);
   std::cout << "overhang share with the control " << with.share() << " (" << with.overhang_area << " of "
-            << with.downward_area << " mm2), without " << without.share() << " (" << without.overhang_area << " of "
-            << without.downward_area << " mm2); compliance " << printed.history.back().compliance << " against "
-            << free_run.history.back().compliance << ", volume " << printed.history.back().volume_fraction << ", grey "
-            << printed.history.back().grey << ", " << printed.history.size() << " iterations\n";
-  EXPECT_LE(with.share(), 0.2);
-  EXPECT_LE(with.share(), 0.5 * without.share());
+            << with.downward_area << " mm2), without " << without.share() << "; compliance "
+            << printed.history.back().compliance << " against " << free_run.history.back().compliance << ", beta "
+            << printed.history.back().beta << ", grey " << printed.history.back().grey << ", " << printed.history.size()
+            << " iterations\n";
+  EXPECT_EQ(printed.history.back().beta, 32) << "beta should reach its end";
+  EXPECT_LE(with.share(), kBeamShareBound);
+  EXPECT_LE(with.share(), 0.6 * without.share());
   EXPECT_GE(without.share(), 0.2) << "the free design should need supports printed this way";
-  EXPECT_LE(crisp_overhang(m, printed.density, Eigen::Vector3d::UnitZ(), 20, -5).share(), 0.02)
-      << "flat overhangs (less than 20 degrees from the plate) should be gone";
   EXPECT_NEAR(printed.history.back().volume_fraction, 0.3, 0.01);
   EXPECT_LE(printed.history.back().compliance, 2 * free_run.history.back().compliance);
 }
