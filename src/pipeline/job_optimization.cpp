@@ -1,5 +1,6 @@
 // The "optimization" section of a job (docs/optimization.md): every SIMP setting typed and
 // range-checked here, once.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -186,11 +187,11 @@ void parse_overhang(const Fields& controls, simp::OverhangControl& o) {
     f.bad("angle",
           "must lie in [10, 80] degrees: the smallest angle to the base plate that prints without "
           "supports (45 is usual)");
-  o.margin = f.number("margin", o.margin);
+  o.margin = f.number("margin", std::min(o.margin, 85 - o.angle));  // the default fits any angle
   if (!(o.margin >= 0 && o.margin <= 20 && o.angle + o.margin <= 85))
     f.bad("margin",
           "must lie in [0, 20] degrees with angle + margin <= 85: the filter prints for angle + margin so that "
-          "walls at the limit stay printable (5 is the default)");
+          "walls at the limit stay printable (10 is the default)");
   if (f.has("base_face")) {
     std::vector<int> faces, nondesign;
     if (!f.at("base_face").is_string()) f.bad("base_face", "must be a face name such as \"Face5\"");

@@ -87,6 +87,11 @@ TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
   EXPECT_EQ(plain.angle, 45);
   EXPECT_EQ(plain.base_face, 0);
   EXPECT_EQ(plain.margin, simp::OverhangControl{}.margin);
+  // the default margin fits a steep angle: 80 + 5 = 85, not refused
+  const simp::OverhangControl steep =
+      parse_job(with_controls(R"({"overhang": {"direction": [0, 0, 1], "angle": 80}})"), "/tmp")
+          .optimization.simp.controls.overhang;
+  EXPECT_EQ(steep.margin, 5);
   expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angle": 80, "margin": 10}})",
                  {"'optimization.controls.overhang.margin'", "angle + margin <= 85"});
   EXPECT_FALSE(parse_job("{}", "/tmp").optimization.simp.controls.overhang.enabled);

@@ -65,8 +65,8 @@ OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double ang
 
 /// The property test's settings and bound. NOT the target (<= 1 % with the control):
 /// measured on the result surface the user gets, facets within 3 degrees of the limit not
-/// counted, β at its end (130-144 iterations): 7.7 % with a margin of 10°, 14.7 % with 5° (the
-/// default), 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang"). The test
+/// counted, β at its end (130-144 iterations): 7.7 % with a margin of 10° (the default), 14.7 % with
+/// 5°, 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang"). The test
 /// holds what is reached, with the margin of 10°.
 constexpr int kBeamIterations = 200;
 constexpr double kBeamTolerance = 3;
