@@ -125,13 +125,14 @@ class Remesher {
     int lock = 0, face = 0;
     if (!split_point(a, b, lock, face)) return 0;
     const std::vector<int> across = m_.edge_triangles(a, c);
+    if (across.size() != 2 || m_.tag(across[0]) != m_.tag(across[1])) return 0;  // ac cannot flip
     double worst_before = angle(t);
     for (int u : m_.edge_triangles(a, b)) worst_before = std::min(worst_before, angle(u));
     for (int u : across) worst_before = std::min(worst_before, angle(u));
     add_point(a, b, lock, face);
     const int p = m_.split_edge(a, b);
-    const int e = across.size() == 2 ? m_.third(across[0] == t ? across[1] : across[0], a, c) : -1;
-    const bool flipped = e >= 0 && flip(a, c);
+    const int e = m_.third(across[0] == t ? across[1] : across[0], a, c);
+    const bool flipped = flip(a, c);
     double worst_after = 180;
     for (int u : m_.star(p)) worst_after = std::min(worst_after, angle(u));
     if (flipped && worst_after > worst_before + 1e-9) {
