@@ -25,13 +25,17 @@ Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
 /// The surface as editable triangles with each point's triangles.
 class Remesher {
  public:
-  Remesher(TriSurface& s, const RemeshParams& p) : s_(s), p_(p), m_(s.F, s.tag, s.V.rows()) {}
+  Remesher(TriSurface& s, const RemeshParams& p)
+      : s_(s), p_(p), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
+    if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
+  }
 
   /// Sweeps until a sweep changes nothing or params.passes sweeps ran.
   void run() {
     for (int pass = 0; pass < p_.passes; ++pass) {
       long changes = 0;
-      for (int t = 0; t < m_.triangles(); ++t)
+      const int n = m_.triangles();  // a pass visits the triangles it found (splits add some)
+      for (int t = 0; t < n; ++t)
         if (m_.alive(t) && angle(t) < p_.target_angle) changes += improve(t);
       if (changes == 0) break;
     }
@@ -41,14 +45,16 @@ class Remesher {
   RemeshReport finish() {
     const std::vector<char> used = m_.used_points();
     std::vector<int> new_index(used.size(), -1);
+    std::vector<int> old_of;
     for (int i = 0; i < static_cast<int>(used.size()); ++i)
-      if (used[i]) new_index[i] = static_cast<int>(report_.kept_points.size()), report_.kept_points.push_back(i);
-    const long np = static_cast<long>(report_.kept_points.size());
+      if (used[i]) new_index[i] = static_cast<int>(old_of.size()), old_of.push_back(i);
+    const long np = static_cast<long>(old_of.size());
     MatX3d V(np, 3);
     VecXi lock(np), point_face(np);
     for (long i = 0; i < np; ++i) {
-      const int old = report_.kept_points[i];
+      const int old = old_of[i];
       V.row(i) = s_.V.row(old), lock[i] = s_.lock[old], point_face[i] = s_.point_face.size() ? s_.point_face[old] : 0;
+      report_.kept_points.push_back(old < given_points_ ? old : -1);
     }
     m_.live(s_.F, s_.tag, &new_index);
     s_.V = V, s_.lock = lock, s_.point_face = point_face;
@@ -75,7 +81,73 @@ class Remesher {
     }
     for (int v : m_.tri(t))
       if (relocate(v)) return 1;
+    return angle(t) < p_.split_angle ? split_needle(t) : 0;
+  }
+
+  /// The lock and cut-line face of a point at the midpoint of edge ab, or false when ab may not
+  /// be split: its two triangles on the free-form region (a free point), on one planar Ω face
+  /// (inside it), one free-form and one on a planar face (on the face's cut line), or on two
+  /// planar faces (on the edge between them; the midpoint lies on both planes). Curved Ω faces
+  /// and non-design faces keep their edges.
+  bool split_point(int a, int b, int& lock, int& face) const {
+    const std::vector<int> e = m_.edge_triangles(a, b);
+    if (e.size() != 2 || (!p_.planar_faces && (m_.tag(e[0]) != 0 || m_.tag(e[1]) != 0))) return false;
+    for (int t : e)
+      if (m_.tag(t) < 0 || (m_.tag(t) > 0 && !planar(m_.tag(t)))) return false;
+    const int f0 = m_.tag(e[0]), f1 = m_.tag(e[1]);
+    lock = (f0 == 0 && f1 == 0) ? 0 : 1;
+    face = (f0 == 0) != (f1 == 0) ? std::max(f0, f1) : 0;
+    return true;
+  }
+
+  /// Adds a point at the midpoint of a and b with the given lock and cut-line face.
+  void add_point(int a, int b, int lock, int face) {
+    const long n = s_.V.rows();
+    s_.V.conservativeResize(n + 1, 3), s_.lock.conservativeResize(n + 1), s_.point_face.conservativeResize(n + 1);
+    s_.V.row(n) = 0.5 * (s_.V.row(a) + s_.V.row(b));
+    s_.lock[n] = lock, s_.point_face[n] = face;
+  }
+
+  /// Mends needle t (corner a with the smallest angle, opposite the short edge bc): splits its
+  /// longest edge ab at the midpoint p (split_point says where that is allowed) and flips the other
+  /// long edge ac into p's opposite edge, so that (p, b, c) replaces the needle. Keeps both when
+  /// the smallest angle of the triangles around p is larger than the one of the triangles they
+  /// replace; else flips back and collapses p into b, which gives the triangles as they were.
+  /// 1 if kept.
+  int split_needle(int t) {
+    const Tri& q = m_.tri(t);
+    int k = 0;  // the corner with the smallest angle: opposite the shortest edge
+    auto len = [&](int i, int j) { return (s_.V.row(i) - s_.V.row(j)).squaredNorm(); };
+    for (int i = 1; i < 3; ++i)
+      if (len(q[(i + 1) % 3], q[(i + 2) % 3]) < len(q[(k + 1) % 3], q[(k + 2) % 3])) k = i;
+    int a = q[k], b = q[(k + 1) % 3], c = q[(k + 2) % 3];
+    if (len(a, c) > len(a, b)) std::swap(b, c);
+    int lock = 0, face = 0;
+    if (!split_point(a, b, lock, face)) return 0;
+    const std::vector<int> across = m_.edge_triangles(a, c);
+    if (across.size() != 2 || m_.tag(across[0]) != m_.tag(across[1])) return 0;  // ac cannot flip
+    double worst_before = angle(t);
+    for (int u : m_.edge_triangles(a, b)) worst_before = std::min(worst_before, angle(u));
+    for (int u : across) worst_before = std::min(worst_before, angle(u));
+    add_point(a, b, lock, face);
+    const int p = m_.split_edge(a, b);
+    const int e = m_.third(across[0] == t ? across[1] : across[0], a, c);
+    const bool flipped = flip(a, c);
+    double worst_after = 180;
+    for (int u : m_.star(p)) worst_after = std::min(worst_after, angle(u));
+    if (flipped && worst_after > worst_before + 1e-9) {
+      ++report_.splits;
+      return 1;
+    }
+    undo_split(p, b, flipped ? e : -1);
     return 0;
+  }
+
+  /// Undoes split_needle's split of ab at p (and its flip of ac into pe when e >= 0).
+  void undo_split(int p, int b, int e) {
+    EditableSurface::Flip f;
+    if (e >= 0 && m_.flip_of(p, e, f)) m_.flip(p, e, f), --report_.flips;
+    if (m_.link_condition(b, p)) m_.collapse(p, b);
   }
 
   /// The planar Ω face whose interior point v is (on Ω's boundary, not on the cut line, and
@@ -269,6 +341,7 @@ class Remesher {
   TriSurface& s_;
   const RemeshParams& p_;
   EditableSurface m_;
+  int given_points_;  ///< the points s had; split_needle adds points after them
   RemeshReport report_;
 };
 

@@ -19,11 +19,15 @@ struct RemeshParams {
   double max_normal_turn = 30;  ///< a collapse may turn no triangle's normal by more than this (degrees)
   int passes = 20;              ///< sweeps over the surface at most (each stops the work when nothing changed)
   bool planar_faces = true;     ///< also flip and collapse on Ω's planar faces (points stay in their plane)
+  /// a needle (a triangle whose smallest angle is below this, degrees) that no flip, collapse or
+  /// move improves has its longest edge split at the midpoint and its other long edge flipped
+  /// away (0: never split)
+  double split_angle = 10;
 };
 
 /// What remesh_surface did.
 struct RemeshReport {
-  long collapses = 0, flips = 0, moves = 0;
+  long collapses = 0, flips = 0, moves = 0, splits = 0;
   std::vector<int> kept_points;  ///< for each point of the remeshed surface, its index before
 };
 
@@ -40,9 +44,17 @@ struct RemeshReport {
 /// or ends with a smaller smallest angle than the worst one it replaces; else moves a point of the
 /// triangle towards the mean of its neighbours when that raises their smallest angle: a free point
 /// within the plane of its triangles, a point inside a planar Ω face within the face's plane, a
-/// cut-line point towards its two neighbours on the line, within the face's plane. Non-design
-/// points and points on Ω's edges keep their positions; tags keep their meaning. Returns the
-/// counts and which points stayed.
+/// cut-line point towards its two neighbours on the line, within the face's plane; and when that
+/// fails too on a needle (below split_angle), splits the needle's longest edge ab at its midpoint
+/// p and flips its other long edge ac, keeping both only when the smallest angle around p beats
+/// the needle's (a needle with a short edge bc whose points may not go: the angle at p in
+/// (p, b, c) is about twice the one at a). The edge split lies on the free-form region, inside
+/// a planar Ω face, on a planar face's cut line, or between two planar faces (the midpoint is on
+/// the planes); never on a curved Ω face (the surface does not hold the face's geometry, so the
+/// midpoint's distance to it is unknown) nor on a non-design face (its points are the FE
+/// mesh's). Non-design points and points on Ω's edges keep their positions; tags keep their
+/// meaning. Returns the counts and which points stayed (a point added by a split has index -1
+/// in kept_points).
 RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {});
 
 }  // namespace topopt::result

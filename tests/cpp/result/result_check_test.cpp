@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "result/design_surface.h"
@@ -146,7 +147,8 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
   // a non-design point that went lay inside one plane of the non-design triangles (its triangles
   // one tag, coplanar): the FE mesh's boundary re-triangulated within its plane
   std::vector<char> stayed(V0.rows(), 0);
-  for (int k : r.kept_points) stayed[k] = 1;
+  for (int k : r.kept_points)
+    if (k >= 0) stayed[k] = 1;
   long removed = 0;
   for (long i = 0; i < V0.rows(); ++i) {
     if (lock0[i] != 2 || stayed[i]) continue;
@@ -165,6 +167,72 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
     }
   }
   EXPECT_EQ((s.lock.array() == 2).count() + removed, (lock0.array() == 2).count());
+}
+
+/// A needle (a, c, b) of 6.3° at a, its short edge bc between two non-design points (lock 2:
+/// neither may go), with its neighbours: (a, b, d) across ab bent up by 56° (no flip across it),
+/// (c, a, e) flat across ac, (b, c, g) flat across bc; every point lock 2. No flip, collapse or
+/// move improves the needle; every triangle has `tag`.
+TriSurface stuck_needle(int tag) {
+  MatX3d V(6, 3);  // a, b, c, d, e, g
+  V << 0, 0, 0, 10, 0.6, 0, 10, -0.5, 0, 5, 3, 4, 5, -12, 0, 14, 0, 0;
+  MatX3i F(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 2, 0, 4, 1, 2, 5;
+  TriSurface s = with_tags(V, F);
+  s.tag.setConstant(tag);
+  s.lock.setConstant(2);
+  return s;
+}
+
+double smallest_angle(const TriSurface& s) {
+  double m = 180;
+  for (long t = 0; t < s.F.rows(); ++t) m = std::min(m, min_triangle_angle(s.V, s.F(t, 0), s.F(t, 1), s.F(t, 2)));
+  return m;
+}
+
+TEST(ResultCheck, RemeshSplitsTheLongEdgeOfANeedleWhoseShortEdgeCannotGo) {
+  TriSurface s = stuck_needle(0);
+  const double before = smallest_angle(s);
+  ASSERT_LT(before, 7.0);
+  RemeshParams no_split;
+  no_split.split_angle = 0;
+  TriSurface unsplit = s;
+  const RemeshReport r0 = remesh_surface(unsplit, no_split);
+  EXPECT_EQ(r0.collapses + r0.flips + r0.moves + r0.splits, 0);  // stuck without the split
+  const RemeshReport r = remesh_surface(s);
+  EXPECT_GE(r.splits, 1);
+  // the needle is gone: (p, c, b) sees bc from half the distance, the flip took a's edge to c
+  EXPECT_GT(smallest_angle(s), 11.0);
+  EXPECT_EQ(s.F.rows(), 4 + 2 * r.splits - 2 * r.collapses);
+  // the six points stay where they were; the added one is free (put at ab's midpoint, a free point
+  // may then move towards its neighbours)
+  ASSERT_EQ(s.V.rows(), 6 + r.splits - r.collapses);
+  for (long i = 0; i < s.V.rows(); ++i) {
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ((s.V.row(i) - stuck_needle(0).V.row(r.kept_points[i])).norm(), 0.0);
+      EXPECT_EQ(s.lock[i], 2);
+    } else {
+      EXPECT_EQ(s.lock[i], 0);
+    }
+  }
+  // one oriented patch still: every interior edge is used once each way
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < s.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
+  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+}
+
+TEST(ResultCheck, RemeshDoesNotSplitOnACurvedFace) {
+  // the same needle on a curved Ω face (no plane): its points are cut-line points of that face, which
+  // may not go, and the face's edges may not be split (the midpoint's distance to the face is unknown)
+  TriSurface s = stuck_needle(1);
+  s.lock.setConstant(1);
+  s.point_face.setConstant(1);
+  s.face_plane.assign(2, Eigen::Vector4d::Zero());
+  const MatX3i F0 = s.F;
+  const RemeshReport r = remesh_surface(s);
+  EXPECT_EQ(r.splits, 0);
+  EXPECT_EQ(s.F, F0);
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
