@@ -8,6 +8,10 @@ Each side runs single-threaded (OMP_NUM_THREADS=1, OPENBLAS_NUM_THREADS=1) pinne
   rocker          the rocker job from the STEP files (1.15 mm, ~100 k tets), job defaults
   solve           one `topopt solve` on the rocker meshed at 1.15 mm (by side A, the same MSH for
                   both sides) and one `ccx` of the same mesh and loads, interleaved
+--iterations N caps every study at N SIMP iterations and --from-mesh reads each example's mesh
+from an MSH file made once by binary A (the same tets for both sides; the two binaries' surface
+and volume meshers may differ): a short, like-for-like measure of the optimisation alone when the
+machine is too loaded for whole studies.
 Every run appends one JSON line to --out (figures: CPU = user + sys of the child, wall, peak RSS,
 tets, iterations, final compliance, grey share, SIMP seconds) and a Markdown summary is printed at
 the end: per study, the CPU of each run and the median ratio B / A.
@@ -28,10 +32,12 @@ def pinned(cmd, cpu):
     return ["nice", "-n", "5", "taskset", "-c", str(cpu)] + list(cmd), env
 
 
-def study(binary, work, tag, name, size, output, cpu):
-    """One `topopt optimize` of example `name` from its STEP files; returns the measured figures."""
+def study(binary, work, tag, name, mesh, extra, cpu):
+    """One `topopt optimize` of example `name`; mesh: {"size": s} (from its STEP files) or
+    {"file": msh}; extra: job keys (output, optimization). Returns the measured figures."""
     out_dir = os.path.join(work, tag)
-    path = targets.write_job(work, tag, name, {"size": size}, {"output": dict(output, directory=out_dir)})
+    extra = dict(extra, output=dict(extra.get("output", {}), directory=out_dir))
+    path = targets.write_job(work, tag, name, mesh, extra)
     cmd, env = pinned([binary, "optimize", path, "--quiet"], cpu)
     out, t, wall, peak = benchlib.run(["timeout", "1500"] + cmd, env, check=False)
     try:
@@ -42,6 +48,12 @@ def study(binary, work, tag, name, size, output, cpu):
     return {"cpu": t, "wall": wall, "peak": peak, "tets": int(tets.group(1)) if tets else None,
             "its": len(h["history"]), "c": h["history"][-1]["compliance"], "grey": grey,
             "status": h.get("status"), "simp": h["seconds"].get("simp"), "surface": h["seconds"].get("surface")}
+
+
+def shared_mesh(binary, work, name, size):
+    """The MSH file of example `name` at `size`, meshed by `binary` on first use."""
+    msh = os.path.join(work, "%s_%g.msh" % (name, size))
+    return msh if os.path.exists(msh) else targets.mesh_file(binary, work, name, size)[0]
 
 
 def solve(binary, work, job, cpu):
@@ -79,6 +91,8 @@ def main():
     ap.add_argument("--cpu", type=int, default=1)
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--studies", default="cantilever_off,cantilever_on,solve,rocker")
+    ap.add_argument("--iterations", type=int, default=0, help="cap on SIMP iterations (0: the job's)")
+    ap.add_argument("--from-mesh", action="store_true", help="studies read a mesh file made by binary A")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     rows = []
@@ -108,9 +122,12 @@ def main():
                     record({"study": "ccx", "round": rnd, "side": side, "cpu": t, "wall": wall, "peak": peak})
                     continue
                 ex, size = ("rocker", 1.15) if name == "rocker" else ("cantilever", 1.0)
-                output = off if name == "cantilever_off" else {}
+                extra = {"output": off if name == "cantilever_off" else {}}
+                if a.iterations:
+                    extra["optimization"] = {"max_iterations": a.iterations}
+                mesh = {"file": shared_mesh(a.a, a.work, ex, size)} if a.from_mesh else {"size": size}
                 tag = "%s_%s%d" % (name, side, rnd)
-                record(dict(base, **study(binary, a.work, tag, ex, size, output, a.cpu)))
+                record(dict(base, **study(binary, a.work, tag, ex, mesh, extra, a.cpu)))
     summary(rows)
 
 
