@@ -38,13 +38,16 @@ def study(binary, work, tag, name, mesh, extra, cpu):
     out_dir = os.path.join(work, tag)
     extra = dict(extra, output=dict(extra.get("output", {}), directory=out_dir))
     path = targets.write_job(work, tag, name, mesh, extra)
-    cmd, env = pinned([binary, "optimize", path, "--quiet"], cpu)
+    stats = os.path.join(work, tag + "_stats.json")
+    cmd, env = pinned([binary, "optimize", path, "--quiet", "--stats", stats], cpu)
     out, t, wall, peak = benchlib.run(["timeout", "1500"] + cmd, env, check=False)
     try:
         grey, h = targets.grey_share(out_dir)
     except (OSError, ValueError):
         return {"failed": out[-2000:], "cpu": t, "wall": wall}
     tets = re.search(r"(\d+) tets", out)
+    st = json.load(open(stats))
+    peak = (st["per_rank"][0] if "per_rank" in st else st).get("peak_mb", peak)  # this run's, not the children's
     return {"cpu": t, "wall": wall, "peak": peak, "tets": int(tets.group(1)) if tets else None,
             "its": len(h["history"]), "c": h["history"][-1]["compliance"], "grey": grey,
             "status": h.get("status"), "simp": h["seconds"].get("simp"), "surface": h["seconds"].get("surface")}
@@ -67,14 +70,14 @@ def summary(rows):
     """Prints, per study, each run's CPU and figures and the median CPU ratio B / A."""
     for name in dict.fromkeys(r["study"] for r in rows):
         rs = [r for r in rows if r["study"] == name]
-        print("\n%s:\n\n| run | side | load (1 min) | tets | iterations | compliance | grey | CPU (s) | wall (s) |"
-              % name)
-        print("|---|---|---|---|---|---|---|---|---|")
+        print("\n%s:\n\n| run | side | load (1 min) | tets | iterations | compliance | grey | CPU (s) | wall (s) | "
+              "peak RSS (MB) |" % name)
+        print("|---|---|---|---|---|---|---|---|---|---|")
         for r in rs:
-            print("| %d | %s | %.1f | %s | %s | %s | %s | %.2f | %.1f |" % (
+            print("| %d | %s | %.1f | %s | %s | %s | %s | %.2f | %.1f | %.0f |" % (
                 r["round"], r["side"], r["load"], r.get("tets", ""), r.get("its", ""),
                 "%.3f" % r["c"] if "c" in r else r.get("failed", "")[:60], "%.4f" % r["grey"] if r.get("grey") is not None
-                else "", r["cpu"], r["wall"]))
+                else "", r["cpu"], r["wall"], r.get("peak", 0)))
         a = [r["cpu"] for r in rs if r["side"] == "A"]
         b = [r["cpu"] for r in rs if r["side"] == "B"]
         if a and b:
