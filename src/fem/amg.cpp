@@ -24,6 +24,7 @@ struct Level {
   double lambda = 1;           // estimate of λmax(D⁻¹A)
   std::vector<double> eigvec;  // its eigenvector estimate (restarts the power iteration)
   CsrMatrix P, R;              // to/from the next coarser level
+  CsrMatrix AP;                // A P, kept so that a Galerkin refresh rewrites values only
   // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
@@ -405,8 +406,8 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     L.P = smoothed_prolongator(Al, Pt, L.inv_diag, L.lambda, m.threads);
     L.R = transpose(L.P);
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
-    CsrMatrix APs = multiply(Al, L.P, m.threads);
-    CsrMatrix coarse = multiply(L.R, APs, m.threads);
+    L.AP = multiply(Al, L.P, m.threads);
+    CsrMatrix coarse = multiply(L.R, L.AP, m.threads);
     Impl::to_float(L.P, L.Pf);
     Impl::to_float(L.R, L.Rf);
     Impl::to_float(Al, L.Af);
@@ -438,8 +439,10 @@ void SmoothedAggregationAmg::refresh_galerkin() {
     m.inverse_diagonal(L);
     m.estimate_lambda(L, 5);
     Impl::to_float(*L.A, L.Af);
-    const CsrMatrix AP = multiply(*L.A, L.P, m.threads);
-    m.levels[l + 1].own = multiply(L.R, AP, m.threads);  // the next level's A points at it
+    // same patterns as the setup's products: rewrite their values in place (the next level's
+    // A points at its `own`)
+    multiply_values(*L.A, L.P, L.AP, m.threads);
+    multiply_values(L.R, L.AP, m.levels[l + 1].own, m.threads);
   }
   m.inverse_diagonal(m.levels.back());
   m.factor_coarsest(true);

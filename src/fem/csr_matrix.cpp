@@ -111,6 +111,36 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
   return C;
 }
 
+void multiply_values(const CsrMatrix& A, const CsrMatrix& B, CsrMatrix& C, int threads) {
+  assert(A.cols == B.rows && C.rows == A.rows && C.cols == B.cols);
+  constexpr int kB = CsrMatrix::kMaxBlock;
+  const bool one_row = A.blocks.empty();
+  const long nblocks = one_row ? A.rows : static_cast<long>(A.blocks.size()) - 1;
+  parallel_for(
+      nblocks, threads,
+      [&](long bb, long be) {
+        std::vector<int> slot(B.cols);  // a column's position in the block's rows of C
+        for (long blk = bb; blk < be; ++blk) {
+          const int r0 = one_row ? static_cast<int>(blk) : A.blocks[blk];
+          const int nr = one_row ? 1 : A.blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
+          const int c0 = C.ptr[r0], clen = C.ptr[r0 + 1] - c0;
+          for (int t = 0; t < clen; ++t) slot[C.col[c0 + t]] = t;
+          for (int r = 0; r < nr; ++r) std::fill_n(&C.val[C.ptr[r0 + r]], clen, 0.0);
+          for (int k = 0; k < len; ++k) {
+            const int cc = A.col[A.ptr[r0] + k];
+            double a[kB];
+            for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
+            for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
+              const int t = slot[B.col[kb]];
+              const double v = B.val[kb];
+              for (int r = 0; r < nr; ++r) C.val[C.ptr[r0 + r] + t] += a[r] * v;
+            }
+          }
+        }
+      },
+      512);
+}
+
 CsrMatrix transpose(const CsrMatrix& A) {
   CsrMatrix T;
   T.rows = A.cols;

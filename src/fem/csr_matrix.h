@@ -72,6 +72,13 @@ void sparse_product(const CsrMatrix& M, const Value* val, const double* x, doubl
 /// are formed together and C inherits A's blocks.
 CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads);
 
+/// C = A B again for new values of A and B on the patterns C was computed from: C must be the
+/// result of multiply(A', B') with A' and B' of A's and B's patterns (and row blocks); only
+/// C.val is rewritten, in place, with the additions in multiply's order (the same values to
+/// the bit). No allocation but one column-slot array per thread: the multigrid's Galerkin
+/// refresh of kept coarse levels (fem/amg.h) without fresh pages to fault in.
+void multiply_values(const CsrMatrix& A, const CsrMatrix& B, CsrMatrix& C, int threads);
+
 /// Aᵀ in compressed rows (no blocks).
 CsrMatrix transpose(const CsrMatrix& A);
 

@@ -1,5 +1,6 @@
 // Sparse matrix kernels against dense arithmetic: products with and without row blocks, the
-// single-precision product, the matrix product and the transpose.
+// single-precision product, the matrix product (fresh, and values only on a kept pattern) and
+// the transpose.
 #include "fem/csr_matrix.h"
 
 #include <gtest/gtest.h>
@@ -69,6 +70,26 @@ TEST(CsrMatrix, MatrixProductAndTransposeEqualDenseArithmetic) {
   EXPECT_EQ(T.rows, A.cols);
   EXPECT_EQ(T.cols, A.rows);
   EXPECT_EQ(dense(T), dense(A).transpose());
+}
+
+TEST(CsrMatrix, ValuesOnlyProductMatchesAFreshProductToTheBit) {
+  for (const bool blocked : {true, false}) {
+    CsrMatrix A = random_blocked(24, 18, 4, 5), B = random_blocked(18, 11, 1, 6);
+    if (!blocked) A.blocks.clear();
+    CsrMatrix C = multiply(A, B, 2);
+    const std::vector<double> old_values = C.val;
+    std::mt19937 rng(7);  // new values, same patterns: SIMP's next stiffness on kept aggregates
+    std::uniform_real_distribution<double> value(-2, 2);
+    for (double& v : A.val) v = value(rng);
+    for (double& v : B.val) v = value(rng);
+    const CsrMatrix fresh = multiply(A, B, 2);
+    multiply_values(A, B, C, 2);
+    EXPECT_EQ(C.ptr, fresh.ptr);
+    EXPECT_EQ(C.col, fresh.col);
+    EXPECT_EQ(C.val, fresh.val) << (blocked ? "blocked" : "one row a block");
+    EXPECT_NE(C.val, old_values);  // the values were rewritten
+    EXPECT_LT((dense(C) - dense(A) * dense(B)).norm(), 1e-12 * (dense(A) * dense(B)).norm());
+  }
 }
 
 TEST(CsrMatrix, InconsistentBlocksAreDetected) {
