@@ -143,14 +143,16 @@ class StudyPanel:
         self.summary.setWordWrap(True)
         layout.addWidget(self.summary)
         layout.addWidget(self._settings_box())
+        # Run and Result next to the settings every study needs, so they show without scrolling
+        # in the default combo view; the optional controls and objectives follow below them
+        layout.addWidget(self._run_box())
+        layout.addWidget(self._result_box())
         from topopt.gui.controls_panel import ControlsBox, ResponsesBox
         self.controls = ControlsBox(self.study)
         self.responses = ResponsesBox(self.study)
         layout.addWidget(self.controls.box)
         layout.addWidget(self.controls.process.box)
         layout.addWidget(self.responses.box)
-        layout.addWidget(self._run_box())
-        layout.addWidget(self._result_box())
         layout.addStretch(1)
         return form
 
