@@ -32,6 +32,15 @@ def _picked(what):
     return picked
 
 
+def _pick_direction(entry, switch):
+    """Sets the direction `entry` from the first selected planar face (its normal) or straight
+    edge and checks `switch`, the control it belongs to. Raises TopOptError naming what was
+    picked otherwise (or that nothing was)."""
+    obj, sub = _picked("a planar face or a straight edge")[0]
+    entry.set(picking.direction_of(obj, sub))
+    switch.setChecked(True)
+
+
 def _number(low, high, decimals, suffix="", special="", min_width=50):
     """A number field that the layout may shrink down to min_width pixels (its value and unit
     must still show there)."""
@@ -195,9 +204,7 @@ class ControlsBox:
             self.cyclic.add({"point": point, "axis": axis, "sectors": self.sectors.value()})
 
     def pick_extrusion(self):
-        obj, sub = _picked("a planar face or a straight edge")[0]
-        self.extrusion_dir.set(picking.direction_of(obj, sub))
-        self.extrusion_on.setChecked(True)
+        _pick_direction(self.extrusion_dir, self.extrusion_on)
 
     def show(self):
         """Shows the study's GeometryControls."""
@@ -315,9 +322,7 @@ class ProcessBox:
     def pick_draw(self):
         """The draw direction from the first selected planar face (normal) or straight edge;
         turns the draw direction on. Raises TopOptError naming what was picked otherwise."""
-        obj, sub = _picked("a planar face or a straight edge")[0]
-        self.draw_dir.set(picking.direction_of(obj, sub))
-        self.draw_on.setChecked(True)
+        _pick_direction(self.draw_dir, self.draw_on)
 
     def pick_parting_point(self):
         """The parting plane's point from the first selected vertex (or a face's or edge's
@@ -330,9 +335,7 @@ class ProcessBox:
     def pick_build(self):
         """The build direction from the first selected planar face (normal) or straight edge;
         turns the overhang limit on. Raises TopOptError naming what was picked otherwise."""
-        obj, sub = _picked("a planar face or a straight edge")[0]
-        self.build_dir.set(picking.direction_of(obj, sub))
-        self.overhang_on.setChecked(True)
+        _pick_direction(self.build_dir, self.overhang_on)
 
     def pick_base_face(self):
         """The base plate's face ("FaceN") from the first selected face of the study's part;
