@@ -9,6 +9,7 @@
 
 #include "common/error.h"
 #include "common/face_key.h"
+#include "fem/tet_element.h"
 #include "mesh/core/predicates.h"
 
 namespace topopt::result {
@@ -25,16 +26,11 @@ MatX3d node_gradients(const TetMesh& mesh, const VecXd& f) {
   VecXd w = VecXd::Zero(mesh.V.rows());
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (tagged && mesh.domain[t] != 0) continue;
-    const Eigen::Vector3d x0 = mesh.V.row(mesh.T(t, 0));
-    Eigen::Matrix3d J;
-    Eigen::Vector3d df;
-    for (int k = 0; k < 3; ++k) {
-      J.row(k) = mesh.V.row(mesh.T(t, k + 1)) - x0.transpose();
-      df[k] = f[mesh.T(t, k + 1)] - f[mesh.T(t, 0)];
-    }
-    const double vol = std::abs(J.determinant()) / 6;
-    if (vol <= 0) continue;
-    const Eigen::Vector3d grad = J.partialPivLu().solve(df);
+    double N[12];  // ∂N_a/∂x_c of the tet's linear shape functions (fem::tet_gradients)
+    const double vol = fem::tet_gradients(mesh, t, N) / 6;
+    if (!(vol > 0)) continue;  // the mesh's tets are positive: never taken on a valid mesh
+    Eigen::Vector3d grad = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) grad += f[mesh.T(t, a)] * Eigen::Vector3d(N[3 * a], N[3 * a + 1], N[3 * a + 2]);
     for (int a = 0; a < 4; ++a) g.row(mesh.T(t, a)) += vol * grad.transpose(), w[mesh.T(t, a)] += vol;
   }
   for (long i = 0; i < g.rows(); ++i)
