@@ -205,8 +205,14 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
   return volume_scale_ * volume_of(project(s.tilde, eta_.dilated));
 }
 
-double ComplianceProblem::grey_share(const VecXd& x) const {
-  const VecXd rho_bar = physical(x);
+double ComplianceProblem::grey_share(const VecXd& x) const { return grey_of(physical(x)); }
+
+double ComplianceProblem::last_grey_share() const {
+  // the physical design is the intermediate one: rho_bar_ itself unless robust (then the eroded)
+  return grey_of(robust_ ? project(stages_.tilde, eta_.intermediate) : rho_bar_);
+}
+
+double ComplianceProblem::grey_of(const VecXd& rho_bar) const {
   double grey = 0;
   for (long i = 0; i < rho_bar.size(); ++i)
     if (rho_bar[i] > 0.1 && rho_bar[i] < 0.9) grey += vd_[i];
@@ -238,7 +244,7 @@ class DesignUpdate {
   VecXd step(const ComplianceProblem& problem, const VecXd& x, const VecXd& dc, const VecXd& dv, const MmaTerms& mma) {
     if (params_.update == UpdateKind::OC) {
       auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params_.volume_fraction; };
-      return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess);
+      return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess, &multiplier_);
     }
     return mma_.update(x, mma.f0, mma.df0, mma.f, mma.df);
   }
@@ -253,6 +259,7 @@ class DesignUpdate {
   const SimpParams& params_;
   Mma mma_;
   MoveLimits moves_;
+  double multiplier_ = 0;  // OC's last Lagrange multiplier: where the next bisection starts
 };
 
 /// The maximum member size's constraint (member_size.h) appended to MMA's terms at x (#N),
@@ -334,7 +341,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
                         vol,
                         (xnew - x).cwiseAbs().maxCoeff(),
                         schedule.beta(),
-                        problem.grey_share(x),
+                        problem.last_grey_share(),
                         0,
                         mma.displacements,
                         mma.stress_relaxed,

@@ -106,6 +106,9 @@ class ComplianceProblem {
   VecXd physical_to_variables(const VecXd& x, const VecXd& d) const;
   /// Share of the design volume whose physical density ρ̄(x) lies strictly between 0.1 and 0.9.
   double grey_share(const VecXd& x) const;
+  /// grey_share of the x of the last compliance() call, from the densities that call filtered
+  /// (no filter application of its own: with the Helmholtz filter that is a solve).
+  double last_grey_share() const;
   /// Sensitivities of compliance filtered by Sigmund's filter (when params ask for it).
   VecXd filter_sensitivity(const VecXd& x, const VecXd& dc) const;
   const std::vector<int>& design() const { return design_; }
@@ -161,6 +164,7 @@ class ComplianceProblem {
   Stages filtered(const VecXd& x) const;
   VecXd project(const VecXd& rho_tilde, double eta) const;
   double volume_of(const VecXd& rho_bar) const { return vd_.dot(rho_bar) / design_volume_; }
+  double grey_of(const VecXd& rho_bar) const;  // share of the design volume with 0.1 < ρ̄ < 0.9
 };
 
 /// Runs SIMP. loads: (3*#V) by #cases (fem::make_loads), weights: #cases (empty: all 1),

@@ -6,8 +6,29 @@
 
 namespace topopt::simp {
 
+namespace {
+
+/// Brackets OC's multiplier around `hint` (> 0, the last iteration's): [l1, l2] with too much
+/// material at l1 (or l1 = 0) and not too much at l2, widening by 4 each way as needed.
+template <class Excess>
+void bracket_near(double hint, const Excess& excess_at, double& l1, double& l2) {
+  l1 = 0;
+  l2 = 2 * hint;
+  while (excess_at(l2) > 0 && l2 < 1e300) l1 = l2, l2 *= 4;
+  if (l1 > 0) return;
+  for (double lo = hint / 2; lo > 1e-300; lo /= 4) {
+    if (excess_at(lo) > 0) {
+      l1 = lo;
+      return;
+    }
+    l2 = lo;
+  }
+}
+
+}  // namespace
+
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
-                const std::function<double(const VecXd&)>& volume_excess) {
+                const std::function<double(const VecXd&)>& volume_excess, double* multiplier) {
   double l1 = 0, l2 = 1e9;
   VecXd xnew(x.size());
   auto candidate = [&](double lambda) {
@@ -16,21 +37,25 @@ VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& m
       xnew[i] = std::clamp(x[i] * b, std::max(0.0, x[i] - move[i]), std::min(1.0, x[i] + move[i]));
     }
   };
-  // Bracket the multiplier first: compliance sensitivities can be far from 1 in scale.
-  while (true) {
-    candidate(l2);
-    if (volume_excess(xnew) <= 0 || l2 > 1e300) break;
-    l1 = l2, l2 *= 1e3;
+  auto excess_at = [&](double lambda) {
+    candidate(lambda);
+    return volume_excess(xnew);
+  };
+  if (multiplier && *multiplier > 0 && std::isfinite(*multiplier)) {
+    bracket_near(*multiplier, excess_at, l1, l2);
+  } else {
+    // Bracket the multiplier first: compliance sensitivities can be far from 1 in scale.
+    while (excess_at(l2) > 0 && l2 <= 1e300) l1 = l2, l2 *= 1e3;
   }
   while ((l2 - l1) / (l1 + l2) > 1e-6) {
     double mid = 0.5 * (l1 + l2);
-    candidate(mid);
-    if (volume_excess(xnew) > 0)
+    if (excess_at(mid) > 0)
       l1 = mid;
     else
       l2 = mid;
   }
   candidate(l2);
+  if (multiplier) *multiplier = l2;
   return xnew;
 }
 

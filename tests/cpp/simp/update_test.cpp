@@ -33,6 +33,36 @@ TEST(OcUpdate, ConvergesToTheAnalyticOptimumOfASeparableProblem) {
   EXPECT_LT((x - best).cwiseAbs().maxCoeff(), 1e-4);
 }
 
+TEST(OcUpdate, StartingFromTheLastMultiplierMeetsTheSameVolumeInFewerEvaluations) {
+  const int n = 200;
+  VecXd v(n), a(n);
+  for (int i = 0; i < n; ++i) {
+    v[i] = 1.0 + 0.5 * std::cos(0.37 * i);
+    a[i] = 1e4 * v[i] * (1.0 + 0.8 * std::sin(0.7 * i));  // a multiplier far from 1e9
+  }
+  const double target = 0.3 * v.sum();
+  int evaluations = 0;
+  auto excess = [&](const VecXd& x) {
+    ++evaluations;
+    return v.dot(x) - target;
+  };
+  VecXd blind = VecXd::Constant(n, 0.3), warm = blind;
+  double multiplier = 0;  // none yet: the first call brackets blind as well
+  int blind_evaluations = 0, warm_evaluations = 0;
+  for (int it = 0; it < 30; ++it) {
+    evaluations = 0;
+    blind = oc_update(blind, -a.array() / blind.array().square(), v, VecXd::Constant(n, 0.2), excess);
+    blind_evaluations += evaluations;
+    evaluations = 0;
+    warm = oc_update(warm, -a.array() / warm.array().square(), v, VecXd::Constant(n, 0.2), excess, &multiplier);
+    warm_evaluations += evaluations;
+    ASSERT_LE(std::abs(excess(warm)), 1e-6 * target) << "iteration " << it;
+    ASSERT_GT(multiplier, 0);
+  }
+  EXPECT_LT((warm - blind).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT(warm_evaluations, 0.75 * blind_evaluations) << warm_evaluations << " vs " << blind_evaluations;
+}
+
 TEST(MoveLimits, ShrinkWhereTheDesignOscillatesAndGrowBackWhereItMovesOneWay) {
   // variable 0 zig-zags, variable 1 climbs steadily, variable 2 stands still
   MoveLimits moves(3, 0.2, 0.01, 0.5, 2.0);
