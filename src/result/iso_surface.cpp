@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <queue>
 #include <unordered_map>
 
 #include "common/error.h"
@@ -133,6 +134,13 @@ double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, doub
 
 namespace {
 
+/// The least share of an edge between a level crossing and the edge's nodes, whatever the
+/// margin: a crossing much closer to a node than this is not representable apart from the
+/// node in double precision (its rounded position can leave the edge, or equal the node) and
+/// the exact self-intersection check then finds folded or degenerate triangles there. It
+/// moves the surface by at most a millionth of an edge.
+constexpr double kLeastCrossingShare = 1e-6;
+
 /// Builds the result surface piece by piece: its points (mesh nodes and level crossings on mesh
 /// edges, each made once), its triangles with their tags, and each point's lock and cut-line
 /// face (TriSurface's fields).
@@ -142,7 +150,7 @@ class IsoSurfaceBuilder {
       : mesh_(mesh), tagged_(mesh.domain.size() == mesh.T.rows()) {
     values_.resize(mesh.V.rows());
     for (long i = 0; i < mesh.V.rows(); ++i) values_[i] = level(node_density, static_cast<int>(i), threshold);
-    if (margin > 0) keep_crossings_off_nodes(margin);
+    keep_crossings_off_nodes(std::max(margin, kLeastCrossingShare));
   }
 
   /// Iso-triangles inside every design tet the level crosses, oriented out of the kept side.
@@ -196,23 +204,45 @@ class IsoSurfaceBuilder {
   bool is_design(long t) const { return !tagged_ || mesh_.domain[t] == 0; }
   double f(int node) const { return values_[node]; }
 
-  /// Raises |f| at nodes the level passes too close to: each node's value becomes at least
-  /// margin / (1 - margin) times the largest |f| across its crossed edges, so that the
-  /// crossings on those edges lie at least about `margin` of the edge away from it. Signs
-  /// stay, so the surface's topology does not change; only its points move along their edges.
+  /// Raises |f| at nodes the level passes too close to, until every crossed edge ab has
+  /// |f(a)| >= k |f(b)| and |f(b)| >= k |f(a)| with k = margin / (1 - margin) for the values
+  /// as finally adjusted (the same values every triangle then uses): its crossing lies at
+  /// least `margin` of the edge from both nodes. A raised node raises its crossed neighbours
+  /// in turn (two nodes barely off the level next to each other both follow the larger value
+  /// around them), so the values are settled largest first: a node's final value is k times
+  /// its largest final crossed neighbour or its own, whichever is larger. Signs stay, so the
+  /// surface's topology does not change; only its points move along their edges.
   void keep_crossings_off_nodes(double margin) {
     const double k = margin / (1 - margin);
-    std::vector<double> need(values_.size(), 0);
+    const std::vector<std::vector<int>> crossed = crossed_neighbours();
+    std::vector<char> settled(values_.size(), 0);
+    std::priority_queue<std::pair<double, int>> largest;  // (|f| proposed, node)
+    for (size_t i = 0; i < values_.size(); ++i) largest.emplace(std::abs(values_[i]), static_cast<int>(i));
+    while (!largest.empty()) {
+      const auto [size, a] = largest.top();
+      largest.pop();
+      if (settled[a]) continue;
+      settled[a] = 1;
+      values_[a] = values_[a] > 0 ? size : -size;
+      for (int b : crossed[a])
+        if (!settled[b] && std::abs(values_[b]) < k * size) {
+          values_[b] = values_[b] > 0 ? k * size : -k * size;
+          largest.emplace(k * size, b);
+        }
+    }
+  }
+
+  /// For each node, the nodes across its design-tet edges with the other sign of the level.
+  std::vector<std::vector<int>> crossed_neighbours() const {
+    std::vector<std::vector<int>> out(values_.size());
     for (long t = 0; t < mesh_.T.rows(); ++t)
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j) {
           const int a = mesh_.T(t, i), b = mesh_.T(t, j);
           if ((values_[a] > 0) == (values_[b] > 0)) continue;
-          need[a] = std::max(need[a], k * std::abs(values_[b]));
-          need[b] = std::max(need[b], k * std::abs(values_[a]));
+          out[a].push_back(b), out[b].push_back(a);
         }
-    for (size_t i = 0; i < values_.size(); ++i)
-      if (std::abs(values_[i]) < need[i]) values_[i] = values_[i] > 0 ? need[i] : -need[i];
+    return out;
   }
 
   int node_point(int n) {

@@ -43,11 +43,14 @@ struct TriSurface {
 /// boundary of the kept region (common/closed_surface.h checks it): iso-triangles in design
 /// tets, Ω's boundary triangles (or their kept parts) with their face tags, non-design tets'
 /// boundary triangles on Ω, and the void side of faces between design and non-design tets.
-/// With margin in (0, 0.5) (0: the exact level set), the level's values at nodes it passes
-/// closer than about margin × the edge are raised in magnitude (signs kept, so the same
-/// topology) so that no crossing lies that close to a node: no needles or caps from
-/// crossings next to nodes, at the price of moving the surface by up to about margin × the
-/// edge length there.
+/// With margin in [0, 0.5), the level's values at nodes it passes closer than margin × the
+/// edge are raised in magnitude (signs kept, so the same topology; one adjusted value per
+/// node, used by every triangle) so that every crossing lies at least margin × its edge from
+/// both nodes: no needles or caps from crossings next to nodes, at the price of moving the
+/// surface by up to margin × the edge length there. A margin below 1e-6 (0: the exact level
+/// set) acts as 1e-6: closer crossings cannot be placed apart from their node in double
+/// precision (nodes within rounding of the threshold, e.g. a region of equal densities at
+/// it, would give folded or degenerate triangles).
 TriSurface extract_iso_surface(const TetMesh& mesh, const VecXd& node_density, double threshold, double margin = 0);
 
 }  // namespace topopt::result
