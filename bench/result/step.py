@@ -74,7 +74,7 @@ def main():
     ap.add_argument("--no-reread", action="store_true")
     a = ap.parse_args()
     print("load average at the start: %.1f %.1f %.1f" % os.getloadavg())
-    print("| example | STEP | size (MB) | faces (from triangles) | planar / curved / facets | curved left as facets | "
+    print("| example | STEP | size (MB) | faces (from triangles) | planar (merged and facets) / on curved input faces | curved pieces left as facets | "
           "valid, solids (re-read) | volume STEP / STL | export CPU s | export wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for name in a.only.split(","):
@@ -92,9 +92,8 @@ def main():
                 print("| %s | %s | failed: %s |||||||| " % (name, setting, r["error"]))
                 continue
             back = {} if a.no_reread else (read_back(path) or {})
-            print("| %s | %s | %.2f | %d (%d) | %d / %d / %d | %d | %s, %s | %s | %.1f | %.1f |"
-                  % (name, setting, r["mb"], r["faces"], r["triangles"], r["planar"], r["analytic"],
-                     r["faces"] - r["planar"] - r["analytic"], r["refused"], back.get("valid", "True (export's check)"),
+            print("| %s | %s | %.2f | %d (%d) | %d / %d | %d | %s, %s | %s | %.1f | %.1f |"
+                  % (name, setting, r["mb"], r["faces"], r["triangles"], r["planar"], r["analytic"], r["refused"], back.get("valid", "True (export's check)"),
                      back.get("solids", "-"),
                      "%.5f" % (back.get("volume", r["volume"]) / r["stl_volume"]), r["step_cpu_s"],
                      r["step_s"]))
