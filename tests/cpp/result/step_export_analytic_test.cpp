@@ -2,7 +2,8 @@
 // (a plate with a through-bore, and a non-design tube — its own bore and boss — joined to it by
 // a bar), triangulated as a result surface would be and tagged as iso_surface.h tags: the bores
 // and the tube's boss come back as cylinders of the input's radius and axis, one valid solid of
-// the surface's volume, and so does the STEP file OCCT reads back.
+// the surface's volume, and so does the STEP file OCCT reads back; a countersunk bore (a cone)
+// and a rounded boss (a torus) come back as a cone and a torus.
 #include "result/step_export_analytic.h"
 
 #include <gtest/gtest.h>
@@ -14,10 +15,14 @@
 #include <BRepGProp.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakeTorus.hxx>
 #include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
+#include <Geom_ConicalSurface.hxx>
 #include <Geom_CylindricalSurface.hxx>
+#include <Geom_ToroidalSurface.hxx>
 #include <Poly_Triangulation.hxx>
 #include <STEPControl_Reader.hxx>
 #include <ShapeUpgrade_UnifySameDomain.hxx>
@@ -143,6 +148,35 @@ double volume(const TopoDS_Shape& shape) {
 
 const StepExportParams kNoCoarsening{.coarsen = {.tolerance = 0}};
 
+/// Faces of `shape` whose surface is of kind T.
+template <class T>
+int faces_on(const TopoDS_Shape& shape) {
+  int n = 0;
+  for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next())
+    n += !Handle(T)::DownCast(BRep_Tool::Surface(TopoDS::Face(e.Current()))).IsNull();
+  return n;
+}
+
+/// A 30x30x10 plate with a boss of radius 6 on top, up to z = 16, whose top edge is rounded
+/// (radius 2: a torus) and a countersunk bore through both (a cone from radius 4 down to 2,
+/// then a cylinder of radius 2): the whole part is the result, its faces Ω's.
+Fixture countersunk_boss() {
+  Fixture f;
+  // the rounded boss: a cylinder of radius 6 to z = 14, one of radius 4 to z = 16 and the torus
+  // (radii 4 and 2, centred at z = 14) between them
+  const TopoDS_Shape torus = BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(15, 15, 14), gp::DZ()), 4, 2).Shape();
+  const TopoDS_Shape boss =
+      BRepAlgoAPI_Fuse(BRepAlgoAPI_Fuse(cylinder(15, 15, 6, 14), cylinder(15, 15, 4, 16)).Shape(), torus).Shape();
+  const TopoDS_Shape body =
+      BRepAlgoAPI_Fuse(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), gp_Pnt(30, 30, 10)).Shape(), boss).Shape();
+  const TopoDS_Shape sink = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(15, 15, 14), gp::DZ()), 2, 4, 2).Shape();
+  ShapeUpgrade_UnifySameDomain unify(
+      BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(body, sink).Shape(), cylinder(15, 15, 2, 16)).Shape());
+  unify.Build();
+  f.part = f.result = unify.Shape();
+  return f;
+}
+
 TEST(StepExportAnalytic, TrianglesOnCurvedInputFacesAreFoundByTagAndPlace) {
   const Fixture f = fixture();
   const TriSurface s = tagged_surface(f);
@@ -223,6 +257,34 @@ TEST(StepExportAnalytic, StepReadBackHasTheCylindersValidWithTheVolume) {
   const double stl = check_surface(s.V, s.F).volume;
   EXPECT_NEAR(r.volume, stl, 0.005 * stl);
   std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace topopt::result
+
+namespace topopt::result {
+namespace {
+
+TEST(StepExportAnalytic, ConesAndToriToo) {
+  const Fixture f = countersunk_boss();
+  ASSERT_EQ(faces_on<Geom_ToroidalSurface>(f.part), 1);
+  ASSERT_EQ(faces_on<Geom_ConicalSurface>(f.part), 1);
+  const TriSurface s = tagged_surface(f);
+  const SourceFaces source(f.part, {});
+  int refused = -1;
+  const TopoDS_Shape solid = result_solid(s, kNoCoarsening, nullptr, &source, &refused);
+  const StepExportReport r = describe_solid(solid);
+  EXPECT_TRUE(r.valid) << solid_faults(solid);
+  EXPECT_EQ(r.solids, 1);
+  EXPECT_EQ(refused, 0);
+  EXPECT_EQ(faces_on<Geom_ToroidalSurface>(solid), 1);
+  EXPECT_EQ(faces_on<Geom_ConicalSurface>(solid), 1);
+  EXPECT_EQ(cylinders(solid, 15, 15, 2), 1);
+  EXPECT_EQ(cylinders(solid, 15, 15, 6), 1);
+  EXPECT_EQ(r.faces, r.planar_faces + r.analytic_faces);
+  const double stl = check_surface(s.V, s.F).volume, exact = volume(f.result);
+  EXPECT_NEAR(r.volume, stl, 0.005 * stl);
+  EXPECT_NEAR(r.volume, exact, 0.005 * exact);
 }
 
 }  // namespace
