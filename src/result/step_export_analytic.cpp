@@ -356,20 +356,21 @@ std::vector<TopoDS_Face> analytic_faces(const TriSurface& s, const std::vector<l
   std::vector<gp_Pnt2d> uv(s.V.rows());
   for (long q : region)
     for (int k = 0; k < 3; ++k) uv[s.F(q, k)] = parameters(g, point(s, s.F(q, k)));
-  // one face per piece; a piece going round the axis is cut in two halves first
+  // one face per piece; a piece going round the axis is cut in two halves first, and so is a
+  // piece whose face OCCT refuses (on the rocker: a piece whose points' angles cover the whole
+  // turn at different heights without going round, so no single seam position clears it)
   const auto face_of = [&](const std::vector<long>& piece, bool may_split, auto& self) -> void {
-    const auto loops = boundary_loops(s, piece);
-    if (!loops) return give_up(piece);
-    if (wraps(*loops, uv)) {
-      if (!may_split) return give_up(piece);
+    const auto split = [&]() {
       const auto [lower, upper] = halves(s, piece, g);
       for (const auto& half : {lower, upper})
         for (const auto& part : connected_pieces(s, half)) self(part, false, self);
-      return;
-    }
+    };
+    const auto loops = boundary_loops(s, piece);
+    if (!loops) return may_split ? split() : give_up(piece);
+    if (wraps(*loops, uv)) return may_split ? split() : give_up(piece);
     const TopoDS_Face face = PieceFace(s, g, edges).make(piece, *loops);
-    if (face.IsNull()) return give_up(piece);
-    out.push_back(face);
+    if (!face.IsNull()) return out.push_back(face);
+    may_split ? split() : give_up(piece);
   };
   if (g.IsNull()) {
     give_up(region);

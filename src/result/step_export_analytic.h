@@ -61,7 +61,8 @@ using EdgeSource = std::function<TopoDS_Edge(int a, int b)>;
 
 /// Faces on the input's surface `surface` for the triangles `region` of `s` (outward triangles,
 /// all lying on that surface, one connected piece or several): one face per connected piece,
-/// two per piece that wraps round the axis (see the file comment). Each face is bounded by the
+/// two per piece that wraps round the axis (see the file comment) or whose one face OCCT's
+/// check refuses (the halves are tried once each). Each face is bounded by the
 /// piece's boundary loops made of `edges`, oriented outwards, checked by BRepCheck. Returns the
 /// faces made; the triangles of pieces whose face could not be made or failed the check are
 /// appended to `facets` (to be written as triangles), the 2D curves added for them removed, and
