@@ -13,6 +13,7 @@
 #include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
 #include "pipeline/output_files.h"
+#include "pipeline/result_files.h"
 #include "result/step_export.h"
 
 namespace topopt::cli {
@@ -22,7 +23,7 @@ namespace fs = std::filesystem;
 
 const char* kResultUsage =
     "usage: topopt result JOB.json --threshold T [--out-dir DIR] [--step PATH] [--stl PATH]\n"
-    "                              [--coarsen F] [--pcurves] [--quiet]\n"
+    "                              [--coarsen F] [--pcurves] [--facets] [--quiet]\n"
     "  The result shape of a finished 'topopt optimize JOB.json' at the density threshold T in\n"
     "  (0, 1), without optimising again: meshes the job as optimize did (the same mesh), reads\n"
     "  SIMP's densities from DIR/density.vtu, then cleans, smooths and checks the shape at T as\n"
@@ -34,6 +35,8 @@ const char* kResultUsage =
     "  --coarsen    chordal tolerance of the free-form region's coarsening, as a share of its\n"
     "               median edge (default 0.05; 0: every triangle becomes a face)\n"
     "  --pcurves    also write the edges' 2D curves on their planes (about twice the size)\n"
+    "  --facets     leave the part's and the non-design solids' curved faces (bores, bosses) as\n"
+    "               facets (default: faces on the input's cylinders, cones, spheres and tori)\n"
     "  --quiet      no progress lines";
 
 /// SIMP's element densities of the run in `dir`, checked against the job's mesh.
@@ -69,7 +72,7 @@ int cmd_result(const Args& args) {
   result::StepExportParams params;
   params.coarsen.tolerance = a.number("coarsen", params.coarsen.tolerance);
   params.pcurves = a.flag("pcurves");
-  const bool quiet = a.flag("quiet");
+  const bool quiet = a.flag("quiet"), facets = a.flag("facets");
   const std::vector<std::string> pos = a.positionals();
   if (pos.size() != 1) throw Error(ErrorCode::InvalidParameter, "give one job file\n" + a.usage());
   if (!(threshold > 0 && threshold < 1))
@@ -95,12 +98,14 @@ int cmd_result(const Args& args) {
       pipeline::anchor_nodes(mesh, job), job.optimization.hygiene, nullptr, nullptr, progress);
   if (!stl.empty()) io::write_stl(stl, s.V, s.F);
   progress.say("step", -1, "writing the result as a STEP solid");
-  const result::StepExportReport r = result::write_result_step(step, s, params, progress);
+  const result::SourceFaces source = facets ? result::SourceFaces() : pipeline::source_faces(job, {}, progress);
+  const result::StepExportReport r = result::write_result_step(step, s, params, progress, &source);
   std::cout << "surface: threshold " << threshold << ", " << s.F.rows() << " triangles, volume "
             << std::setprecision(10) << result::check_surface(s.V, s.F).volume << std::setprecision(6) << " mm^3\n"
-            << "step: " << r.faces << " faces (" << r.planar_faces << " planar) from " << r.triangles << " triangles, "
-            << r.bytes / 1e6 << " MB, volume " << r.volume << " mm^3 (" << r.seconds << " s, " << r.cpu_seconds
-            << " s CPU)\n"
+            << "step: " << r.faces << " faces (" << r.planar_faces << " planar, " << r.analytic_faces
+            << " on the input's curved faces, " << r.analytic_refused << " of those left as facets) from "
+            << r.triangles << " triangles, " << r.bytes / 1e6 << " MB, volume " << r.volume << " mm^3 (" << r.seconds
+            << " s, " << r.cpu_seconds << " s CPU)\n"
             << "wrote " << step << "\n";
   if (!stl.empty()) std::cout << "wrote " << stl << "\n";
   return 0;

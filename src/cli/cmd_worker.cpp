@@ -284,7 +284,9 @@ void put_result_files_first(json& result, const fs::path& dir, const pipeline::J
 
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
-  const pipeline::Job job = job_of(r);
+  pipeline::Job job = job_of(r);
+  // the request's shape files name the job's part: result.step reads its curved faces there
+  if (job.part.empty()) job.part = r.part, job.nondesign = r.nondesign;
   auto [part, nd] = read_shapes(r, ch);
   std::vector<std::string> warnings;
   const pipeline::RunResult run = pipeline::run_job(job, {part, nd}, ch.make_progress(warnings),

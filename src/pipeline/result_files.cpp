@@ -5,9 +5,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "brep/shape_io.h"
 #include "common/error.h"
 #include "io/vtu.h"
 #include "pipeline/output_files.h"
+#include "result/step_export_analytic.h"
 
 namespace topopt::pipeline {
 namespace fs = std::filesystem;
@@ -26,11 +28,18 @@ json figures_json(const result::AnalysisFigures& a) {
 }
 
 json step_json(const result::StepExportReport& s) {
-  return {{"valid", s.valid},         {"solids", s.solids},
-          {"faces", s.faces},         {"planar_faces", s.planar_faces},
-          {"volume", s.volume},       {"bytes", s.bytes},
-          {"seconds", s.seconds},     {"cpu_seconds", s.cpu_seconds},
-          {"triangles", s.triangles}, {"unmerged_bodies", s.unmerged_bodies}};
+  return {{"valid", s.valid},
+          {"solids", s.solids},
+          {"faces", s.faces},
+          {"planar_faces", s.planar_faces},
+          {"volume", s.volume},
+          {"bytes", s.bytes},
+          {"seconds", s.seconds},
+          {"cpu_seconds", s.cpu_seconds},
+          {"triangles", s.triangles},
+          {"unmerged_bodies", s.unmerged_bodies},
+          {"analytic_faces", s.analytic_faces},
+          {"analytic_refused", s.analytic_refused}};
 }
 
 json verification_json(const result::Verification& v) {
@@ -81,12 +90,27 @@ bool attempt(const std::string& what, const std::string& key, Step&& step, Resul
 
 }  // namespace
 
+result::SourceFaces source_faces(const Job& job, const JobShapes& shapes, const Progress& progress) {
+  if (!shapes.part.IsNull()) return {shapes.part, shapes.nondesign};
+  if (job.part.empty()) return {};
+  try {
+    const TopoDS_Shape part = brep::read_shape_file(job.part, "part");
+    const TopoDS_Shape nondesign =
+        job.nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(job.nondesign, "non-design input");
+    return {part, nondesign};
+  } catch (const Error& e) {
+    progress.warn(std::string("result.step: the part's curved faces stay facets, its files could not be read again: ") +
+                  e.what());
+    return {};
+  }
+}
+
 result::VerificationProblem verification_problem(const Job& job) {
   return {job.material, job.supports, job.load_cases};
 }
 
 ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
-                               const ResultFilesParams& params, const Progress& progress) {
+                               const ResultFilesParams& params, const Progress& progress, const JobShapes& shapes) {
   ResultFiles out;
   if (!job.output.step && !job.output.verification) return out;
   const fs::path d(dir);
@@ -97,8 +121,9 @@ ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const Optimi
         "result.step (the result as a CAD solid)", "step",
         [&]() {
           const std::string path = (d / "result.step").string();
+          const result::SourceFaces source = source_faces(job, shapes, progress);
           out.written.push_back(write_replacing(path, [&](const std::string& p) {
-            out.step = result::write_result_step(p, r.surface, params.step, progress);
+            out.step = result::write_result_step(p, r.surface, params.step, progress, &source);
           }));
           out.step->bytes = static_cast<long>(fs::file_size(path));
           report["step"] = step_json(*out.step);

@@ -11,8 +11,10 @@
 
 #include "common/progress.h"
 #include "pipeline/job.h"
+#include "pipeline/job_mesh.h"
 #include "pipeline/optimize_job.h"
 #include "result/step_export.h"
+#include "result/step_export_analytic.h"
 #include "result/verification.h"
 
 namespace topopt::pipeline {
@@ -29,6 +31,12 @@ struct ResultFiles {
   std::optional<result::Verification> verification;  ///< when the verification ran
 };
 
+/// The input's curved analytic faces for result.step (result/step_export_analytic.h): those of
+/// `shapes` when given (the run's own shapes), else of the job's part and non-design files read
+/// again; none (a warning through progress) when the job names no part or its files cannot be
+/// read, so that the STEP is still written, with those faces as facets.
+result::SourceFaces source_faces(const Job& job, const JobShapes& shapes = {}, const Progress& progress = {});
+
 /// The job's problem (material, supports, load cases) as the verification solves it.
 result::VerificationProblem verification_problem(const Job& job);
 
@@ -36,8 +44,10 @@ result::VerificationProblem verification_problem(const Job& job);
 /// DIR/verification.json for the optimisation `r` on the FE `mesh`; `dir` exists
 /// (prepare_output_folder). verification.json is written whenever either step was asked for,
 /// with what succeeded and the error of what failed. Warnings also go to progress.warn.
-/// Throws only Error(Cancelled) when progress says so.
+/// The input's curved faces come back as analytic faces (source_faces: `shapes`, or the job's
+/// files). Throws only Error(Cancelled) when progress says so.
 ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
-                               const ResultFilesParams& params = {}, const Progress& progress = {});
+                               const ResultFilesParams& params = {}, const Progress& progress = {},
+                               const JobShapes& shapes = {});
 
 }  // namespace topopt::pipeline

@@ -28,7 +28,8 @@ RunResult run_job(const Job& job, const JobShapes& shapes, const Progress& progr
   r.optimization.ranks = options.ranks;
   if (!options.write_outputs) return r;
   r.written = write_optimize_outputs(r.mesh, r.optimization, job.output.directory);
-  r.files = write_result_files(job, r.mesh, r.optimization, job.output.directory, options.result_files, watched);
+  r.files =
+      write_result_files(job, r.mesh, r.optimization, job.output.directory, options.result_files, watched, shapes);
   r.written.insert(r.written.end(), r.files.written.begin(), r.files.written.end());
   return r;
 }

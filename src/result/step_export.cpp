@@ -15,6 +15,7 @@
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <GProp_GProps.hxx>
+#include <Geom_ElementarySurface.hxx>
 #include <Geom_Line.hxx>
 #include <Geom_Plane.hxx>
 #include <IFSelect_ReturnStatus.hxx>
@@ -47,6 +48,7 @@
 #include "common/cpu_time.h"
 #include "common/error.h"
 #include "common/isolate.h"
+#include "result/step_export_analytic.h"
 
 namespace topopt::result {
 namespace {
@@ -119,14 +121,15 @@ std::string report_text(const StepExportReport& r) {
   std::ostringstream o;
   o.precision(17);
   o << r.valid << " " << r.solids << " " << r.faces << " " << r.planar_faces << " " << r.volume << " " << r.triangles
-    << " " << r.unmerged_bodies;
+    << " " << r.unmerged_bodies << " " << r.analytic_faces << " " << r.analytic_refused;
   return o.str();
 }
 
 StepExportReport report_of(const std::string& text) {
   StepExportReport r;
   std::istringstream in(text);
-  in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume >> r.triangles >> r.unmerged_bodies;
+  in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume >> r.triangles >> r.unmerged_bodies >>
+      r.analytic_faces >> r.analytic_refused;
   if (!in) throw Error(ErrorCode::Internal, "the STEP export's child answered '" + text + "'");
   return r;
 }
@@ -170,17 +173,37 @@ SurfacePieces surface_pieces(const TriSurface& s) {
   return out;
 }
 
+/// The faces of one piece of the surface (`tris`) into `shell`: the triangles on a curved
+/// analytic input face (`on_source`: per triangle its SourceFaces id, or -1; empty: none) as
+/// faces on that surface (analytic_faces; `refused` counts the pieces left as facets), every
+/// other triangle a planar face.
+void add_piece_faces(TopoDS_Shell& shell, const TriSurface& s, SharedTopology& topo, const std::vector<long>& tris,
+                     const SourceFaces* source, const std::vector<int>& on_source, int& refused) {
+  BRep_Builder builder;
+  std::map<int, std::vector<long>> regions;
+  std::vector<long> facets;
+  for (long q : tris) (on_source.empty() || on_source[q] < 0 ? facets : regions[on_source[q]]).push_back(q);
+  const EdgeSource edges = [&topo](int a, int b) { return topo.edge(a, b); };
+  for (const auto& [id, region] : regions)
+    for (const TopoDS_Face& f : analytic_faces(s, region, source->surface(id), edges, facets, refused))
+      builder.Add(shell, f);
+  for (long q : facets) builder.Add(shell, triangle_face(s, topo, q));
+}
+
 /// One solid per body of the surface, each void's shell added to the body that holds it (by
-/// OCCT's classifier, at one of the void's points).
-std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pieces) {
+/// OCCT's classifier, at one of the void's points); curved input faces as analytic faces where
+/// `source` is given (add_piece_faces).
+std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pieces, const SourceFaces* source,
+                                    int& refused) {
   SharedTopology topo(s);
   BRep_Builder builder;
+  const std::vector<int> on_source = source && !source->empty() ? source->classify(s) : std::vector<int>{};
   std::vector<TopoDS_Solid> bodies;
   std::vector<std::pair<TopoDS_Shell, long>> voids;  // (shell, one of its triangles)
   for (size_t k = 0; k < pieces.triangles.size(); ++k) {
     TopoDS_Shell shell;
     builder.MakeShell(shell);
-    for (long q : pieces.triangles[k]) builder.Add(shell, triangle_face(s, topo, q));
+    add_piece_faces(shell, s, topo, pieces.triangles[k], source, on_source, refused);
     shell.Closed(true);
     if (pieces.volume[k] < 0) {
       voids.emplace_back(shell, pieces.triangles[k][0]);
@@ -265,7 +288,8 @@ int result_bodies(const TriSurface& s) {
   return static_cast<int>(std::count_if(pieces.volume.begin(), pieces.volume.end(), [](double v) { return v > 0; }));
 }
 
-TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& params, CoarsenReport* coarsened) {
+TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& params, CoarsenReport* coarsened,
+                          const SourceFaces* source, int* analytic_refused) {
   const SurfaceCheck check = check_surface(given.V, given.F);
   if (!check.closed_manifold() || check.volume <= 0)
     throw Error(
@@ -275,8 +299,9 @@ TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& param
   const TriSurface s = coarsen_free_form(given, params.coarsen, coarsened);
   // the bodies of the result (a detached non-design solid is one more) with their voids
   // inside, not a single shell of several pieces (BRepCheck: not connected)
-  const std::vector<TopoDS_Solid> bodies = solids_of(s, surface_pieces(s));
-  int refused = 0;
+  int refused = 0, analytic = 0;
+  const std::vector<TopoDS_Solid> bodies = solids_of(s, surface_pieces(s), source, analytic);
+  if (analytic_refused) *analytic_refused = analytic;
   BRep_Builder builder;
   TopoDS_Compound all;
   builder.MakeCompound(all);
@@ -331,7 +356,10 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
   for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) {
     ++r.faces;
     Handle(Geom_Surface) surface = BRep_Tool::Surface(TopoDS::Face(e.Current()));
-    if (!surface.IsNull() && surface->IsKind(STANDARD_TYPE(Geom_Plane))) ++r.planar_faces;
+    if (surface.IsNull()) continue;
+    if (surface->IsKind(STANDARD_TYPE(Geom_Plane))) ++r.planar_faces;
+    if (surface->IsKind(STANDARD_TYPE(Geom_ElementarySurface)) && !surface->IsKind(STANDARD_TYPE(Geom_Plane)))
+      ++r.analytic_faces;
   }
   r.valid = BRepCheck_Analyzer(shape).IsValid();
   GProp_GProps props;
@@ -341,7 +369,7 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 }
 
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
-                                   const Progress& progress) {
+                                   const Progress& progress, const SourceFaces* source) {
   const std::vector<std::string> parts = body_descriptions(s);
   if (parts.size() > 1) {
     std::string named;
@@ -367,10 +395,12 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
         }
         return brep::guard_occt("building the result solid", [&]() {
           CoarsenReport coarsened;
-          const TopoDS_Shape solid = result_solid(s, params, &coarsened);
+          int analytic_refused = 0;
+          const TopoDS_Shape solid = result_solid(s, params, &coarsened, source, &analytic_refused);
           StepExportReport r = describe_solid(solid);
           r.triangles = coarsened.triangles_after;
           r.unmerged_bodies = coarsened.unmerged_bodies;
+          r.analytic_refused = analytic_refused;
           const int bodies = result_bodies(s);
           if (!r.valid || r.solids != bodies)
             throw Error(ErrorCode::InvalidShape,

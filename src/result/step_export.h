@@ -16,6 +16,10 @@
 class TopoDS_Shape;
 
 namespace topopt::result {
+class SourceFaces;  // step_export_analytic.h
+}
+
+namespace topopt::result {
 
 struct StepExportParams {
   /// Wall-time budget of the child process that builds and writes the solid (<= 0: none): a
@@ -37,10 +41,14 @@ struct StepExportParams {
 
 /// What the solid written holds, as OCCT's checks found it after building.
 struct StepExportReport {
-  bool valid = false;       ///< BRepCheck_Analyzer found no fault
-  int solids = 0;           ///< solids in the shape (1 when all went well)
-  int faces = 0;            ///< B-Rep faces after merging
-  int planar_faces = 0;     ///< faces on a Geom_Plane
+  bool valid = false;      ///< BRepCheck_Analyzer found no fault
+  int solids = 0;          ///< solids in the shape (1 when all went well)
+  int faces = 0;           ///< B-Rep faces after merging
+  int planar_faces = 0;    ///< faces on a Geom_Plane
+  int analytic_faces = 0;  ///< faces on a cylinder, cone, sphere or torus (the input's curved faces)
+  /// Pieces of the input's curved faces written as facets: their face on the input's surface
+  /// could not be made or failed OCCT's check (step_export_analytic.h).
+  int analytic_refused = 0;
   long triangles = 0;       ///< triangles that became faces (after coarsening), before merging
   int unmerged_bodies = 0;  ///< bodies written as facets: OCCT's check refused their merged faces
   double volume = 0;        ///< mm³, by OCCT's GProp
@@ -56,8 +64,12 @@ struct StepExportReport {
 /// there are several, e.g. a detached non-design solid), closed voids as inner shells of the
 /// body holding them. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
 /// first triangle without area or an open surface (what to change: the smoothing settings).
-/// Runs OCCT in this process: callers with foreign or untrusted surfaces use write_result_step.
-TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {}, CoarsenReport* coarsened = nullptr);
+/// With `source` (the input's curved analytic faces), the triangles lying on one of them become
+/// faces on that original surface (step_export_analytic.h); `analytic_refused` (optional) counts
+/// the pieces that stayed facets. Runs OCCT in this process: callers with foreign or untrusted
+/// surfaces use write_result_step.
+TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {}, CoarsenReport* coarsened = nullptr,
+                          const SourceFaces* source = nullptr, int* analytic_refused = nullptr);
 
 /// The bodies of the result surface `s`: its pieces (triangles sharing points) that enclose a
 /// positive volume (a piece of negative volume is a closed void inside a body).
@@ -87,8 +99,9 @@ std::string solid_faults(const TopoDS_Shape& shape, int limit = 5);
 /// shape is not valid or not one solid per body (result_bodies), Error(Io) when the file cannot be written.
 /// A result of several bodies is written as one compound of solids (a STEP reader shows several
 /// solids), with a warning through progress naming each body (body_descriptions): the design
-/// does not join them, so as made they are separate parts.
+/// does not join them, so as made they are separate parts. With `source`, the input's curved
+/// analytic faces come back as such (result_solid).
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params = {},
-                                   const Progress& progress = {});
+                                   const Progress& progress = {}, const SourceFaces* source = nullptr);
 
 }  // namespace topopt::result
