@@ -20,7 +20,7 @@ import tempfile
 import FreeCAD
 import numpy as np
 
-from . import quiet, vtu
+from . import quiet, units, vtu
 from .results import nodal_maximum
 from .errors import TopOptError
 
@@ -60,8 +60,8 @@ def store_files(study, files):
     report = files.get(REPORT)
     study.VerificationReport = report.decode("utf-8") if report else ""
     figures = verification_report(study)
-    study.ComplianceAsBuilt = float(figures.get("compliance_as_built", 0.0) or 0.0)
-    study.ComplianceCrisp = float(figures.get("crisp", {}).get("compliance", 0.0) or 0.0)
+    units.set_prop(study, "ComplianceAsBuilt", float(figures.get("compliance_as_built", 0.0) or 0.0), "N*mm")
+    units.set_prop(study, "ComplianceCrisp", float(figures.get("crisp", {}).get("compliance", 0.0) or 0.0), "N*mm")
 
 
 def verification_report(study):
