@@ -296,7 +296,7 @@ def summary_lines(study):
             "valid" if step.get("valid") else "NOT valid", step.get("volume", 0.0)))
     if "compliance_as_built" in report:
         crisp = report.get("crisp", {})
-        lines.append("  verification: as-built compliance %.6g N·mm vs crisp %.6g N·mm (ratio %.3f); "
+        lines.append("  verification: as-built compliance %.6g N·mm vs crisp %.6g N·mm (ratio %.3g); "
                      "max von Mises %.4g MPa, max displacement %.4g mm on %d tets" % (
                          report["compliance_as_built"], crisp.get("compliance", 0.0), report.get("ratio", 0.0),
                          report.get("max_von_mises", 0.0), report.get("max_displacement", 0.0),

@@ -561,7 +561,7 @@ def _verification_text(study, seconds=None):
     report = asbuilt.verification_report(study)
     took = " in %.0f s" % seconds if seconds is not None else ""
     if "compliance_as_built" in report:
-        return "verified%s: as-built compliance %.4g N·mm (%.3f × the crisp design's), max von Mises %.4g MPa" % (
+        return "verified%s: as-built compliance %.4g N·mm (%.3g × the crisp design's), max von Mises %.4g MPa" % (
             took, report["compliance_as_built"], report.get("ratio", 0.0), report.get("max_von_mises", 0.0))
     failed = report.get("failed", {}).get("verification")
     if failed:
