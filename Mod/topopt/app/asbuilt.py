@@ -165,6 +165,7 @@ def make_solid_feature(study, shape):
     if vo is not None:
         from .results import RESULT_COLOUR
         vo.ShapeColor = RESULT_COLOUR
+        vo.DisplayMode = "Shaded"  # a solid of thousands of planar faces: their edges drawn looked like a mesh
     return feature
 
 
