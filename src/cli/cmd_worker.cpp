@@ -233,53 +233,30 @@ void put_last_iterate(json& result, const fs::path& dir, const pipeline::Job& jo
   put_array(result, dir, "von_mises", s.von_mises[0]);
 }
 
-/// As the job's "output" asks (step, verification): result.step, verification.json and
-/// verification.vtu written into DIR (pipeline::write_result_files; each may fail alone with a
-/// warning). Their names go to result["files"], for the workbench to keep them.
-void put_result_files(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
-                      const Progress& progress) {
-  const pipeline::ResultFiles files =
-      pipeline::write_result_files(job, run.mesh, run.optimization, dir.string(), {}, progress);
+/// result["files"]: the names of the result files written so far into the output folder
+/// (pipeline::write_result_files: result.step, verification.json and verification.vtu as the
+/// job's "output" asks; each may fail alone with a warning), for the workbench to keep them.
+void list_result_files(json& result, const pipeline::ResultFiles& files) {
   result["files"] = json::array();
   for (const std::string& path : files.written) result["files"].push_back(fs::path(path).filename().string());
 }
 
 void write_result(const fs::path& dir, const json& result);
 
-/// verification.json in `dir` as a json object ({} when there is none).
-json read_report(const fs::path& dir) {
-  std::ifstream f(dir / "verification.json");
-  return f ? json::parse(f, nullptr, false) : json::object();
-}
-
-/// Result first, verification after (params "result_first": 1, with output.verification): the
-/// result files but the verification (result.step as asked), then result.json and the progress
-/// line {"stage": "result"} (the workbench shows the result there), then the verification; the
-/// verification.json of both parts is merged (the step's report and failures kept) and
-/// result.json written again at the end with every file.
+/// Result first, verification after (params "result_first": 1, with output.verification):
+/// result.step as asked and its verification.json, then result.json and the progress line
+/// {"stage": "result"} (the workbench shows the result there), then the verification added to
+/// the same report (pipeline::add_verification); result.json is written again at the end with
+/// every file.
 void put_result_files_first(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
                             std::vector<std::string>& warnings, WorkerChannel& ch, const Progress& progress) {
-  pipeline::Job shape = job, verification = job;
-  shape.output.verification = false;
-  verification.output.step = false;
-  put_result_files(result, dir, shape, run, progress);
-  json files = result["files"];
+  pipeline::ResultFiles files = pipeline::write_result_step_first(job, run.optimization, dir.string(), {}, progress);
+  list_result_files(result, files);
   result["warnings"] = warnings;
   write_result(dir, result);
   ch.progress("result", -1, "the result is ready: verifying it");
-  const json first = read_report(dir);
-  put_result_files(result, dir, verification, run, progress);
-  json report = read_report(dir);
-  if (first.is_object() && report.is_object()) {
-    if (first.contains("step")) report["step"] = first["step"];
-    const json failed = first.value("failed", json::object());  // named: items() refers to it
-    for (const auto& [key, value] : failed.items()) report["failed"][key] = value;
-    pipeline::write_replacing((dir / "verification.json").string(),
-                              [&](const std::string& p) { std::ofstream(p) << report.dump(2) << "\n"; });
-  }
-  for (const auto& name : result["files"])
-    if (std::find(files.begin(), files.end(), name) == files.end()) files.push_back(name);
-  result["files"] = files;
+  pipeline::add_verification(files, job, run.mesh, run.optimization, dir.string(), {}, progress);
+  list_result_files(result, files);
 }
 
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
@@ -313,7 +290,7 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
   if (job.output.verification && param(r, "result_first", 0) != 0)
     put_result_files_first(result, r.output, job, run, warnings, ch, progress);
   else
-    put_result_files(result, r.output, job, run, progress);
+    list_result_files(result, pipeline::write_result_files(job, run.mesh, run.optimization, r.output, {}, progress));
   result["warnings"] = warnings;  // with those of the last iterate's analysis and the result files
   return result;
 }

@@ -1,6 +1,7 @@
 // The result back in CAD and verified (see result_files.h).
 #include "pipeline/result_files.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -109,12 +110,28 @@ result::VerificationProblem verification_problem(const Job& job) {
   return {job.material, job.supports, job.load_cases};
 }
 
-ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
-                               const ResultFilesParams& params, const Progress& progress, const JobShapes& shapes) {
+namespace {
+
+/// Writes files.report as DIR/verification.json (listed once in files.written).
+void write_report(ResultFiles& files, const fs::path& dir) {
+  const std::string path = write_replacing((dir / "verification.json").string(), [&](const std::string& p) {
+    std::ofstream f(p);
+    f << files.report.dump(2) << "\n";
+    if (!f) throw Error(ErrorCode::Io, "cannot write verification.json (disk full?)");
+  });
+  if (std::find(files.written.begin(), files.written.end(), path) == files.written.end()) files.written.push_back(path);
+}
+
+}  // namespace
+
+ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, const std::string& dir,
+                                    const ResultFilesParams& params, const Progress& progress,
+                                    const JobShapes& shapes) {
   ResultFiles out;
   if (!job.output.step && !job.output.verification) return out;
   const fs::path d(dir);
-  json report = json::object(), failures = json::object();
+  json& report = out.report;
+  report["failed"] = json::object();
   if (job.output.step) {
     progress.say("step", -1, "writing the result as a STEP solid");
     attempt(
@@ -129,28 +146,37 @@ ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const Optimi
           report["step"] = step_json(*out.step);
           report["step"]["threshold"] = r.threshold;  // the shape's: the workbench's slider may move away from it
         },
-        out, failures, progress);
+        out, report["failed"], progress);
   }
-  if (job.output.verification) {
-    progress.say("verification", -1, "meshing and solving the result solid");
-    attempt(
-        "the verification (the result solid meshed and analysed)", "verification",
-        [&]() {
-          out.verification = result::verify_result(r.surface, mesh, r.design, r.threshold, verification_problem(job),
+  write_report(out, d);
+  return out;
+}
+
+void add_verification(ResultFiles& files, const Job& job, const TetMesh& mesh, const OptimizeResult& r,
+                      const std::string& dir, const ResultFilesParams& params, const Progress& progress) {
+  if (!job.output.verification) return;
+  const fs::path d(dir);
+  json& report = files.report;
+  if (!report.contains("failed")) report["failed"] = json::object();
+  progress.say("verification", -1, "meshing and solving the result solid");
+  attempt(
+      "the verification (the result solid meshed and analysed)", "verification",
+      [&]() {
+        files.verification = result::verify_result(r.surface, mesh, r.design, r.threshold, verification_problem(job),
                                                    params.verification, progress);
-          report.update(verification_json(*out.verification));
-          out.written.push_back(write_replacing((d / "verification.vtu").string(), [&](const std::string& p) {
-            write_verification_vtu(p, job, *out.verification);
-          }));
-        },
-        out, failures, progress);
-  }
-  report["failed"] = failures;
-  out.written.push_back(write_replacing((d / "verification.json").string(), [&](const std::string& p) {
-    std::ofstream f(p);
-    f << report.dump(2) << "\n";
-    if (!f) throw Error(ErrorCode::Io, "cannot write verification.json (disk full?)");
-  }));
+        report.update(verification_json(*files.verification));
+        files.written.push_back(write_replacing((d / "verification.vtu").string(), [&](const std::string& p) {
+          write_verification_vtu(p, job, *files.verification);
+        }));
+      },
+      files, report["failed"], progress);
+  write_report(files, d);
+}
+
+ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
+                               const ResultFilesParams& params, const Progress& progress, const JobShapes& shapes) {
+  ResultFiles out = write_result_step_first(job, r, dir, params, progress, shapes);
+  add_verification(out, job, mesh, r, dir, params, progress);
   return out;
 }
 

@@ -5,6 +5,7 @@
 // budget and may fail on its own: what failed is named in a warning and in
 // verification.json, and never costs the files already written.
 #pragma once
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,7 @@ struct ResultFiles {
   std::vector<std::string> warnings;                 ///< one per step that failed, naming it and why
   std::optional<result::StepExportReport> step;      ///< when result.step was written
   std::optional<result::Verification> verification;  ///< when the verification ran
+  nlohmann::json report = nlohmann::json::object();  ///< verification.json as written last (step, figures, failed)
 };
 
 /// The input's curved analytic faces for result.step (result/step_export_analytic.h): those of
@@ -45,9 +47,26 @@ result::VerificationProblem verification_problem(const Job& job);
 /// (prepare_output_folder). verification.json is written whenever either step was asked for,
 /// with what succeeded and the error of what failed. Warnings also go to progress.warn.
 /// The input's curved faces come back as analytic faces (source_faces: `shapes`, or the job's
-/// files). Throws only Error(Cancelled) when progress says so.
+/// files). Throws only Error(Cancelled) when progress says so. The same as
+/// write_result_step_first followed by add_verification.
 ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
                                const ResultFilesParams& params = {}, const Progress& progress = {},
                                const JobShapes& shapes = {});
+
+/// The first part of write_result_files, for a caller that shows the result before it is
+/// verified: DIR/result.step when job.output.step asks for it, and DIR/verification.json
+/// holding its report (or why it failed) when either output was asked for. Returns the files
+/// so far; add_verification continues them. Throws only Error(Cancelled).
+ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, const std::string& dir,
+                                    const ResultFilesParams& params = {}, const Progress& progress = {},
+                                    const JobShapes& shapes = {});
+
+/// The second part: when job.output.verification asks for it, verifies `r`'s result solid
+/// against the FE `mesh`, writes DIR/verification.vtu and adds the figures (or the failure)
+/// to `files.report`, rewriting DIR/verification.json once with the first part's step report
+/// and failures kept. `files`: what write_result_step_first returned for the same job, `r`
+/// and `dir`. Throws only Error(Cancelled).
+void add_verification(ResultFiles& files, const Job& job, const TetMesh& mesh, const OptimizeResult& r,
+                      const std::string& dir, const ResultFilesParams& params = {}, const Progress& progress = {});
 
 }  // namespace topopt::pipeline

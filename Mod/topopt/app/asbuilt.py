@@ -20,7 +20,7 @@ import tempfile
 import FreeCAD
 import numpy as np
 
-from . import quiet, vtu
+from . import quiet, units, vtu
 from .results import nodal_maximum
 from .errors import TopOptError
 
@@ -60,8 +60,8 @@ def store_files(study, files):
     report = files.get(REPORT)
     study.VerificationReport = report.decode("utf-8") if report else ""
     figures = verification_report(study)
-    study.ComplianceAsBuilt = float(figures.get("compliance_as_built", 0.0) or 0.0)
-    study.ComplianceCrisp = float(figures.get("crisp", {}).get("compliance", 0.0) or 0.0)
+    units.set_prop(study, "ComplianceAsBuilt", float(figures.get("compliance_as_built", 0.0) or 0.0), "N*mm")
+    units.set_prop(study, "ComplianceCrisp", float(figures.get("crisp", {}).get("compliance", 0.0) or 0.0), "N*mm")
 
 
 def verification_report(study):
@@ -165,6 +165,7 @@ def make_solid_feature(study, shape):
     if vo is not None:
         from .results import RESULT_COLOUR
         vo.ShapeColor = RESULT_COLOUR
+        vo.DisplayMode = "Shaded"  # a solid of thousands of planar faces: their edges drawn looked like a mesh
     return feature
 
 
@@ -296,7 +297,7 @@ def summary_lines(study):
             "valid" if step.get("valid") else "NOT valid", step.get("volume", 0.0)))
     if "compliance_as_built" in report:
         crisp = report.get("crisp", {})
-        lines.append("  verification: as-built compliance %.6g N·mm vs crisp %.6g N·mm (ratio %.3f); "
+        lines.append("  verification: as-built compliance %.6g N·mm vs crisp %.6g N·mm (ratio %.3g); "
                      "max von Mises %.4g MPa, max displacement %.4g mm on %d tets" % (
                          report["compliance_as_built"], crisp.get("compliance", 0.0), report.get("ratio", 0.0),
                          report.get("max_von_mises", 0.0), report.get("max_displacement", 0.0),

@@ -6,6 +6,8 @@ this module or the classes in it, or saved documents stop loading their studies.
 """
 import FreeCAD
 
+from . import units
+
 PROXY_TYPE = "TopOpt::Study"
 
 #: the study's links to what runs and the Mesh command made: (name, doc)
@@ -29,6 +31,15 @@ ASBUILT_LINKS = [
 ]
 
 
+#: the verification's compliances, quantities of work (N·mm, which FreeCAD shows as mJ): (name, doc)
+COMPLIANCES = [
+    ("ComplianceAsBuilt", "Compliance of the result solid, analysed on its own mesh (work: N·mm = mJ); "
+                          "0 = not verified"),
+    ("ComplianceCrisp", "Compliance of the crisp design (densities 0/1 at the threshold) on the FE mesh "
+                        "(work: N·mm = mJ); 0 = not verified"),
+]
+
+
 def _add(obj, kind, name, group, doc, default=None):
     if name not in obj.PropertiesList:
         obj.addProperty(kind, name, group, doc)
@@ -38,29 +49,39 @@ def _add(obj, kind, name, group, doc, default=None):
 
 def _add_density(obj, text, doc):
     """Adds the property Density holding `text` (a quantity such as "7850 kg/m^3"): an
-    App::PropertyDensity where this FreeCAD has one (0.21 and later), else an
-    App::PropertyString (FreeCAD 0.20 has no density property)."""
-    try:
-        obj.addProperty("App::PropertyDensity", "Density", "Material", doc)
-    except Exception:  # FreeCAD 0.20: no such type
-        obj.addProperty("App::PropertyString", "Density", "Material", doc)
-    obj.Density = text
+    App::PropertyDensity where this FreeCAD has one (0.21 and later), else (0.20) an
+    App::PropertyQuantity given the unit kg/m^3 (units.add_quantity)."""
+    units.add_quantity(obj, "Density", "Material", doc, "App::PropertyDensity", "kg/m^3")
+    units.set_prop(obj, "Density", units.value_in(text, "kg/m^3", "Density"), "kg/m^3")
+
+
+def _work(obj, name, doc):
+    """Adds (or, for a document saved by an older version, turns from a float in N·mm into) the
+    result property `name`: a quantity of work (units.add_quantity: App::PropertyWork, or in
+    FreeCAD 0.20 an App::PropertyQuantity given the unit again each time the document opens)."""
+    old = None
+    if name in obj.PropertiesList and obj.getTypeIdOfProperty(name) == "App::PropertyFloat":
+        old = float(getattr(obj, name))
+        obj.removeProperty(name)
+    units.add_quantity(obj, name, "Result", doc, "App::PropertyWork", "mJ")
+    units.keep_unit(obj, name, "mJ")  # a reopened 0.20 document: the bare number again in mJ
+    if old is not None:
+        units.set_prop(obj, name, old, "N*mm")
 
 
 def _density_to_retype(obj):
-    """True when the study's Density is an older document's float (t/mm³), or FreeCAD 0.20's
-    text in a FreeCAD that has App::PropertyDensity."""
+    """The density text of a Density to turn into a quantity, or None: an older document's
+    float (t/mm³), or the text older versions kept in FreeCAD 0.20 (App::PropertyString),
+    when it is a density FreeCAD understands (a wrong one stays text, and a run names it)."""
     kind = obj.getTypeIdOfProperty("Density") if "Density" in obj.PropertiesList else None
-    if kind == "App::PropertyFloat":
-        return True
-    if kind != "App::PropertyString":
-        return False
+    if kind not in ("App::PropertyFloat", "App::PropertyString"):
+        return None
+    text = _density_text(obj.Density)
     try:
-        obj.addProperty("App::PropertyDensity", "TopOptDensityProbe", "", "")
-    except Exception:  # no such type here
-        return False
-    obj.removeProperty("TopOptDensityProbe")
-    return True
+        units.value_in(text, "kg/m^3", "Density")
+    except Exception:  # TopOptError: not a density
+        return None
+    return text
 
 
 def _retype(obj, name, kind, group, doc, convert):
@@ -111,10 +132,12 @@ class Study:
     def _material(self, obj):
         doc_e, doc_rho = "Young's modulus E", "Mass density, for self weight"
         _retype(obj, "YoungsModulus", "App::PropertyPressure", "Material", doc_e, lambda v: "%.12g MPa" % v)
-        if _density_to_retype(obj):
-            text = _density_text(obj.Density)  # an older document's float, or 0.20's text
+        text = _density_to_retype(obj)  # an older document's float or text
+        if text is not None:
             obj.removeProperty("Density")
             _add_density(obj, text, doc_rho)
+        if "Density" in obj.PropertiesList:
+            units.keep_unit(obj, "Density", "kg/m^3")  # a reopened 0.20 document: the bare number again in kg/m³
         _add(obj, "App::PropertyPressure", "YoungsModulus", "Material", doc_e, "210000 MPa")
         _add(obj, "App::PropertyFloat", "PoissonRatio", "Material", "Poisson's ratio ν", 0.3)
         if "Density" not in obj.PropertiesList:
@@ -154,10 +177,12 @@ class Study:
              "stops, naming the face it lost)", True)
         _add(obj, "App::PropertyString", "GeometryControls", "Optimization",
              "Geometry controls as the job's \"controls\" object in JSON (symmetry planes, cyclic, "
-             "patterns, extrusion; docs/optimization.md); empty = none. Set with api.set_controls", "")
+             "patterns, extrusion; docs/optimization.md; lengths in mm, angles in degrees); empty = none. Set with "
+             "api.set_controls", "")
         _add(obj, "App::PropertyString", "Responses", "Optimization",
              "Objective and limits as the job's optimization keys in JSON (objective, compliance_limit, "
-             "stress_limit, displacement_limits; docs/optimization.md); empty = the stiffest design of the "
+             "stress_limit, displacement_limits; docs/optimization.md; compliance in N·mm, stress in MPa, "
+             "displacements in mm); empty = the stiffest design of the "
              "volume fraction. Set with api.set_responses or the study's panel", "")
 
     def _results(self, obj):
@@ -170,7 +195,8 @@ class Study:
         self._asbuilt(obj)
         _add(obj, "App::PropertyLinkList", "DomainMeshes", "Result",
              "The tagged mesh by domain (FEM meshes: design, then each non-design solid)")
-        _add(obj, "App::PropertyFloatList", "ComplianceHistory", "Result", "Compliance per iteration (N·mm)")
+        _add(obj, "App::PropertyFloatList", "ComplianceHistory", "Result",
+             "Compliance per iteration in N·mm (FreeCAD has no list of quantities: plain numbers)")
         _add(obj, "App::PropertyFloatList", "VolumeHistory", "Result", "Volume fraction per iteration")
         _add(obj, "App::PropertyString", "Status", "Result", "What the last run did")
         # The analysis mesh and the densities, kept so the result can be re-extracted at another
@@ -203,11 +229,8 @@ class Study:
         _add(obj, "App::PropertyFileIncluded", "VerificationVtu", "Result", "The last run's verification.vtu")
         _add(obj, "App::PropertyString", "VerificationReport", "Result",
              "The last run's verification.json (compliance_as_built, max_von_mises, crisp, failed, ...)")
-        _add(obj, "App::PropertyFloat", "ComplianceAsBuilt", "Result",
-             "Compliance of the result solid, analysed on its own mesh (N·mm); 0 = not verified", 0.0)
-        _add(obj, "App::PropertyFloat", "ComplianceCrisp", "Result",
-             "Compliance of the crisp design (densities 0/1 at the threshold) on the FE mesh (N·mm); "
-             "0 = not verified", 0.0)
+        for name, doc in COMPLIANCES:
+            _work(obj, name, doc)
         for name in ("RunThreshold", "ResultFiles", "ResultStep", "VerificationVtu", "VerificationReport",
                      "ComplianceAsBuilt", "ComplianceCrisp"):
             obj.setEditorMode(name, 1)

@@ -103,6 +103,39 @@ def gravity(c):
             for a in "xyz"]
 
 
+def add_quantity(obj, name, group, doc, kind, unit):
+    """Adds property `name` (group `group`, tooltip `doc`) holding a quantity of `unit`'s kind
+    (`unit`: a unit FreeCAD parses, e.g. "mJ"), 0 to start with: FreeCAD's own property type
+    `kind` ("App::PropertyWork") where this FreeCAD has it, else an App::PropertyQuantity given
+    `unit`'s kind (keep_unit). Nothing is done when `obj` has the property already."""
+    if name in obj.PropertiesList:
+        return
+    try:
+        obj.addProperty(kind, name, group, doc)
+    except Exception:  # FreeCAD 0.20 has no such type: a quantity given its unit
+        obj.addProperty("App::PropertyQuantity", name, group, doc)
+        keep_unit(obj, name, unit)
+
+
+def keep_unit(obj, name, unit):
+    """Gives the App::PropertyQuantity `name` of `obj` the kind of `unit` ("mJ"), keeping its
+    value. FreeCAD 0.20 offers no Python call for a quantity property's unit: it refuses any
+    value with a unit ("Not matching Unit!") until an expression has set one, and it saves the
+    value only (a reopened document's quantity is a bare number in FreeCAD's internal units,
+    mm, kg, s). So the unit comes from an expression evaluated once and removed. Properties of
+    another type, or already in `unit`'s kind, are left alone."""
+    if obj.getTypeIdOfProperty(name) != "App::PropertyQuantity":
+        return
+    value = getattr(obj, name)
+    kind = _unit_of(unit)
+    if value.Unit == kind:
+        return
+    in_unit = FreeCAD.Units.Quantity(float(value.Value), kind).getValueAs(unit)  # the bare number is internal
+    obj.setExpression(name, "%.17g %s" % (float(in_unit), unit))
+    obj.recompute()
+    obj.setExpression(name, None)
+
+
 def to_text(value, unit, precision=6):
     """A float in `unit` written as FreeCAD's quantity text ("7850 kg/m^3")."""
     return "%.*g %s" % (precision, value, unit)

@@ -404,10 +404,14 @@ class ResponsesBox:
         layout.addRow(self.objective)  # the whole row: its names show whole
         self.compliance_limit = _number(0, 1e15, 3, " N·mm", "none")
         self.compliance_limit.setToolTip("With the mass objective: the largest compliance allowed")
-        layout.addRow("Compliance limit", self.compliance_limit)
+        # the limits under their labels: beside them, "250.00 MPa" would not show whole in the
+        # default combo view's width
+        layout.addRow(QtGui.QLabel("Compliance limit"))
+        layout.addRow(self.compliance_limit)
         self.stress_limit = _number(0, 1e9, 2, " MPa", "none")
         self.stress_limit.setToolTip("The largest von Mises stress allowed (e.g. yield stress / safety factor)")
-        layout.addRow("Stress limit", self.stress_limit)
+        layout.addRow(QtGui.QLabel("Stress limit"))
+        layout.addRow(self.stress_limit)
         self.limits = _ItemList(lambda d: "%s along %s ≤ %.4g mm" % (", ".join(d["label"]), _fmt(d["direction"]),
                                                                       d["limit"]))
         layout.addRow(QtGui.QLabel("Displacement limits"))

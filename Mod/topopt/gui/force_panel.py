@@ -107,7 +107,9 @@ class ForcePanel:
         layout.addWidget(self.by_vector)
         row = QtGui.QHBoxLayout()
         self.xyz = [_spin(-1e9, 1e9, 3) for _ in range(3)]
-        for w in self.xyz:
+        for w, axis in zip(self.xyz, "xyz"):
+            w.setToolTip("%s component" % axis)
+            w.setButtonSymbols(QtGui.QAbstractSpinBox.NoButtons)  # three in a row: room for "-1.000"
             w.valueChanged.connect(self._vector_edited)
             row.addWidget(w)
         layout.addLayout(row)

@@ -28,6 +28,20 @@ def report_error(e):
         QtGui.QMessageBox.warning(mw, "TopOpt", str(e))
 
 
+class _StatusLine(QtGui.QLabel):
+    """A word-wrapped line of the panel that takes no room while it says nothing (the panel
+    is long enough in the default combo view)."""
+
+    def __init__(self, text=""):
+        super().__init__()
+        self.setWordWrap(True)  # an error says what to try: all of it must show
+        self.setText(text)
+
+    def setText(self, text):
+        super().setText(text)
+        self.setVisible(bool(text))
+
+
 class _Binding:
     """One study property edited by one widget: `get(widget)` reads the widget, `put(widget,
     value)` shows a property value, `changed` is the widget's signal."""
@@ -72,8 +86,10 @@ def _bindings():
     volume = _spin(0.01, 0.99, 0.05, 2)
     volume.setToolTip("Share of the design domain's volume to keep")
     size = _spin(0.0, 1e4, 0.5, 2, " mm", "automatic")
+    size.setToolTip("Target element size; automatic: the part's bounding-box diagonal / 50")
     iterations = _int_spin(1, 10000)
-    keep = QtGui.QCheckBox()
+    iterations.setToolTip("Iteration cap: the optimisation stops there if it has not converged before")
+    keep = QtGui.QCheckBox("Keep loaded faces")  # its own label: the label column stays narrow
     keep.setToolTip("Keep the material under every supported and loaded face (one element layer stays solid); "
                     "off: the optimisation may remove it, and the verification then stops naming the face")
     return [
@@ -89,9 +105,10 @@ def _bindings():
     ]
 
 
-_LABELS = {"VolumeFraction": "Volume fraction", "MaxIterations": "Iterations (max)", "MeshSize": "Mesh size",
-           "Mesher": "Mesher", "WallLayers": "Thin-wall layers",
-           "KeepLoadedFaces": "Keep loaded faces"}
+#: the settings' labels, short: in the default combo view width the label column and the fields
+#: share about 200 px, and a field narrower than its value shows it cut (tests/python/gui)
+_LABELS = {"VolumeFraction": "Volume fraction", "MaxIterations": "Iterations", "MeshSize": "Mesh size",
+           "Mesher": "Mesher", "WallLayers": "Wall layers"}
 
 
 class _StudyObserver:
@@ -162,8 +179,11 @@ class StudyPanel:
         grid.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
         grid.setFieldGrowthPolicy(QtGui.QFormLayout.AllNonFixedFieldsGrow)
         for b in self.bindings:
-            b.widget.setMinimumWidth(60)
-            grid.addRow(_LABELS[b.prop], b.widget)
+            if b.prop in _LABELS:
+                b.widget.setMinimumWidth(60)
+                grid.addRow(_LABELS[b.prop], b.widget)
+            else:  # a check box, labelled itself
+                grid.addRow(b.widget)
         return box
 
     def _run_box(self):
@@ -183,11 +203,9 @@ class StudyPanel:
         self.progress.setToolTip("Meshing, then the optimisation: estimated from the iteration cap and how "
                                  "close the compliance is to converging")
         layout.addWidget(self.progress)
-        self.status = QtGui.QLabel(self.study.Status or "")
-        self.status.setWordWrap(True)  # an error says what to try: all of it must show
+        self.status = _StatusLine(self.study.Status or "")
         layout.addWidget(self.status)
-        self.verify_status = QtGui.QLabel(_verification_text(self.study))
-        self.verify_status.setWordWrap(True)
+        self.verify_status = _StatusLine(_verification_text(self.study))
         self.verify_status.setToolTip("The verification of the result solid (the study's Verify): it runs after "
                                       "the result is shown; Stop during it stops the verification only")
         layout.addWidget(self.verify_status)
@@ -543,7 +561,7 @@ def _verification_text(study, seconds=None):
     report = asbuilt.verification_report(study)
     took = " in %.0f s" % seconds if seconds is not None else ""
     if "compliance_as_built" in report:
-        return "verified%s: as-built compliance %.4g N·mm (%.3f × the crisp design's), max von Mises %.4g MPa" % (
+        return "verified%s: as-built compliance %.4g N·mm (%.3g × the crisp design's), max von Mises %.4g MPa" % (
             took, report["compliance_as_built"], report.get("ratio", 0.0), report.get("max_von_mises", 0.0))
     failed = report.get("failed", {}).get("verification")
     if failed:

@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include <BRepPrimAPI_MakeBox.hxx>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -127,6 +128,18 @@ class CliWorker : public ::testing::Test {
             {"output", "out"}};
   }
 
+  /// Writes beam.brep, a 60 × 10 × 10 box, and returns the job of that beam fixed at x = 0
+  /// (Face1) and pulled down by 100 N at x = 60 (Face2), meshed at size 4, with `optimization`.
+  json beam_job(const json& optimization) {
+    std::ofstream(dir_ / "beam.brep") << topopt::brep::write_brep_string(BRepPrimAPI_MakeBox(60, 10, 10).Shape());
+    return {{"mesh", {{"size", 4.0}}},
+            {"material", {{"E", 210000}, {"nu", 0.3}}},
+            {"supports", {{{"type", "fixed"}, {"faces", {"Face1"}}}}},
+            {"load_cases",
+             {{{"name", "tip"}, {"loads", {{{"type", "force"}, {"faces", {"Face2"}}, {"vector", {0, 0, -100}}}}}}}},
+            {"optimization", optimization}};
+  }
+
   fs::path dir_;
 };
 
@@ -141,15 +154,8 @@ double enclosed_volume(const topopt::io::RowMatXd& P, const topopt::io::RowMatXl
 }
 
 TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
-  std::ofstream(dir_ / "beam.brep") << topopt::brep::write_brep_string(BRepPrimAPI_MakeBox(60, 10, 10).Shape());
-  const json job = {
-      {"mesh", {{"size", 4.0}}},
-      {"material", {{"E", 210000}, {"nu", 0.3}}},
-      {"supports", {{{"type", "fixed"}, {"faces", {"Face1"}}}}},
-      {"load_cases",
-       {{{"name", "tip"}, {"loads", {{{"type", "force"}, {"faces", {"Face2"}}, {"vector", {0, 0, -100}}}}}}}},
-      // keep_loaded_faces off: the shape is then the volume fraction of the whole beam
-      {"optimization", {{"volume_fraction", 0.4}, {"max_iterations", 3}, {"keep_loaded_faces", false}}}};
+  // keep_loaded_faces off: the shape is then the volume fraction of the whole beam
+  const json job = beam_job({{"volume_fraction", 0.4}, {"max_iterations", 3}, {"keep_loaded_faces", false}});
   const WorkerRun r =
       run_worker(request({{"operation", "optimize"}, {"job", job}, {"part", "beam.brep"}, {"output", "out"}}));
   ASSERT_EQ(r.status, 0);
@@ -202,6 +208,51 @@ TEST_F(CliWorker, OptimizeStreamsProgressAndWritesItsResults) {
   EXPECT_NE(std::find(files.begin(), files.end(), "result.step"), files.end());
   EXPECT_NE(std::find(files.begin(), files.end(), "verification.json"), files.end());
   for (const auto& name : files) EXPECT_GT(std::filesystem::file_size(dir_ / "out" / name.get<std::string>()), 0u);
+}
+
+/// The names in result.json's "files" (an array of strings), in order.
+std::vector<std::string> file_names(const json& result) {
+  std::vector<std::string> names;
+  for (const auto& n : result.at("files")) names.push_back(n.get<std::string>());
+  return names;
+}
+
+TEST_F(CliWorker, ResultFirstWritesTheStepThenAddsTheVerificationToTheSameReport) {
+  // enough iterations for one piece joining the load to the support: the verification needs it
+  json job = beam_job({{"volume_fraction", 0.5}, {"max_iterations", 20}});
+  job["output"] = {{"step", true}, {"verification", true}};
+  const WorkerRun r = run_worker(request({{"operation", "optimize"},
+                                          {"job", job},
+                                          {"part", "beam.brep"},
+                                          {"params", {{"result_first", 1}}},
+                                          {"output", "out"}}));
+  ASSERT_EQ(r.status, 0);
+  ASSERT_TRUE(r.all_json);
+  EXPECT_EQ(r.last(), json({{"done", true}}));
+  // the line saying the result is ready comes after the STEP and before the verification
+  auto stage_at = [&](const std::string& stage) {
+    for (size_t i = 0; i < r.lines.size(); ++i)
+      if (r.lines[i].value("stage", "") == stage) return static_cast<long>(i);
+    return -1L;
+  };
+  ASSERT_GE(stage_at("result"), 0);
+  EXPECT_LT(stage_at("step"), stage_at("result"));
+  EXPECT_GT(stage_at("verification"), stage_at("result"));
+  json result, report;
+  std::ifstream(dir_ / "out" / "result.json") >> result;
+  std::ifstream(dir_ / "out" / "verification.json") >> report;
+  // every file listed once, each one there
+  const std::vector<std::string> names = file_names(result);
+  for (const char* name : {"result.step", "verification.json", "verification.vtu"})
+    EXPECT_EQ(std::count(names.begin(), names.end(), name), 1) << name;
+  for (const auto& name : names) EXPECT_GT(fs::file_size(dir_ / "out" / name), 0u) << name;
+  // one report holding the STEP's part and the verification's, nothing failed
+  ASSERT_TRUE(report.contains("step"));
+  EXPECT_TRUE(report["step"].value("valid", false));
+  EXPECT_GT(report["step"].value("volume", 0.0), 0.0);
+  EXPECT_GT(report.value("compliance_as_built", 0.0), 0.0);
+  EXPECT_GT(report["crisp"].value("compliance", 0.0), 0.0);
+  EXPECT_EQ(report["failed"], json::object()) << report.dump(2);
 }
 
 TEST_F(CliWorker, ExtractSurfaceOfAFullCubeIsTheCube) {

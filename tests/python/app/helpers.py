@@ -50,7 +50,9 @@ def _describe(value):
         return ("mesh", value.CountPoints, value.CountFacets, round(value.Volume, 6))
     if hasattr(value, "ShapeType"):
         return ("shape", value.ShapeType, len(value.Faces), round(value.Volume, 6))
-    if type(value).__name__ in ("Vector", "Placement", "Rotation", "Quantity"):
+    if type(value).__name__ == "Quantity":  # a document keeps 16 decimals of its value in internal units
+        return ("quantity", "%.16f" % value.Value, str(value.Unit))
+    if type(value).__name__ in ("Vector", "Placement", "Rotation"):
         return str(value)
     if isinstance(value, float):  # a document keeps 16 significant digits of a float, not 17
         return "%.15g" % value

@@ -12,7 +12,7 @@ import FreeCAD
 import Part
 from helpers import box_study, top_loaded_box_study
 
-from topopt.app import api, asbuilt, results, vtu
+from topopt.app import api, asbuilt, results, units, vtu
 from topopt.app.errors import TopOptError
 
 
@@ -94,7 +94,7 @@ class ResultAsBuilt(unittest.TestCase):
         report = json.loads(self.study.VerificationReport)
         self.assertEqual(report["failed"], {})
         check_verification_objects(self, self.study, report)
-        self.assertGreater(self.study.ComplianceAsBuilt, 0)
+        self.assertGreater(units.prop(self.study, "ComplianceAsBuilt", "N*mm"), 0)
 
     def test_vtu_reader_reads_what_the_writer_wrote(self):
         nodes = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]
@@ -147,7 +147,7 @@ class ResultAsBuilt(unittest.TestCase):
         api.run(self.study, verbose=False)
         for name in ("ResultSolid", "VerificationMesh", "VerificationResult", "VerificationFields"):
             self.assertIsNone(getattr(self.study, name), name)
-        self.assertEqual(self.study.ComplianceAsBuilt, 0.0)
+        self.assertEqual(units.prop(self.study, "ComplianceAsBuilt", "N*mm"), 0.0)
         for call in (lambda: api.result_solid(self.study),
                      lambda: api.export_step(self.study, os.path.join(self.folder, "x.step"))):
             with self.assertRaises(TopOptError) as e:
@@ -168,8 +168,10 @@ def check_verification_objects(test, study, report):
     test.assertAlmostEqual(max(res.vonMises), report["max_von_mises"], delta=1e-6 * report["max_von_mises"])
     test.assertAlmostEqual(max(res.DisplacementLengths), report["max_displacement"],
                            delta=1e-6 * report["max_displacement"])
-    test.assertEqual(study.ComplianceAsBuilt, report["compliance_as_built"])
-    test.assertEqual(study.ComplianceCrisp, report["crisp"]["compliance"])
+    for name, value in (("ComplianceAsBuilt", report["compliance_as_built"]),
+                        ("ComplianceCrisp", report["crisp"]["compliance"])):
+        test.assertEqual(getattr(study, name).Unit, FreeCAD.Units.Quantity("1 mJ").Unit, name)  # a work, not a number
+        test.assertAlmostEqual(units.prop(study, name, "N*mm"), value, delta=1e-9 * value)
     from topopt.app.study import owned_objects
     for obj in (res, mesh, pipe):
         test.assertIn(obj, owned_objects(study))

@@ -6,7 +6,7 @@ import unittest
 import FreeCAD
 import Part
 
-from topopt.app import api
+from topopt.app import api, units
 from topopt.app.study import is_study
 from helpers import bundled
 
@@ -96,6 +96,7 @@ class StudyFromScript(unittest.TestCase):
         study = self.make()
         study.ComplianceHistory = [10.0, 8.0, 7.5]
         study.Densities = [0.5, 1.0]
+        units.set_prop(study, "ComplianceCrisp", 3.25, "N*mm")
         path = os.path.join(tempfile.mkdtemp(), "lever_study.FCStd")
         self.doc.saveAs(path)
         name = self.doc.Name
@@ -109,6 +110,10 @@ class StudyFromScript(unittest.TestCase):
         self.assertEqual(len(s.Constraints), 5)
         self.assertEqual(list(s.ComplianceHistory), [10.0, 8.0, 7.5])
         self.assertAlmostEqual(s.VolumeFraction, 0.35)
+        # a work again after reopening (FreeCAD 0.20 saves a quantity property's value only)
+        self.assertEqual(s.ComplianceCrisp.Unit, FreeCAD.Units.Quantity("1 mJ").Unit)
+        self.assertAlmostEqual(units.prop(s, "ComplianceCrisp", "N*mm"), 3.25)
+        self.assertEqual(s.ComplianceCrisp.UserString, "3.25 mJ")
         self.assertEqual(api.job_of(s)["supports"][0]["faces"], ["Face9"])
 
 

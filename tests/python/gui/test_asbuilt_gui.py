@@ -13,7 +13,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from gui_helpers import BoxPanelCase, open_workbench, select, settle
+from gui_helpers import BoxPanelCase, grab_window, open_workbench, select, settle, texts_cut
 from app.helpers import top_loaded_box_study
 from topopt.app import api
 from topopt.gui import panels
@@ -22,7 +22,8 @@ SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
 
 
 def screenshot(name, fit=True):
-    """The main window (widgets) and the 3D view rendered offscreen. Returns both paths."""
+    """The main window with its 3D view (grab_window), and the 3D view alone rendered offscreen.
+    Returns both paths."""
     os.makedirs(SHOTS, exist_ok=True)
     mw = FreeCADGui.getMainWindow()
     mw.resize(1280, 960)
@@ -31,7 +32,7 @@ def screenshot(name, fit=True):
         FreeCADGui.ActiveDocument.ActiveView.fitAll()
     settle()
     window = os.path.join(SHOTS, name)
-    mw.grab().save(window)
+    grab_window(window)
     view = os.path.join(SHOTS, name.replace(".png", "_3d.png"))
     FreeCADGui.ActiveDocument.ActiveView.saveImage(view, 1000, 750, "White")
     return window, view
@@ -65,6 +66,7 @@ class Panel(BoxPanelCase):
             widths = {b.title(): b.minimumSizeHint().width() for b in p.form.findChildren(QtGui.QGroupBox)}
             self.assertLessEqual(p.form.minimumSizeHint().width(), combo.width(), widths)
         screenshot("panel_controls.png")
+        self.assertEqual(texts_cut(p.form), [])  # every value, item and label shows whole
         form = p.form
         form.resize(max(form.width(), 330), form.sizeHint().height())
         form.grab().save(os.path.join(SHOTS, "panel_controls_whole.png"))  # the whole panel, unscrolled

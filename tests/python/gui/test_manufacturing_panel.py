@@ -11,7 +11,7 @@ import unittest
 import FreeCADGui
 from PySide import QtGui
 
-from gui_helpers import BoxPanelCase, scroll_to, select, settle
+from gui_helpers import BoxPanelCase, grab_window, scroll_to, select, settle, texts_cut
 from topopt.app import api, runner
 from topopt.gui import panels
 
@@ -26,7 +26,7 @@ def shoot_panel(panel, name):
     mw.resize(1280, 960)
     settle()
     scroll_to(panel, panel.controls.process.box)
-    mw.grab().save(os.path.join(SHOTS, name))
+    grab_window(os.path.join(SHOTS, name))
     form = panel.form
     form.resize(form.width(), form.sizeHint().height())
     form.grab().save(os.path.join(SHOTS, name.replace(".png", "_whole.png")))
@@ -76,6 +76,7 @@ class ManufacturingPanel(BoxPanelCase):
             self.assertLessEqual(self.panel.form.minimumSizeHint().width(), combo.width(), widths)
         shoot_panel(self.panel, "panel_manufacturing.png")
         self.assertEqual(outside_their_parents(self.panel.form), [])
+        self.assertEqual(texts_cut(self.panel.form), [])  # every value, item and label shows whole
         self.assertTrue(self.panel.accept())
         c = json.loads(self.study.GeometryControls)
         self.assertEqual(c["draw_direction"], {"direction": [0.0, 0.0, -1.0], "parting_point": [0.0, 5.0, 5.0]})

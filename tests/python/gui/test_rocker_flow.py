@@ -14,6 +14,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
+from gui_helpers import grab_window, texts_cut
 from topopt.app.study import is_study
 
 SHARED = os.environ.get("TOPOPT_SHARED_DATA", "")
@@ -27,11 +28,11 @@ def settle(n=20):
 
 
 def screenshot(name, view=True):
-    """The main window (widgets) and the 3D view rendered offscreen (a widget grab does not
-    capture OpenGL)."""
+    """The main window with its 3D view painted in (grab_window), and the 3D view alone
+    rendered offscreen at a fixed size (*_3d.png)."""
     os.makedirs(SHOTS, exist_ok=True)
     settle()
-    FreeCADGui.getMainWindow().grab().save(os.path.join(SHOTS, name + ".png"))
+    grab_window(os.path.join(SHOTS, name + ".png"))
     if view and FreeCADGui.ActiveDocument is not None:
         FreeCADGui.ActiveDocument.ActiveView.saveImage(os.path.join(SHOTS, name + "_3d.png"), 1000, 750, "White")
 
@@ -126,6 +127,7 @@ class RockerFlow(unittest.TestCase):
         self.assertAlmostEqual(float(study.MeshSize), 2.5)  # the panel writes the study itself
         self.assertEqual(study.MaxIterations, 40)
         screenshot("02_new_study_panel")
+        self.assertEqual(texts_cut(panel.form), [])  # every value ("2.50 mm"), item and label shows whole
         return study
 
     def step_constraints(self, study, part):
@@ -174,6 +176,7 @@ class RockerFlow(unittest.TestCase):
         if face == "Face9":
             self.assertLessEqual(panel.form.minimumSizeHint().width(), 240)  # fits the default combo view
             screenshot("04_force_panel")
+            self.assertEqual(texts_cut(panel.form), [])
         self.assertIsInstance(panel, ForcePanel)
         self.assertTrue(panel.accept())
         settle()

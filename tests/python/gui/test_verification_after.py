@@ -13,8 +13,9 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from gui_helpers import open_workbench, scroll_to, settle
+from gui_helpers import grab_window, open_workbench, scroll_to, settle
 from app.helpers import top_loaded_box_study
+from topopt.app import units
 from topopt.gui import panels
 
 SHOTS = os.environ.get("TOPOPT_SCREENSHOTS", "/tmp/topopt-screenshots")
@@ -65,7 +66,7 @@ class VerificationAfter(unittest.TestCase):
         self.assertTrue(study.Result.Mesh.isSolid())
         self.assertIn("TopOpt run", self.doc.UndoNames)
         self.assertIsNone(study.VerificationResult)  # its verification is not yet
-        self.assertEqual(study.ComplianceAsBuilt, 0.0)
+        self.assertEqual(units.prop(study, "ComplianceAsBuilt", "N*mm"), 0.0)
         self.assertIn("result.step", study.ResultFiles)
         self.assertNotIn("verification.vtu", study.ResultFiles)
         self.assertEqual(self.panel.progress.value(), 100)
@@ -88,7 +89,7 @@ class VerificationAfter(unittest.TestCase):
             os.makedirs(SHOTS, exist_ok=True)
             self.panel.timer.stop()  # no poll while the screenshot is taken: the verification's end waits
             scroll_to(self.panel, self.panel.verify_status)
-            FreeCADGui.getMainWindow().grab().save(os.path.join(SHOTS, "verification_running.png"))
+            grab_window(os.path.join(SHOTS, "verification_running.png"))
             self.assertTrue(self.panel.verifying)
             self.panel.timer.start()
             seen.append(True)
@@ -100,7 +101,7 @@ class VerificationAfter(unittest.TestCase):
         self.assertIsNone(self.panel.thread)
         self.assertFalse(self.panel.verifying)
         self.assertIsNotNone(study.VerificationResult, self.panel.verify_status.text())
-        self.assertGreater(study.ComplianceAsBuilt, 0.0)
+        self.assertGreater(units.prop(study, "ComplianceAsBuilt", "N*mm"), 0.0)
         self.assertEqual(sorted(study.ResultFiles), ["result.step", "verification.json", "verification.vtu"])
         report = json.loads(study.VerificationReport)
         self.assertIn("compliance_as_built", report)
@@ -112,7 +113,7 @@ class VerificationAfter(unittest.TestCase):
         self.assertEqual(self.panel.cancel_button.text(), "Stop")
         self.assertAlmostEqual(study.VolumeFraction, 0.35)  # the edit made meanwhile stays
         scroll_to(self.panel, self.panel.verify_status)
-        FreeCADGui.getMainWindow().grab().save(os.path.join(SHOTS, "verification_done.png"))
+        grab_window(os.path.join(SHOTS, "verification_done.png"))
 
     def test_stop_during_the_verification_keeps_the_result(self):
         self.start_until_result()

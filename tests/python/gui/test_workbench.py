@@ -10,6 +10,7 @@ import Part
 from PySide import QtGui
 
 from topopt.app import api
+from gui_helpers import colours_in, grab_window, viewer_rect
 from topopt.app.study import is_study
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -23,13 +24,13 @@ def settle(n=20):
 
 
 def screenshot(name):
-    """The main window (widgets) and, beside it, the 3D view rendered offscreen (a widget grab
-    does not capture OpenGL). Returns the path of the 3D view image."""
+    """The main window with its 3D view painted in (grab_window) and, beside it, the 3D view
+    alone rendered offscreen. Returns the path of the 3D view image."""
     os.makedirs(SHOTS, exist_ok=True)
     mw = FreeCADGui.getMainWindow()
     mw.resize(1280, 960)
     settle()
-    mw.grab().save(os.path.join(SHOTS, name))
+    grab_window(os.path.join(SHOTS, name))
     view_path = os.path.join(SHOTS, name.replace(".png", "_3d.png"))
     FreeCADGui.ActiveDocument.ActiveView.saveImage(view_path, 1000, 750, "White")
     return view_path
@@ -94,6 +95,10 @@ class Workbench(unittest.TestCase):
         FreeCADGui.SendMsgToActiveView("ViewFit")
         path = screenshot("workbench_study.png")
         self.assertGreater(os.path.getsize(path), 10000)
+        # the window's screenshot shows the 3D view (a bare widget grab leaves it one flat colour)
+        rect = viewer_rect()
+        self.assertIsNotNone(rect)
+        self.assertGreater(colours_in(QtGui.QImage(os.path.join(SHOTS, "workbench_study.png")), rect), 20)
         FreeCADGui.Control.closeDialog()
 
     def test_mesh_run_and_result_in_the_panel(self):
