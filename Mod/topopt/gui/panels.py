@@ -210,8 +210,8 @@ class StudyPanel:
                                       "the result is shown; Stop during it stops the verification only")
         layout.addWidget(self.verify_status)
         self.plot = HistoryPlot()
-        self.plot.set_history(self.study.ComplianceHistory, self.study.VolumeHistory)
         layout.addWidget(self.plot)
+        self._show_history()
         self.run_button.clicked.connect(self.start_run)
         self.cancel_button.clicked.connect(self.request_cancel)
         self.timer = QtCore.QTimer()
@@ -281,7 +281,13 @@ class StudyPanel:
             self.volume_data = None
             self._show_result_state()
         if prop in ("ComplianceHistory", "VolumeHistory") and self.thread is None:
-            self.plot.set_history(self.study.ComplianceHistory, self.study.VolumeHistory)
+            self._show_history()
+
+    def _show_history(self):
+        """The plot of the study's last run; hidden while the study has none (the panel is long
+        enough in the default combo view)."""
+        self.plot.set_history(self.study.ComplianceHistory, self.study.VolumeHistory)
+        self.plot.setVisible(bool(self.study.ComplianceHistory))
 
     # --- running ---------------------------------------------------------------------------
     def _set_running(self, running):
@@ -323,6 +329,7 @@ class StudyPanel:
         from topopt.gui.statusbar import StatusProgress
         self.status_bar = StatusProgress()
         self.plot.set_history([], [])
+        self.plot.show()  # its axes wait for the first iteration
         self.progress.setValue(0)
         self._set_running(True)
         self.status.setText("starting…")
