@@ -51,6 +51,7 @@ json verification_json(const result::Verification& v) {
           {"as_built", figures_json(v.as_built)},
           {"crisp", figures_json(v.crisp)},
           {"ratio", v.ratio()},
+          {"crisp_carries_load", v.crisp_carries_load()},
           {"unheld_volumes", v.unheld_volumes}};
 }
 

@@ -312,6 +312,14 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
     if (e.code() == ErrorCode::Cancelled) out_of_time("solving the verification");
     throw;
   }
+  if (!v.crisp_carries_load())
+    progress.warn(
+        "verification: the crisp design on the FE mesh (the tets whose mean density reaches the threshold) "
+        "does not carry the load (compliance " +
+        std::to_string(v.crisp.compliance) + " N·mm against the result solid's " +
+        std::to_string(v.as_built.compliance) +
+        "): members of the result are thinner than one FE tet, as in a design that has not converged. "
+        "Raise optimization.max_iterations (MaxIterations in the study) or refine mesh.size");
   return v;
 }
 

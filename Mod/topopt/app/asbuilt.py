@@ -297,6 +297,9 @@ def summary_lines(study):
             "valid" if step.get("valid") else "NOT valid", step.get("volume", 0.0)))
     if "compliance_as_built" in report:
         crisp = report.get("crisp", {})
+        if not report.get("crisp_carries_load", True):
+            lines.append("  verification: the crisp design on the FE mesh does not carry the load (members "
+                         "thinner than one tet: the design has not converged)")
         lines.append("  verification: as-built compliance %.6g N·mm vs crisp %.6g N·mm (ratio %.3g); "
                      "max von Mises %.4g MPa, max displacement %.4g mm on %d tets" % (
                          report["compliance_as_built"], crisp.get("compliance", 0.0), report.get("ratio", 0.0),

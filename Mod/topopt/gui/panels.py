@@ -568,8 +568,12 @@ def _verification_text(study, seconds=None):
     report = asbuilt.verification_report(study)
     took = " in %.0f s" % seconds if seconds is not None else ""
     if "compliance_as_built" in report:
-        return "verified%s: as-built compliance %.4g N·mm (%.3g × the crisp design's), max von Mises %.4g MPa" % (
-            took, report["compliance_as_built"], report.get("ratio", 0.0), report.get("max_von_mises", 0.0))
+        if not report.get("crisp_carries_load", True):
+            compared = "the crisp design on the FE mesh does not carry the load: not converged"
+        else:
+            compared = "%.3g × the crisp design's" % report.get("ratio", 0.0)
+        return "verified%s: as-built compliance %.4g N·mm (%s), max von Mises %.4g MPa" % (
+            took, report["compliance_as_built"], compared, report.get("max_von_mises", 0.0))
     failed = report.get("failed", {}).get("verification")
     if failed:
         return "verification failed: %s" % failed.get("message", "")
