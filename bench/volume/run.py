@@ -218,26 +218,34 @@ def product_row(topopt, part, nd, factor, tmp):
 
 
 def product(args):
+    """--product runs; with --before OLD, each row runs OLD first then --product, one after the
+    other (the same load for both), OLD's rows going to --json with .before before its suffix."""
     import json, tempfile
-    rows = json.load(open(args.json)) if os.path.exists(args.json) else {}
+    runs = [(args.product, args.json)]
+    if args.before:
+        runs.insert(0, (args.before, "%s.before%s" % os.path.splitext(args.json)))
+    rows = {path: json.load(open(path)) if os.path.exists(path) else {} for _, path in runs}
     with tempfile.TemporaryDirectory() as tmp:
         for name, part, nd in product_parts():
             for f in (float(x) for x in args.factors.split(",")):
                 key = "%s@%g" % (name, f)
-                if key in rows or (args.parts and name not in args.parts.split(",")):
+                if args.parts and name not in args.parts.split(","):
                     continue
-                rows[key] = product_row(args.product, part, nd, f, tmp)
-                print(key, json.dumps(rows[key]), file=sys.stderr, flush=True)
-                json.dump(rows, open(args.json, "w"), indent=1)
+                for topopt, path in runs:
+                    if key in rows[path]:
+                        continue
+                    rows[path][key] = product_row(topopt, part, nd, f, tmp)
+                    print(key, topopt, json.dumps(rows[path][key]), file=sys.stderr, flush=True)
+                    json.dump(rows[path], open(path, "w"), indent=1)
 
 
 def table(files):
     """Two --json files (before, after) side by side as a Markdown table (rows of the second)."""
     import json
     old, new = (json.load(open(f)) for f in files.split(","))
-    print("| part | size | tets before / after | radius ratio min before / after | share < 0.1 before / after |"
-          " share < 0.2 before / after | flat / inverted after | conformity after |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| part | size | tets before / after | radius ratio min before / after | tets < 0.1 before / after |"
+          " share < 0.2 before / after | flat / inverted after | conformity after | CPU s before / after |")
+    print("|---|---|---|---|---|---|---|---|---|")
     pct = lambda x: "%.3f %%" % (100 * x)
     for key in new:
         a, b = old.get(key, {}), new[key]
@@ -247,9 +255,11 @@ def table(files):
             print("| %s | %s | before: %s / after: %s | | | | | |" % (name, size, a.get("error", "-")[-80:],
                                                                     b.get("error", "-")[-80:]))
             continue
-        print("| %s | %s | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %s / %s | %s |" % (
-            name, size, a["tets"], b["tets"], a["rr_min"], b["rr_min"], pct(a["below_0.1"]), pct(b["below_0.1"]),
-            pct(a["below_0.2"]), pct(b["below_0.2"]), b["flat"], b["inverted"], "ok" if b["conformity"] else "DEFECTS"))
+        below = lambda r: "%d (%s)" % (round(r["below_0.1"] * r["tets"]), pct(r["below_0.1"]))
+        print("| %s | %s | %d / %d | %.4f / %.4f | %s / %s | %s / %s | %s / %s | %s | %s / %s |" % (
+            name, size, a["tets"], b["tets"], a["rr_min"], b["rr_min"], below(a), below(b),
+            pct(a["below_0.2"]), pct(b["below_0.2"]), b["flat"], b["inverted"], "ok" if b["conformity"] else "DEFECTS",
+            a["cpu_seconds"], b["cpu_seconds"]))
 
 
 def classes(path):
@@ -332,6 +342,7 @@ def main():
     ap.add_argument("--cases", default="rocker:1.0,rocker:2.77,cantilever:1.28,bracket:2.72")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--product", help="a topopt executable: its product path on every shared part (see above)")
+    ap.add_argument("--before", help="with --product: an older topopt run on each row just before --product")
     ap.add_argument("--factors", default="1.0,0.6", help="with --product: sizes as factors of the default")
     ap.add_argument("--parts", default="", help="with --product: only these parts (names as in the table)")
     ap.add_argument("--json", default="product.json", help="with --product: rows kept here (a rerun skips them)")
