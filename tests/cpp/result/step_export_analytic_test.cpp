@@ -177,6 +177,20 @@ Fixture countersunk_boss() {
   return f;
 }
 
+/// The solid of `s` with the curved faces of `part` and `nondesign` as analytic faces, checked
+/// on the way: valid, one solid, no curved piece refused. `r`: what describe_solid says of it.
+TopoDS_Shape analytic_solid(const TriSurface& s, const TopoDS_Shape& part, const TopoDS_Shape& nondesign,
+                            StepExportReport& r) {
+  const SourceFaces source(part, nondesign);
+  int refused = -1;
+  const TopoDS_Shape solid = result_solid(s, kNoCoarsening, nullptr, &source, &refused);
+  r = describe_solid(solid);
+  EXPECT_TRUE(r.valid) << solid_faults(solid);
+  EXPECT_EQ(r.solids, 1);
+  EXPECT_EQ(refused, 0);
+  return solid;
+}
+
 TEST(StepExportAnalytic, TrianglesOnCurvedInputFacesAreFoundByTagAndPlace) {
   const Fixture f = fixture();
   const TriSurface s = tagged_surface(f);
@@ -202,13 +216,8 @@ TEST(StepExportAnalytic, TrianglesOnCurvedInputFacesAreFoundByTagAndPlace) {
 TEST(StepExportAnalytic, BoresAndBossAreCylindersOfTheInputInOneValidSolid) {
   const Fixture f = fixture();
   const TriSurface s = tagged_surface(f);
-  const SourceFaces source(f.part, f.nondesign);
-  int refused = -1;
-  const TopoDS_Shape solid = result_solid(s, kNoCoarsening, nullptr, &source, &refused);
-  const StepExportReport r = describe_solid(solid);
-  EXPECT_TRUE(r.valid) << solid_faults(solid);
-  EXPECT_EQ(r.solids, 1);
-  EXPECT_EQ(refused, 0);
+  StepExportReport r;
+  const TopoDS_Shape solid = analytic_solid(s, f.part, f.nondesign, r);
   // the plate's bore and the tube's bore (full turns, built as two halves each) and the tube's boss
   // (what the bar leaves of it): cylinders of the input's radius and axis
   EXPECT_GE(cylinders(solid, 12, 15, 5), 1);
@@ -259,24 +268,13 @@ TEST(StepExportAnalytic, StepReadBackHasTheCylindersValidWithTheVolume) {
   std::filesystem::remove(path);
 }
 
-}  // namespace
-}  // namespace topopt::result
-
-namespace topopt::result {
-namespace {
-
 TEST(StepExportAnalytic, ConesAndToriToo) {
   const Fixture f = countersunk_boss();
   ASSERT_EQ(faces_on<Geom_ToroidalSurface>(f.part), 1);
   ASSERT_EQ(faces_on<Geom_ConicalSurface>(f.part), 1);
   const TriSurface s = tagged_surface(f);
-  const SourceFaces source(f.part, {});
-  int refused = -1;
-  const TopoDS_Shape solid = result_solid(s, kNoCoarsening, nullptr, &source, &refused);
-  const StepExportReport r = describe_solid(solid);
-  EXPECT_TRUE(r.valid) << solid_faults(solid);
-  EXPECT_EQ(r.solids, 1);
-  EXPECT_EQ(refused, 0);
+  StepExportReport r;
+  const TopoDS_Shape solid = analytic_solid(s, f.part, {}, r);
   EXPECT_EQ(faces_on<Geom_ToroidalSurface>(solid), 1);
   EXPECT_EQ(faces_on<Geom_ConicalSurface>(solid), 1);
   EXPECT_EQ(cylinders(solid, 15, 15, 2), 1);
