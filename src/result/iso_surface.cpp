@@ -120,6 +120,37 @@ double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double
   return total;
 }
 
+namespace {
+
+/// Node densities within this of the threshold count as lying on it.
+constexpr double kOnThreshold = 1e-9;
+/// How far off_plateau moves the threshold past the plateau (at most half the gap to the next value).
+constexpr double kPlateauStep = 1e-6;
+
+/// `t` moved off the node densities lying on it (within kOnThreshold: a plateau of equal
+/// densities, as extrusion or a grey region gives), to just below or just above them, whichever
+/// keeps the design volume nearer `target`. On the plateau each node's side would be set by the
+/// filter's rounding, not by the design. Unchanged when no node lies that close.
+double off_plateau(const TetMesh& mesh, const VecXd& node_density, double t, double target) {
+  double below = 0, above = 1, low = 2, high = -1;
+  for (long i = 0; i < node_density.size(); ++i) {
+    const double d = node_density[i];
+    if (std::abs(d - t) <= kOnThreshold)
+      low = std::min(low, d), high = std::max(high, d);
+    else if (d < t)
+      below = std::max(below, d);
+    else
+      above = std::min(above, d);
+  }
+  if (high < low) return t;
+  const double down = low - std::min(kPlateauStep, 0.5 * (low - below));
+  const double up = high + std::min(kPlateauStep, 0.5 * (above - high));
+  const double miss_down = std::abs(kept_design_volume(mesh, node_density, down) - target);
+  return miss_down <= std::abs(kept_design_volume(mesh, node_density, up) - target) ? down : up;
+}
+
+}  // namespace
+
 double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, double volume_fraction) {
   if (!(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "the volume fraction must lie strictly between 0 and 1");
@@ -129,7 +160,7 @@ double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, doub
     double mid = 0.5 * (lo + hi);
     (kept_design_volume(mesh, node_density, mid) > target ? lo : hi) = mid;
   }
-  return 0.5 * (lo + hi);
+  return off_plateau(mesh, node_density, 0.5 * (lo + hi), target);
 }
 
 namespace {

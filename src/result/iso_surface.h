@@ -22,7 +22,9 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density);
 double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold);
 
 /// The threshold in (0, 1) at which the kept design volume equals `volume_fraction` of the
-/// design domain's volume, by bisection.
+/// design domain's volume, by bisection. Where that lands on a plateau of equal node densities
+/// (within 1e-9), the threshold steps just off it (by up to 1e-6) to the side whose volume is
+/// nearer: the whole plateau is then in or out, not each node by the filter's rounding.
 double threshold_for_volume(const TetMesh& mesh, const VecXd& node_density, double volume_fraction);
 
 /// A triangle surface with a tag per triangle and what may move when smoothing.

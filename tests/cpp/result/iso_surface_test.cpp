@@ -48,6 +48,28 @@ TEST(IsoSurface, ClosedManifoldOrientedWithTheTargetVolume) {
   EXPECT_TRUE(face1 && face2);
 }
 
+TEST(IsoSurface, TheThresholdForAVolumeStepsOffAPlateauOfEqualDensities) {
+  // the nodes of a slab across the bar (x in [15, 25]) all at 0.4 (plus round-off either side,
+  // as a filter leaves it), and a volume fraction inside the jump the plateau makes: the
+  // bisection ends on 0.4, where each plateau node's side would be its round-off's
+  Fixture f = bar_fixture();
+  VecXd nd = node_densities(f.mesh, f.density);
+  long plateau = 0;
+  for (long i = 0; i < nd.size(); ++i)
+    if (f.mesh.V(i, 0) >= 15 && f.mesh.V(i, 0) <= 25) nd[i] = 0.4 + ((i % 3) - 1) * 1e-16, ++plateau;
+  ASSERT_GT(plateau, 20);
+  const double design = kept_design_volume(f.mesh, nd, -1.0);
+  const double below = kept_design_volume(f.mesh, nd, 0.4 - 1e-7), above = kept_design_volume(f.mesh, nd, 0.4 + 1e-7);
+  ASSERT_GT(below - above, 0.05 * design);
+  const double t = threshold_for_volume(f.mesh, nd, (0.4 * below + 0.6 * above) / design);
+  for (long i = 0; i < nd.size(); ++i) ASSERT_GT(std::abs(nd[i] - t), 1e-9) << "node " << i << " on the threshold";
+  EXPECT_GT(t, 0.4);  // the nearer side: above the plateau (60 % of the jump), all its nodes out
+  EXPECT_NEAR(kept_design_volume(f.mesh, nd, t), above, 1e-5 * design);
+  // and the surface at that threshold is closed and crossing-free
+  const TriSurface s = extract_iso_surface(f.mesh, nd, t, 0.2);
+  EXPECT_TRUE(check_surface(s.V, s.F).closed_manifold());
+}
+
 TEST(IsoSurface, SmoothingKeepsItClosedAndNonDesignInPlace) {
   Fixture f = bar_fixture();
   VecXd nd = node_densities(f.mesh, f.density);
