@@ -19,6 +19,7 @@
 #include "cli/commands.h"
 #include "cli/worker_channel.h"
 #include "common/error.h"
+#include "common/tet_boundary.h"
 #include "fem/boundary_conditions.h"
 #include "io/npy.h"
 #include "mesh/core/tet_quality.h"
@@ -46,8 +47,9 @@ const char* kUsage =
     "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
     "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
-    "     DIR/result.step, the shape as one CAD solid; optimize: result_first: 1 writes result.json\n"
-    "     and prints {\"stage\": \"result\"} before the verification, result.json again after it),\n"
+    "     DIR/result.step, the shape as one CAD solid, its curved faces analytic when \"part\"\n"
+    "     is given; optimize: result_first: 1 writes result.json and prints {\"stage\":\n"
+    "     \"result\"} before the verification, result.json again after it),\n"
     "     \"output\": DIR}\n"
     "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
     "  progress {\"stage\", \"fraction\", \"message\"}, iterations {\"iteration\", \"compliance\",\n"
@@ -331,7 +333,22 @@ std::pair<TetMesh, VecXd> checked_densities(const Request& r) {
   return {mesh, density};
 }
 
-/// extract_surface: the result shape of given densities at a threshold (or volume fraction).
+/// The study's part and non-design shapes when the request gives them (op_optimize's files):
+/// their curved faces for the STEP, and `mesh`'s boundary triangles (the stored mesh has none)
+/// numbered by the curved face of the part they lie on, so that the result surface's triangles
+/// there carry the tags SourceFaces::classify reads. None without a part.
+result::SourceFaces source_faces_for(const Request& r, TetMesh& mesh, WorkerChannel& ch) {
+  auto [part, nd] = read_shapes(r, ch);
+  if (part.IsNull()) return {};
+  result::SourceFaces source(part, nd);
+  mesh.F = boundary_triangles(mesh.T);
+  mesh.face = source.part_face_numbers(mesh.V, mesh.F);
+  return source;
+}
+
+/// extract_surface: the result shape of given densities at a threshold (or volume fraction);
+/// with "part" (and "nondesign") its STEP has the input's cylinders, cones, spheres and tori
+/// as analytic faces, as optimize's result.step.
 json op_extract_surface(const Request& r, WorkerChannel& ch) {
   const double threshold = param(r, "threshold", -1), volume_fraction = param(r, "volume_fraction", -1);
   if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
@@ -341,7 +358,8 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   if (smooth.iterations < 0 || smooth.iterations > 1000)
     throw Error(ErrorCode::InvalidParameter, "smoothing_iterations must lie in [0, 1000]");
   ch.progress("read", 0, "reading the densities");
-  const auto [mesh, density] = checked_densities(r);
+  auto [mesh, density] = checked_densities(r);
+  const result::SourceFaces source = source_faces_for(r, mesh, ch);
   ch.progress("surface", -1, "extracting the result shape");
   double used = 0;
   result::HygieneReport hygiene;  // without supports and loads: the largest piece is kept
@@ -352,7 +370,8 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   put_result_surface(result, r.output, s);
   if (param(r, "step", 0) != 0) {  // the shape at this threshold as one CAD solid, DIR/result.step
     ch.progress("step", -1, "writing the result as a STEP solid");
-    const result::StepExportReport step = result::write_result_step((fs::path(r.output) / "result.step").string(), s);
+    const result::StepExportReport step =
+        result::write_result_step((fs::path(r.output) / "result.step").string(), s, {}, {}, &source);
     result["step"] = {{"faces", step.faces},
                       {"triangles", step.triangles},
                       {"volume", step.volume},

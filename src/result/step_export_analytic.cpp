@@ -1,10 +1,12 @@
 // The input's curved analytic faces in the result's STEP (see step_export_analytic.h).
 #include "result/step_export_analytic.h"
 
+#include <BRepBndLib.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
 #include <ElSLib.hxx>
 #include <GProp_GProps.hxx>
 #include <Geom2d_BSplineCurve.hxx>
@@ -321,6 +323,19 @@ void SourceFaces::add(const TopoDS_Face& face, std::vector<int>& ids) {
   surfaces_.push_back(g);
 }
 
+int SourceFaces::nearest(const std::vector<int>& ids, const gp_Pnt& c, const gp_Vec& n, double edge) const {
+  int out = -1;
+  double best = 0.2 * edge;
+  for (int id : ids) {
+    gp_Pnt on;
+    const auto g = Handle(Geom_ElementarySurface)::DownCast(surfaces_[id]);
+    const gp_Vec normal = normal_at(g, parameters(g, c), &on);
+    const double d = on.Distance(c);
+    if (d < best && std::abs(normal.Dot(n.Normalized())) > std::cos(M_PI / 4)) best = d, out = id;
+  }
+  return out;
+}
+
 std::vector<int> SourceFaces::classify(const TriSurface& s) const {
   const std::vector<int> none;
   std::vector<int> out(s.F.rows(), -1);
@@ -331,15 +346,40 @@ std::vector<int> SourceFaces::classify(const TriSurface& s) const {
                                                                                                : none;
     if (candidates.empty()) continue;
     const auto [n, c] = triangle_frame(s, q);
-    if (n.Magnitude() <= 0) continue;
-    double best = 0.2 * longest_edge(s, q);
-    for (int id : candidates) {
-      gp_Pnt on;
-      const auto g = Handle(Geom_ElementarySurface)::DownCast(surfaces_[id]);
-      const gp_Vec normal = normal_at(g, parameters(g, c), &on);
-      const double d = on.Distance(c);
-      if (d < best && std::abs(normal.Dot(n.Normalized())) > std::cos(M_PI / 4)) best = d, out[q] = id;
+    if (n.Magnitude() > 0) out[q] = nearest(candidates, c, n, longest_edge(s, q));
+  }
+  return out;
+}
+
+VecXi SourceFaces::part_face_numbers(const MatX3d& V, const MatX3i& F) const {
+  std::vector<std::pair<int, Bnd_Box>> curved;  // Ω's curved faces: id and bounding box
+  std::vector<int> number(size(), 0);           // id -> Ω's face number (0: a non-design face)
+  for (int f = 1; f < static_cast<int>(part_face_.size()); ++f)
+    for (int id : part_face_[f]) {
+      Bnd_Box box;
+      BRepBndLib::Add(faces_[id], box);
+      curved.emplace_back(id, box);
+      number[id] = f;
     }
+  VecXi out = VecXi::Zero(F.rows());
+  TriSurface s;  // one triangle at a time, for triangle_frame and longest_edge
+  s.F.resize(1, 3);
+  s.F << 0, 1, 2;
+  s.V.resize(3, 3);
+  std::vector<int> ids;
+  for (long q = 0; q < F.rows() && !curved.empty(); ++q) {
+    for (int k = 0; k < 3; ++k) s.V.row(k) = V.row(F(q, k));
+    const auto [n, c] = triangle_frame(s, 0);
+    const double edge = longest_edge(s, 0);
+    if (n.Magnitude() <= 0) continue;
+    ids.clear();
+    for (const auto& [id, box] : curved) {
+      Bnd_Box near = box;
+      near.Enlarge(edge);
+      if (!near.IsOut(c)) ids.push_back(id);
+    }
+    const int id = nearest(ids, c, n, edge);
+    if (id >= 0) out[q] = number[id];
   }
   return out;
 }

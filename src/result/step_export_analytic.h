@@ -14,6 +14,8 @@
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
 #include <functional>
+#include <gp_Pnt.hxx>
+#include <gp_Vec.hxx>
 #include <vector>
 
 #include "result/iso_surface.h"
@@ -40,6 +42,14 @@ class SourceFaces {
   /// within 45° of the surface's (either way round). Of several, the nearest.
   std::vector<int> classify(const TriSurface& s) const;
 
+  /// For a tet mesh whose boundary triangles carry no face numbers (the workbench's stored
+  /// mesh, re-extracted by the threshold slider): per row of `F` (#F by 3 boundary triangles of
+  /// nodes `V`, #V by 3, mm, either orientation), the number f (1-based, as classify reads tags)
+  /// of the curved analytic face of Ω the triangle lies on, by the same test as classify and
+  /// inside that face's bounding box (enlarged by the triangle's longest edge); 0 for any other
+  /// triangle (planar faces, non-design solids, none). Returns #F numbers, a TetMesh::face.
+  VecXi part_face_numbers(const MatX3d& V, const MatX3i& F) const;
+
   /// The input face with index `id` (0 <= id < size()).
   const TopoDS_Face& face(int id) const { return faces_[id]; }
   /// Its surface (cylinder, cone, sphere or torus) in the face's place, untrimmed.
@@ -52,6 +62,9 @@ class SourceFaces {
   std::vector<Handle(Geom_Surface)> surfaces_;  ///< #faces_: their surfaces
   std::vector<std::vector<int>> part_face_;     ///< Ω face number f (1-based) -> ids (0 or 1)
   std::vector<std::vector<int>> solid_faces_;   ///< non-design solid k (1-based) -> its ids
+  /// Of the candidates `ids`, the one whose surface lies nearest the triangle with centre `c`,
+  /// area normal `n` and longest edge `edge` (within 0.2 edge, normals within 45°); -1 if none.
+  int nearest(const std::vector<int>& ids, const gp_Pnt& c, const gp_Vec& n, double edge) const;
 };
 
 /// Gives the shared B-Rep edge from point a to point b of the surface, oriented a -> b (the

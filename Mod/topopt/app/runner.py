@@ -226,7 +226,9 @@ def run(study, on_progress=None, cancel=None, verbose=True):
 def extract_at(study, threshold, cancel=None, stored=None, step=False):
     """The result shape of the study's stored densities at `threshold` (in (0, 1)), extracted in
     the worker process; the document is not touched. stored: checks.stored_mesh(study) when
-    the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]).
+    the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]),
+    with the study's part and non-design shapes so that their cylinders, cones, spheres and tori
+    come back as analytic faces, as in the run's result.step.
     Returns the worker's answer (surface_points #P×3, surface_triangles #Q×3, surface_tags #Q,
     files). cancel(): polled, True cancels. Raises TopOptError if the study has no result, if
     what it stored is damaged, or if the worker fails or runs past REEXTRACT_TIMEOUT seconds."""
@@ -234,10 +236,21 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
         raise TopOptError("the study has no densities yet: run it first", "InvalidParameter")
     threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
     nodes, tets, domain, densities = stored if stored is not None else checks.stored_mesh(study)
+    shapes = _source_shapes(study) if step else {}
     return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
                                                  "densities": densities},
                       params=dict({"threshold": threshold}, **({"step": 1} if step else {})), cancel=cancel,
-                      timeout=REEXTRACT_TIMEOUT)
+                      timeout=REEXTRACT_TIMEOUT, **shapes)
+
+
+def _source_shapes(study):
+    """{"part", "nondesign"}: the study's shapes as BREP strings for the worker (those of
+    prepare), or {} when the part is gone or empty: the STEP is then written with facets only."""
+    part = getattr(study, "Part", None)
+    if part is None or part.Shape.isNull():
+        return {}
+    nd = jobmod.nondesign_compound(study)
+    return {"part": part.Shape.exportBrepToString(), "nondesign": nd.exportBrepToString() if nd else ""}
 
 
 def reextract(study, threshold, cancel=None):

@@ -5,7 +5,13 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <gp_Ax2.hxx>
 
 #include <algorithm>
 #include <array>
@@ -264,6 +270,47 @@ TEST_F(CliWorker, ExtractSurfaceOfAFullCubeIsTheCube) {
   const RowMatXl F = npy_integer(read_npy((dir_ / "out" / "surface_triangles.npy").string()), 3, "triangles");
   EXPECT_EQ(F.rows(), 12);
   EXPECT_NEAR(enclosed_volume(P, F), 1.0, 1e-12);
+}
+
+/// Radii of the cylindrical faces of the one shape in the STEP file at `path`.
+std::vector<double> cylinder_radii(const fs::path& path) {
+  std::vector<double> radii;
+  for (TopExp_Explorer e(topopt::brep::read_shape_file(path.string(), "result"), TopAbs_FACE); e.More(); e.Next()) {
+    const BRepAdaptor_Surface a(TopoDS::Face(e.Current()));
+    if (a.GetType() == GeomAbs_Cylinder) radii.push_back(a.Cylinder().Radius());
+  }
+  return radii;
+}
+
+TEST_F(CliWorker, ExtractSurfaceStepWithThePartHasItsBoreAsCylinders) {
+  // a 40 x 20 x 10 plate with a bore of radius 4 through it, meshed by the worker as the
+  // workbench's run does; all its tets full, the slider's STEP is the plate again
+  const TopoDS_Shape bore = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(20, 10, -1), gp::DZ()), 4, 12).Shape();
+  const TopoDS_Shape plate = BRepAlgoAPI_Cut(BRepPrimAPI_MakeBox(40, 20, 10).Shape(), bore).Shape();
+  std::ofstream(dir_ / "plate.brep") << topopt::brep::write_brep_string(plate);
+  json job = beam_job(json::object());
+  job["mesh"]["size"] = 2.5;
+  WorkerRun r = run_worker(request({{"operation", "mesh"}, {"job", job}, {"part", "plate.brep"}, {"output", "mesh"}}));
+  ASSERT_EQ(r.status, 0);
+  const long tets = topopt::io::read_npy((dir_ / "mesh" / "tets.npy").string()).shape[0];
+  topopt::io::write_npy((dir_ / "densities.npy").string(), topopt::VecXd(topopt::VecXd::Ones(tets)));
+  json extract = {{"operation", "extract_surface"},
+                  {"arrays",
+                   {{"nodes", "mesh/nodes.npy"},
+                    {"tets", "mesh/tets.npy"},
+                    {"domain", "mesh/domain.npy"},
+                    {"densities", "densities.npy"}}},
+                  {"params", {{"threshold", 0.5}, {"step", 1}}},
+                  {"output", "facets"}};
+  r = run_worker(request(extract));  // without the part: the bore stays facets
+  ASSERT_EQ(r.status, 0);
+  EXPECT_TRUE(cylinder_radii(dir_ / "facets" / "result.step").empty());
+  extract["part"] = "plate.brep", extract["output"] = "analytic";
+  r = run_worker(request(extract));
+  ASSERT_EQ(r.status, 0);
+  const std::vector<double> radii = cylinder_radii(dir_ / "analytic" / "result.step");
+  ASSERT_FALSE(radii.empty());
+  for (double radius : radii) EXPECT_NEAR(radius, 4.0, 1e-6);
 }
 
 TEST_F(CliWorker, ErrorsAreALastLineNamingCodeAndStage) {

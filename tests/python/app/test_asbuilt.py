@@ -1,7 +1,7 @@
 """The result back in CAD and verified, in FreeCADCmd: a run keeps result.step and the
 verification's files in the study; api.result_solid makes a Part solid from the STEP (one undo
 step), api.export_step writes it, both at the threshold the slider shows, both refuse cleanly (naming the setting) when the run wrote
-no STEP; the verification becomes a FEM mesh, a FEM result and a fields pipeline whose largest
+no STEP; at a threshold the slider moved to, the part's bore comes back as cylinders; the verification becomes a FEM mesh, a FEM result and a fields pipeline whose largest
 von Mises stress is verification.json's; a re-run without the files removes what they made."""
 import json
 import os
@@ -226,6 +226,46 @@ class VerificationInFem(unittest.TestCase):
             self.assertFalse([o for o in doc.Objects if o.Name.startswith(study.Name + "_Verification")])
         finally:
             FreeCAD.closeDocument(doc.Name)
+
+
+class SliderSolidKeepsTheBore(unittest.TestCase):
+    """Result as solid at a threshold the slider moved to (the worker's extract_surface, not
+    the run's result.step) gives the part's bore back as cylinders of its radius (issue 19/23)."""
+
+    RADIUS = 2.5
+
+    @classmethod
+    def setUpClass(cls):
+        cls.doc = FreeCAD.newDocument("SliderBore")
+        part = cls.doc.addObject("Part::Feature", "BoredBeam")
+        bore = Part.makeCylinder(cls.RADIUS, 12, FreeCAD.Vector(45, 5, -1))
+        part.Shape = Part.makeBox(60, 10, 10).cut(bore)
+        cls.doc.recompute()
+        ends = {}
+        for i, face in enumerate(part.Shape.Faces, 1):  # the end faces x = 0 and x = 60, by place
+            if face.Surface.__class__.__name__ == "Plane" and abs(face.Surface.Axis.x) > 0.99:
+                ends[round(face.CenterOfMass.x)] = "Face%d" % i
+        cls.study = api.new_study(cls.doc, part, (), volume_fraction=0.4, mesh_size=3.0)
+        cls.study.MaxIterations = 6
+        cls.study.WriteStep = True
+        api.add_fixed(cls.study, ends[0])
+        api.add_force(cls.study, ends[60], (0, 0, -100))
+        cls.doc.recompute()
+        api.run(cls.study, verbose=False)
+
+    @classmethod
+    def tearDownClass(cls):
+        FreeCAD.closeDocument(cls.doc.Name)
+
+    def test_the_solid_at_a_low_threshold_has_the_bore_as_cylinders(self):
+        # at 0.02 every tet is kept: the beam with its bore, no longer the run's shape
+        solid = api.result_solid(self.study, threshold=0.02).Shape
+        self.assertEqual(len(solid.Solids), 1)
+        self.assertTrue(solid.isValid())
+        radii = [f.Surface.Radius for f in solid.Faces if f.Surface.__class__.__name__ == "Cylinder"]
+        self.assertGreater(len(radii), 0, "the bore came back as %d facets" % len(solid.Faces))
+        for radius in radii:
+            self.assertAlmostEqual(radius, self.RADIUS, places=6)
 
 
 class NoResult(unittest.TestCase):
