@@ -251,8 +251,10 @@ void write_result(const fs::path& dir, const json& result);
 /// the same report (pipeline::add_verification); result.json is written again at the end with
 /// every file.
 void put_result_files_first(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
-                            std::vector<std::string>& warnings, WorkerChannel& ch, const Progress& progress) {
-  pipeline::ResultFiles files = pipeline::write_result_step_first(job, run.optimization, dir.string(), {}, progress);
+                            const pipeline::JobShapes& shapes, std::vector<std::string>& warnings, WorkerChannel& ch,
+                            const Progress& progress) {
+  pipeline::ResultFiles files =
+      pipeline::write_result_step_first(job, run.optimization, dir.string(), {}, progress, shapes);
   list_result_files(result, files);
   result["warnings"] = warnings;
   write_result(dir, result);
@@ -263,12 +265,12 @@ void put_result_files_first(json& result, const fs::path& dir, const pipeline::J
 
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
-  pipeline::Job job = job_of(r);
-  // the request's shape files name the job's part: result.step reads its curved faces there
-  if (job.part.empty()) job.part = r.part, job.nondesign = r.nondesign;
-  auto [part, nd] = read_shapes(r, ch);
+  const pipeline::Job job = job_of(r);
+  // the request's shapes, read once: the mesh and result.step's curved faces come from them
+  const auto [part, nd] = read_shapes(r, ch);
+  const pipeline::JobShapes shapes{part, nd};
   std::vector<std::string> warnings;
-  const pipeline::RunResult run = pipeline::run_job(job, {part, nd}, ch.make_progress(warnings),
+  const pipeline::RunResult run = pipeline::run_job(job, shapes, ch.make_progress(warnings),
                                                     [&ch](const simp::IterationRecord& rec) { ch.iteration(rec); });
   const pipeline::OptimizeResult& o = run.optimization;
   json history = json::array();
@@ -290,9 +292,10 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
   put_array(result, r.output, "densities", o.simp.density);
   put_result_surface(result, r.output, o.surface);
   if (job.output.verification && param(r, "result_first", 0) != 0)
-    put_result_files_first(result, r.output, job, run, warnings, ch, progress);
+    put_result_files_first(result, r.output, job, run, shapes, warnings, ch, progress);
   else
-    list_result_files(result, pipeline::write_result_files(job, run.mesh, run.optimization, r.output, {}, progress));
+    list_result_files(result,
+                      pipeline::write_result_files(job, run.mesh, run.optimization, r.output, {}, progress, shapes));
   result["warnings"] = warnings;  // with those of the last iterate's analysis and the result files
   return result;
 }
