@@ -36,11 +36,16 @@ class PreparedRun:
         return int(self.job["optimization"]["max_iterations"])
 
 
+def _shape_breps(study):
+    """(part, non-design) of the study as the worker takes them: BREP strings, "" for no
+    non-design solids."""
+    nd = jobmod.nondesign_compound(study)
+    return study.Part.Shape.exportBrepToString(), nd.exportBrepToString() if nd else ""
+
+
 def prepare(study):
     job = jobmod.study_to_job(study)
-    part = study.Part.Shape
-    nd = jobmod.nondesign_compound(study)
-    return PreparedRun(job, part.exportBrepToString(), nd.exportBrepToString() if nd else "")
+    return PreparedRun(job, *_shape_breps(study))
 
 
 @contextlib.contextmanager
@@ -244,13 +249,13 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
 
 
 def _source_shapes(study):
-    """{"part", "nondesign"}: the study's shapes as BREP strings for the worker (those of
-    prepare), or {} when the part is gone or empty: the STEP is then written with facets only."""
+    """{"part", "nondesign"}: the study's shapes as BREP strings for the worker (as prepare
+    sends them), or {} when the part is gone or empty: the STEP is then written with facets only."""
     part = getattr(study, "Part", None)
     if part is None or part.Shape.isNull():
         return {}
-    nd = jobmod.nondesign_compound(study)
-    return {"part": part.Shape.exportBrepToString(), "nondesign": nd.exportBrepToString() if nd else ""}
+    part_brep, nondesign_brep = _shape_breps(study)
+    return {"part": part_brep, "nondesign": nondesign_brep}
 
 
 def reextract(study, threshold, cancel=None):
