@@ -69,15 +69,22 @@ gp_Vec normal_at(const Handle(Geom_Surface) & g, const gp_Pnt2d& uv, gp_Pnt* at 
   return n.Magnitude() > 1e-12 ? n.Normalized() : gp_Vec();
 }
 
-/// Area-weighted outward normal (its length: twice the area) and centre of triangle q.
-std::pair<gp_Vec, gp_Pnt> triangle_frame(const TriSurface& s, long q) {
-  const gp_Pnt a = point(s, s.F(q, 0)), b = point(s, s.F(q, 1)), c = point(s, s.F(q, 2));
-  return {gp_Vec(a, b).Crossed(gp_Vec(a, c)), gp_Pnt((a.XYZ() + b.XYZ() + c.XYZ()) / 3)};
+/// A triangle's area-weighted normal (its length: twice the area; outward for the surface's
+/// triangles), centre and longest edge.
+struct TriangleFrame {
+  gp_Vec normal;
+  gp_Pnt centre;
+  double longest = 0;
+};
+
+TriangleFrame triangle_frame(const gp_Pnt& a, const gp_Pnt& b, const gp_Pnt& c) {
+  return {gp_Vec(a, b).Crossed(gp_Vec(a, c)), gp_Pnt((a.XYZ() + b.XYZ() + c.XYZ()) / 3),
+          std::max({a.Distance(b), b.Distance(c), c.Distance(a)})};
 }
 
-double longest_edge(const TriSurface& s, long q) {
-  const gp_Pnt a = point(s, s.F(q, 0)), b = point(s, s.F(q, 1)), c = point(s, s.F(q, 2));
-  return std::max({a.Distance(b), b.Distance(c), c.Distance(a)});
+/// The frame of triangle q of `s`.
+TriangleFrame triangle_frame(const TriSurface& s, long q) {
+  return triangle_frame(point(s, s.F(q, 0)), point(s, s.F(q, 1)), point(s, s.F(q, 2)));
 }
 
 /// Distance from the middle of the gap-free arc of the angles `a` (radians, any range) to
@@ -214,8 +221,8 @@ class PieceFace {
   double outward_sense(const std::vector<long>& tris) const {
     double sense = 0;
     for (long q : tris) {
-      const auto [n, c] = triangle_frame(s_, q);
-      sense += n.Dot(normal_at(turned_, parameters(turned_, c)));
+      const TriangleFrame t = triangle_frame(s_, q);
+      sense += t.normal.Dot(normal_at(turned_, parameters(turned_, t.centre)));
     }
     return sense;
   }
@@ -264,7 +271,7 @@ class PieceFace {
   bool accepted(const TopoDS_Face& face, const std::vector<long>& tris) const {
     if (!BRepCheck_Analyzer(face).IsValid()) return false;
     double area = 0;
-    for (long q : tris) area += triangle_frame(s_, q).first.Magnitude() / 2;
+    for (long q : tris) area += triangle_frame(s_, q).normal.Magnitude() / 2;
     GProp_GProps props;
     BRepGProp::SurfaceProperties(face, props);
     return std::abs(props.Mass() - area) <= 0.05 * area;
@@ -291,7 +298,7 @@ std::pair<std::vector<long>, std::vector<long>> halves(const TriSurface& s, cons
                                                        const Handle(Geom_ElementarySurface) & g) {
   std::pair<std::vector<long>, std::vector<long>> out;
   for (long q : piece) {
-    double u = parameters(g, triangle_frame(s, q).second).X();
+    double u = parameters(g, triangle_frame(s, q).centre).X();
     u -= kTwoPi * std::floor(u / kTwoPi);
     (u < M_PI ? out.first : out.second).push_back(q);
   }
@@ -328,8 +335,7 @@ int SourceFaces::nearest(const std::vector<int>& ids, const gp_Pnt& c, const gp_
   double best = 0.2 * edge;
   for (int id : ids) {
     gp_Pnt on;
-    const auto g = Handle(Geom_ElementarySurface)::DownCast(surfaces_[id]);
-    const gp_Vec normal = normal_at(g, parameters(g, c), &on);
+    const gp_Vec normal = normal_at(surfaces_[id], parameters(surfaces_[id], c), &on);
     const double d = on.Distance(c);
     if (d < best && std::abs(normal.Dot(n.Normalized())) > std::cos(M_PI / 4)) best = d, out = id;
   }
@@ -345,8 +351,8 @@ std::vector<int> SourceFaces::classify(const TriSurface& s) const {
                                          : t < 0 && -t < static_cast<int>(solid_faces_.size()) ? solid_faces_[-t]
                                                                                                : none;
     if (candidates.empty()) continue;
-    const auto [n, c] = triangle_frame(s, q);
-    if (n.Magnitude() > 0) out[q] = nearest(candidates, c, n, longest_edge(s, q));
+    const TriangleFrame f = triangle_frame(s, q);
+    if (f.normal.Magnitude() > 0) out[q] = nearest(candidates, f.centre, f.normal, f.longest);
   }
   return out;
 }
@@ -362,32 +368,26 @@ VecXi SourceFaces::part_face_numbers(const MatX3d& V, const MatX3i& F) const {
       number[id] = f;
     }
   VecXi out = VecXi::Zero(F.rows());
-  TriSurface s;  // one triangle at a time, for triangle_frame and longest_edge
-  s.F.resize(1, 3);
-  s.F << 0, 1, 2;
-  s.V.resize(3, 3);
+  const auto at = [&V](int i) { return gp_Pnt(V(i, 0), V(i, 1), V(i, 2)); };
   std::vector<int> ids;
   for (long q = 0; q < F.rows() && !curved.empty(); ++q) {
-    for (int k = 0; k < 3; ++k) s.V.row(k) = V.row(F(q, k));
-    const auto [n, c] = triangle_frame(s, 0);
-    const double edge = longest_edge(s, 0);
-    if (n.Magnitude() <= 0) continue;
+    const TriangleFrame f = triangle_frame(at(F(q, 0)), at(F(q, 1)), at(F(q, 2)));
+    if (f.normal.Magnitude() <= 0) continue;
     ids.clear();
     for (const auto& [id, box] : curved) {
       Bnd_Box near = box;
-      near.Enlarge(edge);
-      if (!near.IsOut(c)) ids.push_back(id);
+      near.Enlarge(f.longest);
+      if (!near.IsOut(f.centre)) ids.push_back(id);
     }
-    const int id = nearest(ids, c, n, edge);
+    const int id = nearest(ids, f.centre, f.normal, f.longest);
     if (id >= 0) out[q] = number[id];
   }
   return out;
 }
 
 std::vector<TopoDS_Face> analytic_faces(const TriSurface& s, const std::vector<long>& region,
-                                        const Handle(Geom_Surface) & surface, const EdgeSource& edges,
+                                        const Handle(Geom_ElementarySurface) & g, const EdgeSource& edges,
                                         std::vector<long>& facets, int& refused) {
-  const Handle(Geom_ElementarySurface) g = Handle(Geom_ElementarySurface)::DownCast(surface);
   std::vector<TopoDS_Face> out;
   const auto give_up = [&](const std::vector<long>& tris) {
     facets.insert(facets.end(), tris.begin(), tris.end());

@@ -1,15 +1,15 @@
 // The input's curved analytic faces in the result's STEP: which triangles of the result surface
 // lie on a cylinder, cone, sphere or torus of Ω or of a non-design solid (SourceFaces, a lookup
 // from a triangle's tag and place to the input's TopoDS_Face), and one B-Rep face on that
-// ORIGINAL surface per connected region of such triangles (analytic_face), bounded by the
+// ORIGINAL surface per connected region of such triangles (analytic_faces), bounded by the
 // region's boundary polylines made of the same shared edges the neighbouring faces use, so the
-// shell stays closed by construction. Each edge gets a 2D curve on the surface (the projection of
-// its end points) and the tolerance of its largest distance from the surface (BRepLib::
-// SameParameter). A region that wraps all the way round the axis (a full bore) is split in two
-// halves, each on a copy of the surface turned about its axis so that the half lies clear of the
-// parametric seam: no seam edge to build.
+// shell stays closed by construction. Each edge gets a 2D curve on the surface (the straight
+// line between its end points' (u, v)) and the tolerance of its largest distance from the
+// surface along it (the straight edge is a chord, sampled at 17 points). A region that wraps all the way round the axis
+// (a full bore) is split in two halves, each on a copy of the surface turned about its axis so that the half lies clear
+// of the parametric seam: no seam edge to build.
 #pragma once
-#include <Geom_Surface.hxx>
+#include <Geom_ElementarySurface.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
@@ -53,15 +53,15 @@ class SourceFaces {
   /// The input face with index `id` (0 <= id < size()).
   const TopoDS_Face& face(int id) const { return faces_[id]; }
   /// Its surface (cylinder, cone, sphere or torus) in the face's place, untrimmed.
-  const Handle(Geom_Surface) & surface(int id) const { return surfaces_[id]; }
+  const Handle(Geom_ElementarySurface) & surface(int id) const { return surfaces_[id]; }
   int size() const { return static_cast<int>(faces_.size()); }
 
  private:
   void add(const TopoDS_Face& face, std::vector<int>& ids);
-  std::vector<TopoDS_Face> faces_;              ///< the curved analytic faces, Ω's first
-  std::vector<Handle(Geom_Surface)> surfaces_;  ///< #faces_: their surfaces
-  std::vector<std::vector<int>> part_face_;     ///< Ω face number f (1-based) -> ids (0 or 1)
-  std::vector<std::vector<int>> solid_faces_;   ///< non-design solid k (1-based) -> its ids
+  std::vector<TopoDS_Face> faces_;                        ///< the curved analytic faces, Ω's first
+  std::vector<Handle(Geom_ElementarySurface)> surfaces_;  ///< #faces_: their surfaces
+  std::vector<std::vector<int>> part_face_;               ///< Ω face number f (1-based) -> ids (0 or 1)
+  std::vector<std::vector<int>> solid_faces_;             ///< non-design solid k (1-based) -> its ids
   /// Of the candidates `ids`, the one whose surface lies nearest the triangle with centre `c`,
   /// area normal `n` and longest edge `edge` (within 0.2 edge, normals within 45°); -1 if none.
   int nearest(const std::vector<int>& ids, const gp_Pnt& c, const gp_Vec& n, double edge) const;
@@ -81,7 +81,7 @@ using EdgeSource = std::function<TopoDS_Edge(int a, int b)>;
 /// appended to `facets` (to be written as triangles), the 2D curves added for them removed, and
 /// `refused` counts such pieces.
 std::vector<TopoDS_Face> analytic_faces(const TriSurface& s, const std::vector<long>& region,
-                                        const Handle(Geom_Surface) & surface, const EdgeSource& edges,
+                                        const Handle(Geom_ElementarySurface) & surface, const EdgeSource& edges,
                                         std::vector<long>& facets, int& refused);
 
 }  // namespace topopt::result
