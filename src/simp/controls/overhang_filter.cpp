@@ -34,7 +34,7 @@ const OverhangControl& checked(const OverhangControl& p) {
   if (!(p.margin >= 0 && p.margin <= 20 && p.angle + p.margin <= 85))
     bad("margin",
         "must lie in [0, 20] degrees with angle + margin <= 85 (the filter prints for angle + margin; "
-        "default 5), not " +
+        "default 10), not " +
             std::to_string(p.margin) + " with angle " + std::to_string(p.angle));
   if (!(p.xi0 > 0 && p.xi0 < 1)) bad("xi0", "must lie in (0, 1) (default 0.5), not " + std::to_string(p.xi0));
   const double q = p.exponent + std::log(kSupports) / std::log(p.xi0);
