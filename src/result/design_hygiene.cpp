@@ -212,6 +212,10 @@ void fill_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& para
     ++report.voids_filled, report.void_volume_filled += volume[c];
     fill_void(mesh, label, c, solid, out);
   }
+}
+
+/// The warnings about filled or kept voids, once for all rounds.
+void warn_voids(HygieneReport& report) {
   if (report.voids_filled)
     report.warnings.push_back("filled " + std::to_string(report.voids_filled) + " closed internal void(s) of " +
                               mm3(report.void_volume_filled) +
@@ -220,6 +224,22 @@ void fill_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& para
   if (report.voids_kept)
     report.warnings.push_back("the design keeps " + std::to_string(report.voids_kept) + " closed internal void(s) of " +
                               mm3(report.void_volume_kept) + " in all (optimization.fill_voids is false)");
+}
+
+/// Adds what a later round of cleaning did (removed pieces, filled voids) to the first round's
+/// report; the pieces it only names again are named already.
+void add_round(const HygieneReport& later, HygieneReport& report) {
+  for (const DesignPiece& piece : later.apart)
+    if (piece.removed) report.apart.push_back(piece);
+  for (const std::string& w : later.warnings)
+    if (w.rfind("removed a loose piece", 0) == 0) report.warnings.push_back(w);
+  report.voids_filled += later.voids_filled, report.void_volume_filled += later.void_volume_filled;
+}
+
+bool changed_design(const HygieneReport& round) {
+  for (const DesignPiece& piece : round.apart)
+    if (piece.removed) return true;
+  return round.voids_filled > 0;
 }
 
 }  // namespace
@@ -358,10 +378,26 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
                    const HygieneParams& params, HygieneReport& report) {
   report = HygieneReport{};
   const MatX4i nb = tet_neighbours(mesh.T);
-  std::vector<char> solid = crisp_tets(mesh, node_densities(mesh, density), threshold);
   VecXd out = density;
-  remove_pieces(mesh, anchors, solid, out, report);
-  fill_voids(mesh, nb, params, solid, out, report);
+  // Taking a piece out lowers the node densities of the tets around it, filling a void raises
+  // them, so the crisp design of the cleaned densities can hold a piece or a void the first
+  // round did not see: clean again until a round changes nothing, so that the design handed
+  // over is clean by the same test (at most kRounds rounds).
+  constexpr int kRounds = 4;
+  std::vector<char> solid;
+  for (int round = 0; round < kRounds; ++round) {
+    solid = crisp_tets(mesh, node_densities(mesh, out), threshold);
+    HygieneReport found;
+    remove_pieces(mesh, anchors, solid, out, found);
+    fill_voids(mesh, nb, params, solid, out, found);
+    if (round == 0)
+      report = std::move(found);
+    else
+      add_round(found, report);
+    if (!changed_design(round == 0 ? report : found)) break;
+  }
+  warn_voids(report);
+  solid = crisp_tets(mesh, node_densities(mesh, out), threshold);
   report.min_feature = min_feature_size(mesh, nb, solid, report.min_feature_at);
   return out;
 }

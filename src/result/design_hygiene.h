@@ -72,8 +72,10 @@ double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std
 /// set to density 0 when it is design material with no load on it, named otherwise (its
 /// non-design solids, or a loaded piece of the design). Closed voids (void tets
 /// face-connected to no boundary face of the mesh) are set to 1 when params.fill_voids.
-/// Fills `report` (a warning for every removal, every piece apart, several load-carrying
-/// pieces, filled or kept voids) and returns the cleaned densities (#T).
+/// Cleaning is repeated on the cleaned densities' own crisp design until a round changes
+/// nothing (at most 4 rounds), so that cleaning the result again finds nothing. Fills `report`
+/// (pieces counted before cleaning; a warning for every removal, every piece apart, several
+/// load-carrying pieces, filled or kept voids) and returns the cleaned densities (#T).
 VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
                    const HygieneParams& params, HygieneReport& report);
 
