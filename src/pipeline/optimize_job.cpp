@@ -14,6 +14,8 @@
 #include "io/vtu.h"
 #include "pipeline/output_files.h"
 #include "pipeline/problem_checks.h"
+#include "pipeline/result_files.h"
+#include "result/curved_faces.h"
 #include "result/iso_surface_refine.h"
 #include "simp/density_filter.h"
 
@@ -52,6 +54,7 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
                   {"collapses", sr.collapses},
                   {"flips", sr.flips},
                   {"moves", sr.moves},
+                  {"splits", sr.splits},
                   {"remesh_undone", sr.remesh_undone}};
   const result::HygieneReport& h = r.hygiene;
   json apart = json::array();
@@ -192,7 +195,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
                                   const result::SmoothParams& smooth, double* threshold_used,
                                   const std::vector<char>& anchors, const result::HygieneParams& hygiene,
                                   result::HygieneReport* report, VecXd* design, const Progress& progress,
-                                  result::DesignSurfaceReport* surface_report) {
+                                  result::DesignSurfaceReport* surface_report, const result::SourceFaces* source) {
   const double t = threshold > 0
                        ? threshold
                        : result::threshold_for_volume(mesh, result::node_densities(mesh, density), volume_fraction);
@@ -209,7 +212,8 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   } else {
     s = result::extract_iso_surface(mesh, nd, t, margin);
   }
-  const result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth);
+  const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
+  const result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
   refuse_invalid(finished.check, t, smooth.repair, progress);
   if (surface_report) *surface_report = finished;
   if (report) *report = std::move(found);
@@ -254,8 +258,12 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
   const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;
-  r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold,
-                             anchor_nodes(mesh, job), set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report);
+  // the input's curved faces (read again from the job's files; none without them): splits inside
+  // them put their points on the true surfaces
+  const result::SourceFaces source = source_faces(job);
+  r.surface =
+      result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold, anchor_nodes(mesh, job),
+                     set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report, &source);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();

@@ -14,6 +14,10 @@
 #include "result/smoothing.h"
 #include "simp/optimizer.h"
 
+namespace topopt::result {
+class SourceFaces;  // result/step_export_analytic.h
+}  // namespace topopt::result
+
 namespace topopt::pipeline {
 
 /// The SIMP run of optimize_job, with simp::optimize's arguments and answer: simp::optimize
@@ -70,12 +74,14 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 /// densities) and `surface_report` are optional outputs; the report's warnings are also given
 /// to progress.warn. Throws Error(MeshingFailed) naming the threshold when the finished
 /// surface is open or still crosses itself (with smooth.repair off a crossing surface is
-/// returned with a warning instead).
+/// returned with a warning instead). `source` (optional): the input's curved faces; with it the
+/// remeshing may split edges inside Ω's curved faces, the new points on their true surfaces.
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used = nullptr,
                                   const std::vector<char>& anchors = {}, const result::HygieneParams& hygiene = {},
                                   result::HygieneReport* report = nullptr, VecXd* design = nullptr,
-                                  const Progress& progress = {}, result::DesignSurfaceReport* surface_report = nullptr);
+                                  const Progress& progress = {}, result::DesignSurfaceReport* surface_report = nullptr,
+                                  const result::SourceFaces* source = nullptr);
 
 /// Writes DIR/density.vtu (fields "density", SIMP's, and "design", after hygiene),
 /// DIR/history.csv, DIR/history.json (with the hygiene report under "design") and

@@ -12,22 +12,24 @@ constexpr double kMinDesignAngle = 10.0;
 
 /// Remeshes s, and keeps the remeshed surface only when it crosses nothing (a flip across a
 /// bent edge, a collapse or a move can fold the surface onto a neighbour); counts into report.
-void remesh_unless_crossing(TriSurface& s, const RemeshParams& params, DesignSurfaceReport& report) {
+void remesh_unless_crossing(TriSurface& s, const RemeshParams& params, const FaceProjector& onto,
+                            DesignSurfaceReport& report) {
   TriSurface kept = s;
-  const RemeshReport r = remesh_surface(s, params);
+  const RemeshReport r = remesh_surface(s, params, onto);
   if (!mesh::self_intersections(s.V, s.F, 1).empty()) {
     s = std::move(kept);
     ++report.remesh_undone;
     return;
   }
-  report.collapses += r.collapses, report.flips += r.flips, report.moves += r.moves;
+  report.collapses += r.collapses, report.flips += r.flips, report.moves += r.moves, report.splits += r.splits;
 }
 
 }  // namespace
 
-DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smooth, const RemeshParams& remesh) {
+DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smooth, const RemeshParams& remesh,
+                                          const FaceProjector& onto) {
   DesignSurfaceReport report;
-  if (smooth.remesh) remesh_unless_crossing(s, remesh, report);
+  if (smooth.remesh) remesh_unless_crossing(s, remesh, onto, report);
   MatX3d before = s.V;
   if (smooth.iterations > 0) {
     smooth_surface(s, smooth);
@@ -37,7 +39,7 @@ DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smo
     if (smooth.repair) unsharpen(s, before, kMinDesignAngle);
     if (smooth.repair && !mesh::self_intersections(s.V, s.F, 1).empty()) untangle(s, before);
     // smoothing bent some triangles: flip, collapse and move again
-    if (smooth.remesh) remesh_unless_crossing(s, remesh, report);
+    if (smooth.remesh) remesh_unless_crossing(s, remesh, onto, report);
   }
   report.check = check_result(s);
   return report;

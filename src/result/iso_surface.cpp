@@ -263,7 +263,8 @@ class IsoSurfaceBuilder {
     }
   }
 
-  /// For each node, the nodes across its design-tet edges with the other sign of the level.
+  /// For each node, the nodes across its design-tet edges with the other sign of the level,
+  /// sorted, each once (an edge belongs to several tets).
   std::vector<std::vector<int>> crossed_neighbours() const {
     std::vector<std::vector<int>> out(values_.size());
     for (long t = 0; t < mesh_.T.rows(); ++t)
@@ -273,6 +274,10 @@ class IsoSurfaceBuilder {
           if ((values_[a] > 0) == (values_[b] > 0)) continue;
           out[a].push_back(b), out[b].push_back(a);
         }
+    for (std::vector<int>& nb : out) {
+      std::sort(nb.begin(), nb.end());
+      nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
     return out;
   }
 

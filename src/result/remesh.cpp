@@ -25,8 +25,8 @@ Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
 /// The surface as editable triangles with each point's triangles.
 class Remesher {
  public:
-  Remesher(TriSurface& s, const RemeshParams& p)
-      : s_(s), p_(p), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
+  Remesher(TriSurface& s, const RemeshParams& p, const FaceProjector& onto)
+      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
     if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
   }
 
@@ -84,27 +84,65 @@ class Remesher {
     return angle(t) < p_.split_angle ? split_needle(t) : 0;
   }
 
-  /// The lock and cut-line face of a point at the midpoint of edge ab, or false when ab may not
-  /// be split: its two triangles on the free-form region (a free point), on one planar Ω face
-  /// (inside it), one free-form and one on a planar face (on the face's cut line), or on two
-  /// planar faces (on the edge between them; the midpoint lies on both planes). Curved Ω faces
-  /// and non-design faces keep their edges.
-  bool split_point(int a, int b, int& lock, int& face) const {
+  /// Where a point splitting edge ab goes (`at`), its lock and cut-line face, or false when ab
+  /// may not be split: its two triangles on the free-form region (a free point at the midpoint),
+  /// on one planar Ω face (inside it), one free-form and one on a planar face (on the face's cut
+  /// line), on two planar faces (on the edge between them; the midpoint lies on both planes), on
+  /// one curved Ω face that `onto` knows (the midpoint projected onto its surface), or in one
+  /// plane with a non-design triangle among them (nondesign_split). Other curved faces keep their edges.
+  bool split_point(int a, int b, int& lock, int& face, Eigen::Vector3d& at) const {
     const std::vector<int> e = m_.edge_triangles(a, b);
     if (e.size() != 2 || (!p_.planar_faces && (m_.tag(e[0]) != 0 || m_.tag(e[1]) != 0))) return false;
-    for (int t : e)
-      if (m_.tag(t) < 0 || (m_.tag(t) > 0 && !planar(m_.tag(t)))) return false;
     const int f0 = m_.tag(e[0]), f1 = m_.tag(e[1]);
+    at = 0.5 * (s_.V.row(a) + s_.V.row(b)).transpose();
+    if (f0 < 0 || f1 < 0) return nondesign_split(e, lock, face);
+    if (f0 > 0 && f0 == f1 && !planar(f0)) {  // inside a curved face: onto its surface
+      lock = 1, face = 0;
+      const Eigen::Vector3d mid = at;
+      return onto_ && onto_(f0, at) && (at - mid).norm() < 0.25 * (s_.V.row(a) - s_.V.row(b)).norm();
+    }
+    if (f0 > 0 && f1 > 0 && planar(f0) != planar(f1)) return on_curved_and_plane(f0, f1, a, b, lock, face, at);
+    for (int t : e)
+      if (m_.tag(t) > 0 && !planar(m_.tag(t))) return false;
     lock = (f0 == 0 && f1 == 0) ? 0 : 1;
     face = (f0 == 0) != (f1 == 0) ? std::max(f0, f1) : 0;
     return true;
   }
 
-  /// Adds a point at the midpoint of a and b with the given lock and cut-line face.
-  void add_point(int a, int b, int lock, int face) {
+  /// Whether edge ab on the B-Rep edge between a curved Ω face and a planar one (f0, f1 in either
+  /// order) may be split: the midpoint `at`, projected onto the curved face's surface (`onto`),
+  /// still lies on the planar face's plane to 1e-9 of the edge, so it is a point of both faces (a
+  /// straight line or a circle on a cylinder cut by a plane normal to its axis). The new point is
+  /// a fixed point of Ω's edges (lock 1, on no cut line).
+  bool on_curved_and_plane(int f0, int f1, int a, int b, int& lock, int& face, Eigen::Vector3d& at) const {
+    const int curved = planar(f0) ? f1 : f0, flat = planar(f0) ? f0 : f1;
+    const double len = (s_.V.row(a) - s_.V.row(b)).norm();
+    const Eigen::Vector3d mid = at;
+    lock = 1, face = 0;
+    if (!onto_ || !onto_(curved, at) || (at - mid).norm() > 0.25 * len) return false;
+    const Eigen::Vector4d& plane = s_.face_plane[flat];
+    return std::abs(plane.head<3>().dot(at) - plane[3]) <= 1e-9 * len * plane.head<3>().norm();
+  }
+
+  /// Whether the edge of triangles e (two, at least one non-design) may be split at its midpoint:
+  /// both triangles lie in one plane (to kCoplanar) and the other is non-design or on a planar Ω
+  /// face (the border of a non-design footprint on it), so the midpoint lies on the non-design
+  /// solid's face as it was. The new point is a fixed non-design point (lock 2).
+  bool nondesign_split(const std::vector<int>& e, int& lock, int& face) const {
+    if (!p_.planar_faces) return false;
+    for (int t : e)
+      if (m_.tag(t) == 0 || (m_.tag(t) > 0 && !planar(m_.tag(t)))) return false;
+    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(e[0])), n1 = normal_of(s_.V, m_.tri(e[1]));
+    if (n0.norm() == 0 || n1.norm() == 0 || n0.normalized().dot(n1.normalized()) < 1 - kCoplanar) return false;
+    lock = 2, face = 0;
+    return true;
+  }
+
+  /// Adds a point at `at` with the given lock and cut-line face.
+  void add_point(const Eigen::Vector3d& at, int lock, int face) {
     const long n = s_.V.rows();
     s_.V.conservativeResize(n + 1, 3), s_.lock.conservativeResize(n + 1), s_.point_face.conservativeResize(n + 1);
-    s_.V.row(n) = 0.5 * (s_.V.row(a) + s_.V.row(b));
+    s_.V.row(n) = at.transpose();
     s_.lock[n] = lock, s_.point_face[n] = face;
   }
 
@@ -123,30 +161,56 @@ class Remesher {
     int a = q[k], b = q[(k + 1) % 3], c = q[(k + 2) % 3];
     if (len(a, c) > len(a, b)) std::swap(b, c);
     int lock = 0, face = 0;
-    if (!split_point(a, b, lock, face)) return 0;
+    Eigen::Vector3d at;
+    if (!split_point(a, b, lock, face, at)) return 0;
     const std::vector<int> across = m_.edge_triangles(a, c);
     if (across.size() != 2 || m_.tag(across[0]) != m_.tag(across[1])) return 0;  // ac cannot flip
     double worst_before = angle(t);
     for (int u : m_.edge_triangles(a, b)) worst_before = std::min(worst_before, angle(u));
     for (int u : across) worst_before = std::min(worst_before, angle(u));
-    add_point(a, b, lock, face);
+    add_point(at, lock, face);
     const int p = m_.split_edge(a, b);
+    std::vector<int> flipped_to;  // the far corners of the edges flipped into edges of p, in order
     const int e = m_.third(across[0] == t ? across[1] : across[0], a, c);
-    const bool flipped = flip(a, c);
+    if (flip(a, c)) flipped_to.push_back(e);
+    flip_link(p, flipped_to);
     double worst_after = 180;
     for (int u : m_.star(p)) worst_after = std::min(worst_after, angle(u));
-    if (flipped && worst_after > worst_before + 1e-9) {
+    if (worst_after > worst_before + 1e-9) {
       ++report_.splits;
       return 1;
     }
-    undo_split(p, b, flipped ? e : -1);
+    undo_split(p, b, flipped_to);
     return 0;
   }
 
-  /// Undoes split_needle's split of ab at p (and its flip of ac into pe when e >= 0).
-  void undo_split(int p, int b, int e) {
-    EditableSurface::Flip f;
-    if (e >= 0 && m_.flip_of(p, e, f)) m_.flip(p, e, f), --report_.flips;
+  /// Flips the edges opposite p in its triangles where that raises the smallest angle of the two
+  /// triangles (flip): halving a neighbour of the needle can leave a thin half, which a flip
+  /// towards p's far side mends. Each flip makes an edge from p to the far corner, added to
+  /// `flipped_to`. Two rounds over p's star.
+  void flip_link(int p, std::vector<int>& flipped_to) {
+    for (int round = 0; round < 2; ++round) {
+      const std::vector<int> star = m_.star(p);
+      for (int t : star) {
+        if (!m_.alive(t)) continue;
+        const Tri& q = m_.tri(t);
+        const int k = static_cast<int>(std::find(q.begin(), q.end(), p) - q.begin());
+        const int u = q[(k + 1) % 3], w = q[(k + 2) % 3];
+        const std::vector<int> e = m_.edge_triangles(u, w);
+        if (e.size() != 2) continue;
+        const int x = m_.third(e[0] == t ? e[1] : e[0], u, w);
+        if (flip(u, w)) flipped_to.push_back(x);
+      }
+    }
+  }
+
+  /// Undoes split_needle's split at p: flips back the edges from p to `flipped_to` (latest
+  /// first), then collapses p into b, which gives the triangles as they were.
+  void undo_split(int p, int b, const std::vector<int>& flipped_to) {
+    for (auto x = flipped_to.rbegin(); x != flipped_to.rend(); ++x) {
+      EditableSurface::Flip f;
+      if (m_.flip_of(p, *x, f)) m_.flip(p, *x, f), --report_.flips;
+    }
     if (m_.link_condition(b, p)) m_.collapse(p, b);
   }
 
@@ -340,6 +404,7 @@ class Remesher {
 
   TriSurface& s_;
   const RemeshParams& p_;
+  const FaceProjector& onto_;
   EditableSurface m_;
   int given_points_;  ///< the points s had; split_needle adds points after them
   RemeshReport report_;
@@ -347,8 +412,8 @@ class Remesher {
 
 }  // namespace
 
-RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params) {
-  Remesher r(s, params);
+RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params, const FaceProjector& onto) {
+  Remesher r(s, params, onto);
   r.run();
   return r.finish();
 }

@@ -2,8 +2,11 @@
 // where the level passes close to a mesh node. Edge collapses and edge flips on the
 // free-form region (and on Ω's planar faces, within their plane; flips on Ω's curved faces
 // between triangles bent a little; flips within one plane on the non-design faces) remove
-// them; no point of a non-design solid moves and no point of Ω's faces leaves its face.
+// them, and needles nothing else mends have an edge split (the new point on the face the edge
+// lies on: its plane, or a curved face's true surface); no point of a non-design solid moves and
+// no point of Ω's faces leaves its face.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "result/iso_surface.h"
@@ -24,6 +27,12 @@ struct RemeshParams {
   /// away (0: never split)
   double split_angle = 10;
 };
+
+/// Moves point p (mm) onto the true surface of Ω's face `tag` (> 0) and returns true when that
+/// face is a curved analytic face the projector knows (curved_faces.h makes one from the input's
+/// faces); returns false and leaves p alone for any other tag. Lets a split place its new point on
+/// a curved face rather than on a chord of it.
+using FaceProjector = std::function<bool(int tag, Eigen::Vector3d& p)>;
 
 /// What remesh_surface did.
 struct RemeshReport {
@@ -46,15 +55,19 @@ struct RemeshReport {
 /// within the plane of its triangles, a point inside a planar Ω face within the face's plane, a
 /// cut-line point towards its two neighbours on the line, within the face's plane; and when that
 /// fails too on a needle (below split_angle), splits the needle's longest edge ab at its midpoint
-/// p and flips its other long edge ac, keeping both only when the smallest angle around p beats
-/// the needle's (a needle with a short edge bc whose points may not go: the angle at p in
+/// p, flips its other long edge ac and then the edges opposite p where that helps (a halved
+/// neighbour can be thin), keeping all only when the smallest angle around p beats the replaced
+/// triangles' (else all undone) (a needle with a short edge bc whose points may not go: the angle at p in
 /// (p, b, c) is about twice the one at a). The edge split lies on the free-form region, inside
 /// a planar Ω face, on a planar face's cut line, or between two planar faces (the midpoint is on
-/// the planes); never on a curved Ω face (the surface does not hold the face's geometry, so the
-/// midpoint's distance to it is unknown) nor on a non-design face (its points are the FE
-/// mesh's). Non-design points and points on Ω's edges keep their positions; tags keep their
-/// meaning. Returns the counts and which points stayed (a point added by a split has index -1
-/// in kept_points).
-RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {});
+/// the planes); inside a curved Ω face only when `onto` knows the face (the new point goes onto
+/// its true surface, not the chord's midpoint); on the B-Rep edge between a curved and a planar Ω
+/// face when the midpoint projected onto the curved surface stays on the plane (a straight line or
+/// a circle normal to a cylinder's axis); between two triangles in one plane of which one
+/// or both are non-design (a non-design face or the border of its footprint on a planar Ω face:
+/// the midpoint lies in that plane, and is a fixed non-design point, lock 2). Non-design points
+/// and points on Ω's edges keep their positions; tags keep their meaning. Returns the counts and
+/// which points stayed (a point added by a split has index -1 in kept_points).
+RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {}, const FaceProjector& onto = {});
 
 }  // namespace topopt::result

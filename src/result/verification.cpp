@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include <unordered_map>
 
@@ -17,6 +18,14 @@
 
 namespace topopt::result {
 namespace {
+
+/// v with 4 significant digits ("311.9", "1.234e+05"), as the other messages print figures.
+std::string four_digits(double v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << v;
+  return s.str();
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -316,8 +325,7 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
     progress.warn(
         "verification: the crisp design on the FE mesh (the tets whose mean density reaches the threshold) "
         "does not carry the load (compliance " +
-        std::to_string(v.crisp.compliance) + " N·mm against the result solid's " +
-        std::to_string(v.as_built.compliance) +
+        four_digits(v.crisp.compliance) + " N·mm against the result solid's " + four_digits(v.as_built.compliance) +
         "): members of the result are thinner than one FE tet, as in a design that has not converged. "
         "Raise optimization.max_iterations (MaxIterations in the study) or refine mesh.size");
   return v;

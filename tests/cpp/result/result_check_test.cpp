@@ -12,6 +12,7 @@
 #include "result/remesh.h"
 #include "simp/density_filter.h"
 #include "testing/bar_field.h"
+#include "testing/nondesign_distance.h"
 
 namespace topopt::result {
 namespace {
@@ -127,12 +128,20 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
   EXPECT_TRUE(c1.valid()) << c1.crossings.size() << " crossings";
   EXPECT_GT(c1.min_angle_free, c0.min_angle_free);
   EXPECT_NEAR(c1.closed.volume, kept, 0.01 * kept);
-  // non-design points that stay keep their places; points on Ω's boundary may move only within the plane
-  // of every planar Ω face they touch (free points within their triangles' plane)
-  for (size_t i = 0; i < r.kept_points.size(); ++i)
-    if (s.lock[i] == 2) {
+  // non-design points that stay keep their places, those a split added lie on the non-design faces
+  // as they were; points on Ω's boundary may move only within the plane of every planar Ω face they
+  // touch (free points within their triangles' plane)
+  const TriSurface s0 = bar_surface();
+  long added_fixed = 0;
+  for (size_t i = 0; i < r.kept_points.size(); ++i) {
+    if (s.lock[i] != 2) continue;
+    if (r.kept_points[i] >= 0) {
       EXPECT_EQ((s.V.row(i) - V0.row(r.kept_points[i])).norm(), 0.0);
+    } else {
+      ++added_fixed;
+      EXPECT_LT(testing::distance_to_nondesign(s0, s.V.row(i).transpose()), 1e-12) << "point " << i;
     }
+  }
   long on_planes = 0;
   for (long t = 0; t < s.F.rows(); ++t) {
     const int f = s.tag[t];
@@ -166,7 +175,7 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
       EXPECT_GT(normals[k].dot(normals[0]), 1 - 1e-9) << "point " << i;
     }
   }
-  EXPECT_EQ((s.lock.array() == 2).count() + removed, (lock0.array() == 2).count());
+  EXPECT_EQ((s.lock.array() == 2).count() + removed, (lock0.array() == 2).count() + added_fixed);
 }
 
 /// A needle (a, c, b) of 6.3° at a, its short edge bc between two non-design points (lock 2:
@@ -233,6 +242,110 @@ TEST(ResultCheck, RemeshDoesNotSplitOnACurvedFace) {
   const RemeshReport r = remesh_surface(s);
   EXPECT_EQ(r.splits, 0);
   EXPECT_EQ(s.F, F0);
+}
+
+TEST(ResultCheck, RemeshSplitsANeedleOnANonDesignPlaneWithAFixedPoint) {
+  // stuck_needle in one plane (d at (5, 9, 0): the flip of ab would make (c, b, d) a 3° needle) on
+  // a non-design face whose footprint border is bc: (b, c, g) lies on Ω's planar face 6 in the same
+  // plane, g a point of that face. b and c may not go (border points), a may go only into a worse
+  // triangle, flips within the plane do not help; the split of ab puts a fixed non-design point
+  // at its midpoint, in the plane
+  TriSurface s0 = stuck_needle(-1);
+  s0.V.row(3) << 5, 9, 0;
+  s0.tag[3] = 6, s0.lock[5] = 1;
+  s0.face_plane.assign(7, Eigen::Vector4d::Zero());
+  s0.face_plane[6] << 0, 0, 1, 0;
+  ASSERT_LT(smallest_angle(s0), 7.0);
+  TriSurface s = s0;
+  const RemeshReport r = remesh_surface(s);
+  EXPECT_GE(r.splits, 1);
+  EXPECT_GT(smallest_angle(s), 10.0);
+  long added = 0;
+  for (long i = 0; i < s.V.rows(); ++i) {
+    EXPECT_EQ(s.V(i, 2), 0.0) << "point " << i;  // in the face's plane
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
+    } else {
+      ++added;
+      EXPECT_EQ(s.lock[i], 2);
+    }
+  }
+  EXPECT_EQ(added, r.splits - r.collapses);
+  EXPECT_EQ((s.tag.array() == 6).count(), 1);
+  EXPECT_EQ((s.tag.array() == -1).count(), s.F.rows() - 1);
+  // a non-design face bent at ab (stuck_needle's own d, 56° up) is not split: the midpoint of a
+  // crease between two non-design triangles of unknown faces is not known to be on the solid
+  TriSurface bent = stuck_needle(-1);
+  EXPECT_EQ(remesh_surface(bent).splits, 0);
+}
+
+/// The radius of the cylinder (axis x) that needle_on_cylinder lies on.
+constexpr double kCylinderRadius = 40;
+
+/// stuck_needle's layout wrapped onto the cylinder y² + z² = 40² (a plane point (x, y) goes to
+/// (x, 40 sin(y/40), 40 cos(y/40)): lengths along the surface kept), with d at (5, 9) instead (the
+/// flip of ab would make (c, b, d) a 3° needle, so it is not made), on curved Ω face 1: a needle of
+/// 6.3° whose points are all on the face's cut line (none may go or move). The same needle on a
+/// rocker's cylindrical face between an FE node and a B-Rep edge.
+TriSurface needle_on_cylinder() {
+  const double plane[6][2] = {{0, 0}, {10, 0.6}, {10, -0.5}, {5, 9}, {5, -12}, {14, 0}};  // a, b, c, d, e, g
+  MatX3d V(6, 3);
+  for (int i = 0; i < 6; ++i) {
+    const double phi = plane[i][1] / kCylinderRadius;
+    V.row(i) << plane[i][0], kCylinderRadius * std::sin(phi), kCylinderRadius * std::cos(phi);
+  }
+  MatX3i F(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 2, 0, 4, 1, 2, 5;
+  TriSurface s = with_tags(V, F);
+  s.tag.setConstant(1);
+  s.lock.setConstant(1);
+  s.point_face.setConstant(1);
+  s.face_plane.assign(2, Eigen::Vector4d::Zero());
+  return s;
+}
+
+/// The projector onto needle_on_cylinder's face 1: the nearest point of the cylinder.
+bool onto_cylinder(int tag, Eigen::Vector3d& p) {
+  if (tag != 1) return false;
+  const double r = std::hypot(p.y(), p.z());
+  p.y() *= kCylinderRadius / r, p.z() *= kCylinderRadius / r;
+  return true;
+}
+
+TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
+  const TriSurface s0 = needle_on_cylinder();
+  ASSERT_LT(smallest_angle(s0), 7.0);
+  TriSurface unsplit = s0;
+  EXPECT_EQ(remesh_surface(unsplit).splits, 0);  // without the face's geometry, stuck
+  EXPECT_LT(smallest_angle(unsplit), 7.0);
+  TriSurface s = s0;
+  const RemeshReport r = remesh_surface(s, {}, onto_cylinder);
+  EXPECT_GE(r.splits, 1);
+  EXPECT_GT(smallest_angle(s), 10.0);
+  // every point on the cylinder (the given ones unmoved, the added ones projected onto it, not
+  // left at the chord's midpoint, which lies 40 - 40 cos(0.0075 / 2) ≈ 3e-4 inside), on face 1
+  ASSERT_EQ(static_cast<long>(r.kept_points.size()), s.V.rows());
+  long added = 0;
+  for (long i = 0; i < s.V.rows(); ++i) {
+    EXPECT_NEAR(std::hypot(s.V(i, 1), s.V(i, 2)), kCylinderRadius, 1e-9 * kCylinderRadius) << "point " << i;
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
+    } else {
+      ++added;
+      EXPECT_EQ(s.lock[i], 1);
+    }
+  }
+  EXPECT_EQ(added, r.splits - r.collapses);
+  EXPECT_TRUE((s.tag.array() == 1).all());
+  // one oriented patch still, every triangle facing away from the axis
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
+    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
+    const Eigen::Vector3d centre = (a + b + c) / 3;
+    EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
+  }
+  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
