@@ -51,7 +51,7 @@ OverhangProblem overhang_problem(const OverhangControl& p) {
   if (!(p.margin >= 0 && p.margin <= 20 && p.angle + p.margin <= 85))
     return {"margin",
             "must lie in [0, 20] degrees with angle + margin <= 85 (the filter prints for angle + margin so "
-            "that walls at the limit stay printable; default 10), not " +
+            "that walls at the limit stay printable; default 20), not " +
                 std::to_string(p.margin) + " with angle " + std::to_string(p.angle)};
   if (!(p.xi0 > 0 && p.xi0 < 1)) return {"xi0", "must lie in (0, 1) (default 0.5), not " + std::to_string(p.xi0)};
   if (!(p.exponent + std::log(kSupports) / std::log(p.xi0) >= 1))
