@@ -79,7 +79,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   if (params.controls.ties()) progress.info("controls: " + controls_->describe());
   if (params.controls.draw.enabled) {
     const double cell = params.controls.draw.cell > 0 ? params.controls.draw.cell : tolerance;
-    draw_ = std::make_unique<DrawFilter>(design_centroids(mesh, design_), vd_, params.controls.draw, cell);
+    draw_ = std::make_unique<DrawFilter>(mesh, design_, vd_, params.controls.draw, cell);
     progress.info("controls: " + draw_->describe());
   }
   if (params.controls.overhang.enabled) {

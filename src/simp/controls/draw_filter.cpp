@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "simp/controls/design_map.h"
 
 namespace topopt::simp {
 
@@ -35,10 +36,25 @@ double smooth_max(double a, double b, double eps, double* da, double* db) {
   return 0.5 * (a + b + r - std::sqrt(eps));
 }
 
-DrawFilter::DrawFilter(const Eigen::MatrixX3d& centroids, const VecXd& volumes, const DrawDirection& params,
-                       double cell)
+namespace {
+
+TetCastParams tet_cast_params(const DrawDirection& p) {
+  TetCastParams t;
+  t.direction = p.direction;
+  t.split = p.split;
+  t.parting_point = p.parting_point;
+  t.smoothness = p.smoothness;
+  return t;
+}
+
+}  // namespace
+
+DrawFilter::DrawFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volumes,
+                       const DrawDirection& params, double cell)
     : params_(checked(params)),
-      grid_(centroids, volumes, unit_direction(params.direction), cell, params.parting_point, true) {
+      grid_(design_centroids(mesh, design), volumes, unit_direction(params.direction), cell, params.parting_point,
+            true),
+      tets_(mesh, design, tet_cast_params(params)) {
   const Eigen::Vector3d d = params.direction.normalized();
   if (params.split) {
     const double s = params.parting_point.dot(d);
@@ -48,7 +64,10 @@ DrawFilter::DrawFilter(const Eigen::MatrixX3d& centroids, const VecXd& volumes, 
   std::ostringstream log;
   log << "draw direction (" << d.x() << ", " << d.y() << ", " << d.z() << "), "
       << (params.split ? "split at layer " + std::to_string(parting_layer_) : std::string("one-sided")) << ", grid "
-      << grid_.num_columns() << " columns x " << grid_.num_layers() << " layers of " << cell << " mm";
+      << grid_.num_columns() << " columns x " << grid_.num_layers() << " layers of " << cell
+      << " mm, then on the tets (" << tets_.num_pairs() << " face pairs"
+      << (tets_.num_dropped() ? ", " + std::to_string(tets_.num_dropped()) + " dropped in cycles" : std::string())
+      << ")";
   summary_ = log.str();
 }
 
@@ -89,11 +108,14 @@ VecXd DrawFilter::cumulate(const VecXd& g, VecXd* adjoint) const {
   return out;
 }
 
-VecXd DrawFilter::apply(const VecXd& r) const { return grid_.to_elements(cumulate(grid_.to_grid(r), nullptr)); }
+VecXd DrawFilter::apply(const VecXd& r) const {
+  return tets_.apply(grid_.to_elements(cumulate(grid_.to_grid(r), nullptr)));
+}
 
 VecXd DrawFilter::apply_transpose(const VecXd& r, const VecXd& g) const {
-  VecXd adjoint = grid_.to_elements_transpose(g);
-  cumulate(grid_.to_grid(r), &adjoint);
+  const VecXd on_grid = grid_.to_grid(r);
+  VecXd adjoint = grid_.to_elements_transpose(tets_.apply_transpose(grid_.to_elements(cumulate(on_grid, nullptr)), g));
+  cumulate(on_grid, &adjoint);
   return grid_.to_grid_transpose(adjoint);
 }
 

@@ -25,25 +25,8 @@ constexpr double kAnchored = 0.25;
 }
 
 const OverhangControl& checked(const OverhangControl& p) {
-  if (!(p.direction.norm() > 0) || !p.direction.allFinite())
-    bad("direction", "must be a non-zero vector: the build direction, from the base plate upwards");
-  if (!(p.angle >= 10 && p.angle <= 80))
-    bad("angle",
-        "must lie in [10, 80] degrees (the smallest self-supporting angle to the base plate; default 45), not " +
-            std::to_string(p.angle));
-  if (!(p.margin >= 0 && p.margin <= 20 && p.angle + p.margin <= 85))
-    bad("margin",
-        "must lie in [0, 20] degrees with angle + margin <= 85 (the filter prints for angle + margin; "
-        "default 10), not " +
-            std::to_string(p.margin) + " with angle " + std::to_string(p.angle));
-  if (!(p.xi0 > 0 && p.xi0 < 1)) bad("xi0", "must lie in (0, 1) (default 0.5), not " + std::to_string(p.xi0));
-  const double q = p.exponent + std::log(kSupports) / std::log(p.xi0);
-  if (!(q >= 1))
-    bad("exponent", "must exceed 1 + ln 5 / ln(1/xi0) = " + std::to_string(1 - std::log(kSupports) / std::log(p.xi0)) +
-                        " (default 40), not " + std::to_string(p.exponent));
-  if (!(p.smoothness > 0 && p.smoothness <= 0.01))
-    bad("smoothness", "must lie in (0, 0.01] (default 1e-4), not " + std::to_string(p.smoothness));
-  if (p.base_face < 0) bad("base_face", "must be a face of the part (1 for Face1), or 0 for its lowest point");
+  const OverhangProblem problem = overhang_problem(p);
+  if (!problem.key.empty()) bad(problem.key, problem.what);
   return p;
 }
 
@@ -56,6 +39,31 @@ Eigen::MatrixX3d all_centroids(const TetMesh& mesh) {
 }
 
 }  // namespace
+
+OverhangProblem overhang_problem(const OverhangControl& p) {
+  if (!(p.direction.norm() > 0) || !p.direction.allFinite())
+    return {"direction", "must be a non-zero vector: the build direction, from the base plate upwards"};
+  if (!(p.angle >= 10 && p.angle <= 80))
+    return {"angle",
+            "must lie in [10, 80] degrees (the smallest self-supporting angle to the base plate; default 45), "
+            "not " +
+                std::to_string(p.angle)};
+  if (!(p.margin >= 0 && p.margin <= 20 && p.angle + p.margin <= 85))
+    return {"margin",
+            "must lie in [0, 20] degrees with angle + margin <= 85 (the filter prints for angle + margin so "
+            "that walls at the limit stay printable; default 20), not " +
+                std::to_string(p.margin) + " with angle " + std::to_string(p.angle)};
+  if (!(p.xi0 > 0 && p.xi0 < 1)) return {"xi0", "must lie in (0, 1) (default 0.5), not " + std::to_string(p.xi0)};
+  if (!(p.exponent + std::log(kSupports) / std::log(p.xi0) >= 1))
+    return {"exponent",
+            "must exceed 1 + ln 5 / ln(1/xi0) = " + std::to_string(1 - std::log(kSupports) / std::log(p.xi0)) +
+                " (default 40), not " + std::to_string(p.exponent)};
+  if (!(p.smoothness > 0 && p.smoothness <= 0.01))
+    return {"smoothness",
+            "must lie in (0, 0.01] (the ε of the smooth minimum; default 1e-4), not " + std::to_string(p.smoothness)};
+  if (p.base_face < 0) return {"base_face", "must be a face of the part (1 for Face1), or 0 for its lowest point"};
+  return {};
+}
 
 double smooth_support(const double* x, int n, double p, double q, double* dx) {
   double s = 0;

@@ -56,6 +56,19 @@ class OverhangFilter {
   VecXd print(const VecXd& g, VecXd* adjoint) const;
 };
 
+/// A setting of the overhang control out of range: its key under controls.overhang and what
+/// to fix (the allowed range, the default, the value given).
+struct OverhangProblem {
+  std::string key;   ///< "angle", "margin", ...; empty when every setting is valid
+  std::string what;  ///< "must lie in [10, 80] degrees ..., not 95"
+};
+
+/// The one place that decides whether the settings of p are valid (the filter's constructor
+/// throws with it, the job parser reports it under the key's path in the job file): the first
+/// setting out of range, or an empty key. The base face's existence and flatness need the mesh
+/// and are checked by base_plate_height.
+OverhangProblem overhang_problem(const OverhangControl& p);
+
 /// Langelaar's smooth maximum of x[0 … n) (values >= 0): (Σ xᵢ^p)^(1/q), with
 /// q = p + ln 5 / ln ξ₀ it equals ξ₀ when five values equal ξ₀. Its partial derivatives in dx
 /// (n); 0 and zero derivatives when every value is 0.

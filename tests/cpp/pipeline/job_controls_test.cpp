@@ -4,6 +4,7 @@
 
 #include "common/error.h"
 #include "pipeline/job.h"
+#include "simp/controls/overhang_filter.h"
 
 namespace topopt::pipeline {
 namespace {
@@ -94,6 +95,20 @@ TEST(JobControls, OverhangIsParsedAndItsMistakesNamed) {
   EXPECT_EQ(steep.margin, 5);
   expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angle": 80, "margin": 10}})",
                  {"'optimization.controls.overhang.margin'", "angle + margin <= 85"});
+  // one place decides the ranges: the parser reports the filter's own words under the key's path
+  simp::OverhangControl wide;
+  wide.margin = 25;
+  const simp::OverhangProblem problem = simp::overhang_problem(wide);
+  EXPECT_EQ(problem.key, "margin");
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "margin": 25}})",
+                 {"'optimization.controls.overhang.margin'", problem.what});
+  wide = simp::OverhangControl{};
+  wide.angle = 85;
+  wide.margin = 0;
+  EXPECT_EQ(simp::overhang_problem(wide).key, "angle");
+  expect_refused(R"({"overhang": {"direction": [0, 0, 1], "angle": 85}})",
+                 {"'optimization.controls.overhang.angle'", simp::overhang_problem(wide).what});
+  EXPECT_TRUE(simp::overhang_problem(simp::OverhangControl{}).key.empty());
   EXPECT_FALSE(parse_job("{}", "/tmp").optimization.simp.controls.overhang.enabled);
   expect_refused(R"({"overhang": {"angle": 45}})", {"'optimization.controls.overhang.direction'"});
   expect_refused(R"({"overhang": {"direction": [0, 0, 0]}})",

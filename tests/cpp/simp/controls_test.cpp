@@ -16,6 +16,8 @@
 #include "mesh/core/structured_box.h"
 #include "simp/controls/design_map.h"
 #include "simp/controls/draw_filter.h"
+#include "simp/controls/tet_cast.h"
+#include "simp/density_filter.h"
 #include "simp/optimizer.h"
 #include "simp/test_beam.h"
 
@@ -217,36 +219,182 @@ TEST(Controls, DrawDirectionRaysCrossTheBoundaryOnceOrTwice) {
   EXPECT_NEAR(split.history.back().volume_fraction, 0.3, 0.01);
 }
 
+/// The design tets of mesh (all tets outside the non-design solids), in mesh.T's order.
+std::vector<int> design_tets(const TetMesh& mesh) {
+  std::vector<int> d;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain[t] == 0) d.push_back(static_cast<int>(t));
+  return d;
+}
+
+/// #T: the design field z (#D) on every tet, 1 on the non-design tets.
+VecXd on_all_tets(const TetMesh& mesh, const std::vector<int>& design, const VecXd& z) {
+  VecXd all = VecXd::Ones(mesh.T.rows());
+  for (size_t i = 0; i < design.size(); ++i) all[design[i]] = z[i];
+  return all;
+}
+
 TEST(Controls, DrawFilterIsMonotoneAlongTheDirection) {
-  // a 1-D column of 10 elements 1 mm apart along z: the cast field never rises along +z
-  // (one-sided) and, split at z = 5, rises below and falls above; it never exceeds the input's
-  // largest value and keeps a field that is already castable
-  Eigen::MatrixX3d c = Eigen::MatrixX3d::Zero(10, 3);
-  for (int k = 0; k < 10; ++k) c(k, 2) = k + 0.5;
-  const VecXd vol = VecXd::Ones(10);
-  VecXd r(10);
-  r << 0.1, 0.9, 0.2, 0.0, 1.0, 0.0, 0.3, 0.8, 0.0, 0.1;
+  // a column of 10 cubes of 1 mm along z (six tets each), one value per cube: the cast field
+  // never rises along +z (one-sided) and, split at z = 5, rises below and falls above; it never
+  // exceeds the input's largest value and keeps a field that is already castable
+  mesh::StructuredBoxParams box;
+  box.size = {1, 1, 10};
+  box.cells = {1, 1, 10};
+  const TetMesh m = mesh::structured_box_mesh(box);
+  const std::vector<int> design = design_tets(m);
+  const Eigen::MatrixX3d c = design_centroids(m, design);
+  const VecXd vol = tet_volumes(m);
+  const auto per_cube = [&](const std::array<double, 10>& v) {
+    VecXd r(design.size());
+    for (size_t i = 0; i < design.size(); ++i) r[i] = v[static_cast<int>(c(i, 2))];
+    return r;
+  };
+  const auto layer = [&](const VecXd& x, int k, bool largest) {  // the cube's largest or smallest value
+    double v = largest ? -1e300 : 1e300;
+    for (size_t i = 0; i < design.size(); ++i)
+      if (static_cast<int>(c(i, 2)) == k) v = largest ? std::max(v, x[i]) : std::min(v, x[i]);
+    return v;
+  };
+  const VecXd r = per_cube({0.1, 0.9, 0.2, 0.0, 1.0, 0.0, 0.3, 0.8, 0.0, 0.1});
   DrawDirection d;
   d.enabled = true;
   d.smoothness = 1e-6;
-  const VecXd one = DrawFilter(c, vol, d, 1.0).apply(r);
-  const double slack = 0.5 * std::sqrt(d.smoothness) + 1e-12;  // smax(a, b) >= max(a, b) - √ε/2
-  for (int k = 0; k + 1 < 10; ++k) EXPECT_GE(one[k], one[k + 1] - slack) << k;
-  EXPECT_NEAR(one[0], 1.0, 0.01);
+  const VecXd one = DrawFilter(m, design, vol, d, 1.0).apply(r);
+  const double slack = 3 * 0.5 * std::sqrt(d.smoothness) + 1e-12;  // up to three smooth maxima per tet
+  for (int k = 0; k + 1 < 10; ++k) EXPECT_GE(layer(one, k, false), layer(one, k + 1, true) - slack) << k;
+  EXPECT_NEAR(layer(one, 0, false), 1.0, 0.01);
   EXPECT_LE(one.maxCoeff(), 1.0 + 1e-12);
   d.split = true;
   d.parting_point = {0, 0, 5};
-  const VecXd two = DrawFilter(c, vol, d, 1.0).apply(r);
-  for (int k = 0; k + 1 < 5; ++k) EXPECT_LE(two[k], two[k + 1] + slack) << k;
-  for (int k = 5; k + 1 < 10; ++k) EXPECT_GE(two[k], two[k + 1] - slack) << k;
-  EXPECT_NEAR(two[4], 1.0, 0.01);
-  EXPECT_NEAR(two[5], 0.8, 0.01);
-  VecXd castable(10);
-  castable << 1, 1, 1, 0.7, 0.2, 0, 0, 0, 0, 0;
+  const VecXd two = DrawFilter(m, design, vol, d, 1.0).apply(r);
+  for (int k = 0; k + 1 < 5; ++k) EXPECT_LE(layer(two, k, true), layer(two, k + 1, false) + slack) << k;
+  for (int k = 5; k + 1 < 10; ++k) EXPECT_GE(layer(two, k, false), layer(two, k + 1, true) - slack) << k;
+  EXPECT_NEAR(layer(two, 4, false), 1.0, 0.01);
+  EXPECT_NEAR(layer(two, 5, false), 0.8, 0.01);
+  const VecXd castable = per_cube({1, 1, 1, 0.7, 0.2, 0, 0, 0, 0, 0});
   d.split = false;
-  EXPECT_LE((DrawFilter(c, vol, d, 1.0).apply(castable) - castable).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LE((DrawFilter(m, design, vol, d, 1.0).apply(castable) - castable).cwiseAbs().maxCoeff(), slack);
   d.direction = {0, 0, 0};
-  EXPECT_THROW(DrawFilter(c, vol, d, 1.0), Error);
+  EXPECT_THROW(DrawFilter(m, design, vol, d, 1.0), Error);
+}
+
+/// Rays along d through the beam's part x < 28 (the design; the pad is not), started on a grid
+/// of `spacing` across d and sampled every 0.05 mm: calls visit(ray, values along it) with the
+/// values of the per-tet field rho (#T) at the samples inside, in order along d.
+void along_rays(const Beam& b, const VecXd& rho, const Eigen::Vector3d& d, double spacing,
+                const std::function<void(const std::vector<double>&)>& visit) {
+  Eigen::Vector3d u, v;
+  u = d.unitOrthogonal();
+  v = d.cross(u);
+  const Eigen::Vector3d centre(14, 0, 0);
+  for (double a = -20; a <= 20; a += spacing)
+    for (double c = -20; c <= 20; c += spacing) {
+      std::vector<double> values;
+      for (double t = -25; t <= 25; t += 0.05) {
+        const Eigen::Vector3d p = centre + a * u + c * v + t * d;
+        if (p.x() > 1e-3 && p.x() < 28 - 1e-3 && std::abs(p.y()) < 5 - 1e-3 && std::abs(p.z()) < 5 - 1e-3)
+          values.push_back(b.at(rho, p));
+      }
+      if (values.size() > 1) visit(values);
+    }
+}
+
+TEST(Controls, TetCastNeverRisesAlongATurnedDirection) {
+  // a random field cast on the tets along directions turned against the mesh: along every ray
+  // the values never rise above the parting plane (one-sided: anywhere) and never fall below it
+  const Beam b({18, 6, 6});
+  const std::vector<int> design = design_tets(b.mesh);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  VecXd z(design.size());
+  for (long i = 0; i < z.size(); ++i) z[i] = u(rng);
+  // a tet takes the smooth maximum with each tet above it in turn (up to three): each may fall
+  // short of the exact maximum by √ε/2, and a sample step may skip a thin tet: 20 such steps
+  const double eps = 1e-12, slack = 20 * 0.5 * std::sqrt(eps);
+  for (const Eigen::Vector3d& dir :
+       {Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(0.3, 0.2, 0.93), Eigen::Vector3d(0, 0, 1)})
+    for (bool split : {false, true}) {
+      TetCastParams p;
+      p.direction = dir;
+      p.split = split;
+      p.parting_point = {14, 0.5, -0.7};
+      p.smoothness = eps;
+      const TetCast cast(b.mesh, design, p);
+      const VecXd out = on_all_tets(b.mesh, design, cast.apply(z)), raw = on_all_tets(b.mesh, design, z);
+      const Eigen::Vector3d d = dir.normalized();
+      // one-sided: a rise anywhere is wrong; split: a rise after a fall (the values climb to
+      // the parting plane and fall beyond it)
+      const auto wrong = [&](const std::vector<double>& values) {
+        bool fell = !split;
+        for (size_t k = 0; k + 1 < values.size(); ++k) {
+          if (values[k + 1] > values[k] + slack && fell) return true;
+          fell = fell || values[k + 1] < values[k] - slack;
+        }
+        return false;
+      };
+      long rays = 0, bad = 0, raw_bad = 0;
+      along_rays(b, out, d, 0.37, [&](const std::vector<double>& values) { ++rays, bad += wrong(values); });
+      along_rays(b, raw, d, 0.37, [&](const std::vector<double>& values) { raw_bad += wrong(values); });
+      std::cout << "direction " << dir.transpose() << (split ? " split" : " one-sided") << ": " << bad << " of " << rays
+                << " rays wrong (the field before the cast " << raw_bad << "), " << cast.num_pairs() << " pairs, "
+                << cast.num_dropped() << " dropped\n";
+      EXPECT_GT(rays, 100) << dir.transpose();
+      EXPECT_GT(raw_bad, rays / 2) << "the random field should rise along most rays";
+      EXPECT_EQ(bad, 0) << "rays along " << dir.transpose() << (split ? " split" : " one-sided");
+      EXPECT_EQ(cast.num_dropped(), 0) << "a cycle on the structured mesh";
+    }
+}
+/// Share of the rays along d (along_rays, 0.5 mm apart) through the crisp design (rho > 0.5,
+/// #T) that a die drawn along d could not release: one-sided, solid above void; split, solid
+/// → void → solid (a cavity between the two dies' reach). Such a ray crosses the boundary
+/// more than once (one-sided) or twice (split) or in the wrong order.
+double share_not_castable(const Beam& b, const VecXd& rho, const Eigen::Vector3d& d, bool split) {
+  long rays = 0, bad = 0;
+  along_rays(b, rho, d.normalized(), 0.5, [&](const std::vector<double>& values) {
+    ++rays;
+    bool left = !split;  // one-sided: the ray starts in the lower die's solid; any void → solid is wrong
+    for (size_t k = 0; k + 1 < values.size(); ++k) {
+      const bool now = values[k] > 0.5, next = values[k + 1] > 0.5;
+      if (!now && next && left) {
+        ++bad;
+        return;
+      }
+      left = left || (now && !next);
+    }
+  });
+  return rays ? static_cast<double>(bad) / rays : 1.0;
+}
+
+TEST(Controls, DrawDirectionHoldsOnATurnedDirection) {
+  // the grid's columns across the mesh's cells (a direction turned against it, the default
+  // cell: the mean edge length): the tet pass keeps every ray castable on the crisp design
+  Beam b({18, 6, 6});
+  SimpParams p = run_params();
+  const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  p.controls.draw.enabled = true;
+  p.controls.draw.direction = {0.3, 0.2, 0.93};
+  p.controls.draw.smoothness = 1e-6;  // the field is still grey here: values near 0.5 move by √ε/2 per step
+  const SimpResult one = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  p.controls.draw.direction = {1, 1, 0};
+  p.controls.draw.split = true;
+  p.controls.draw.parting_point = {14, 0, 0};
+  const SimpResult split = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  const double one_bad = share_not_castable(b, one.density, {0.3, 0.2, 0.93}, false);
+  const double split_bad = share_not_castable(b, split.density, {1, 1, 0}, true);
+  const double free_one = share_not_castable(b, free_run.density, {0.3, 0.2, 0.93}, false);
+  const double free_split = share_not_castable(b, free_run.density, {1, 1, 0}, true);
+  std::cout << "turned draw direction, rays not castable: one-sided along (0.3, 0.2, 0.93) " << one_bad << " (free "
+            << free_one << "), split along (1, 1, 0) " << split_bad << " (free " << free_split << "); grey "
+            << one.history.back().grey << " / " << split.history.back().grey << "; compliance free "
+            << free_run.history.back().compliance << ", one-sided " << one.history.back().compliance << ", split "
+            << split.history.back().compliance << "\n";
+  EXPECT_LE(one_bad, 0.02);
+  EXPECT_LE(split_bad, 0.02);
+  EXPECT_GE(free_one, 0.1) << "the free design should not be castable along (0.3, 0.2, 0.93) by chance";
+  EXPECT_GE(free_split, 0.1) << "the free design should not be castable along (1, 1, 0) by chance";
+  EXPECT_NEAR(one.history.back().volume_fraction, 0.3, 0.01);
+  EXPECT_NEAR(split.history.back().volume_fraction, 0.3, 0.01);
 }
 
 TEST(Controls, MirroredDesignMatchesItselfOnAnInclinedPlane) {

@@ -2,7 +2,7 @@
 // the printed field keeps what is supported and drops what is not, the lattice transfer works
 // on a lattice turned against the mesh, non-design solids and a picked base face support, bad
 // settings are named, the chain rule against finite differences, and the property on an
-// optimised cantilever: less of its downward-facing surface is flatter than the critical angle
+// optimised beam: less of its downward-facing surface is flatter than the critical angle
 // with the control than without (the issue's ≤ 1 % is not reached: see the test).
 #include <gtest/gtest.h>
 
@@ -65,13 +65,14 @@ OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double ang
 
 /// The property test's settings and bound. NOT the target (<= 1 % with the control):
 /// measured on the result surface the user gets, facets within 3 degrees of the limit not
-/// counted, β at its end (130-144 iterations): 7.7 % with a margin of 10° (the default), 14.7 % with
-/// 5°, 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang"). The test
-/// holds what is reached, with the margin of 10°.
+/// counted, β at its end: 3.0 % with a margin of 20° (the default), 7.7 % with 10°, 14.7 % with
+/// 5°, 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang": what is left is
+/// the mesh's staircase on ceilings next to the pad and at the fixed wall). The test holds
+/// what is reached, with the default margin.
 constexpr int kBeamIterations = 200;
 constexpr double kBeamTolerance = 3;
-constexpr double kBeamMargin = 10;
-constexpr double kBeamShareBound = 0.1;
+constexpr double kBeamMargin = 20;
+constexpr double kBeamShareBound = 0.04;
 
 TEST(Overhang, SmoothMinAndMaxBoundTheExactOnes) {
   double da, db, dx[5];
@@ -365,7 +366,7 @@ TEST(Overhang, BeamHasLessOverhangWithTheControl) {
             << " iterations\n";
   EXPECT_EQ(printed.history.back().beta, 32) << "beta should reach its end";
   EXPECT_LE(with.share(), kBeamShareBound);
-  EXPECT_LE(with.share(), 0.6 * without.share());
+  EXPECT_LE(with.share(), 0.2 * without.share());
   EXPECT_GE(without.share(), 0.2) << "the free design should need supports printed this way";
   EXPECT_NEAR(printed.history.back().volume_fraction, 0.3, 0.01);
   EXPECT_LE(printed.history.back().compliance, 2 * free_run.history.back().compliance);
