@@ -110,28 +110,27 @@ Sizes measure_sizes(const Cantilever& b, const VecXd& crisp, const std::string& 
   return s;
 }
 
-TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
-  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm) with
-  // β run to its end (32), against the free design with a 2 mm filter and against the same
-  // control with the filter normalised over the part (the part's free faces not padded)
+TEST(MemberSize, MinimumSizeThickensTheCleanedResult) {
+  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm, the
+  // part's faces not padded: the default) with β run to its end (32), against the free design
+  // with a 2 mm filter
   Cantilever b({24, 8, 8});
   SimpParams p = run_params();
   const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   p.controls.member.min_size = 4;
   p.max_iterations = 120;
   const SimpResult robust = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  p.controls.member.pad_faces = false;
-  const SimpResult unpadded = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   const Sizes free_s = measure_sizes(b, crisp_after_hygiene(b, free_run.density), "free");
   const Sizes robust_s = measure_sizes(b, crisp_after_hygiene(b, robust.density), "min size 4 mm");
-  const Sizes unpadded_s = measure_sizes(b, crisp_after_hygiene(b, unpadded.density), "min size 4 mm, unpadded");
-  std::cout << "compliance free " << free_run.history.back().compliance << ", min size "
-            << robust.history.back().compliance << " (beta " << robust.history.back().beta << ", grey "
-            << robust.history.back().grey << "), unpadded " << unpadded.history.back().compliance << "\n";
   EXPECT_EQ(robust.history.back().beta, 32) << "the continuation should reach its end";
   EXPECT_LE(robust.history.back().grey, 0.03);
-  EXPECT_GE(robust_s.members.smallest_member, 0.0);
+  // the target (the set size, less a cell for the measure: 2.75 mm) is NOT reached:
+  // 1.25 mm measured, 10.5 % of the solid tets thinner than 2 mm (docs/optimization.md); the
+  // bounds hold what is reached, so that the test fails if the control stops working
+  EXPECT_GE(robust_s.members.smallest_member, 1.0);
+  EXPECT_LE(robust_s.thinner2, 0.15);
   EXPECT_LT(free_s.members.smallest_member, 1.0) << "the free design should hold a thinner member";
+  EXPECT_GE(free_s.thinner2, 0.5);
 }
 
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
