@@ -8,8 +8,11 @@
 #include <cstdint>
 #include <sstream>
 #include <unordered_map>
+#include <unordered_set>
 
+#include "common/face_key.h"
 #include "common/parallel.h"
+#include "common/tet_boundary.h"
 
 namespace topopt::simp {
 namespace {
@@ -37,8 +40,15 @@ class CentroidGrid {
   /// included, d = 0), in increasing j.
   template <class Fn>
   void for_each_neighbour(long i, std::vector<std::pair<int, double>>& scratch, Fn&& fn) const {
+    for_each_near(centre_.row(i), scratch, fn);
+  }
+
+  /// Calls fn(j, d) for every element j whose centroid lies within r of the point p, in
+  /// increasing j. p must lie within one cell of the centroids' bounding box or inside it.
+  template <class Fn>
+  void for_each_near(const Eigen::RowVector3d& p, std::vector<std::pair<int, double>>& scratch, Fn&& fn) const {
     scratch.clear();
-    const std::array<long, 3> c = cell(i);
+    const std::array<long, 3> c = cell_of(p);
     for (long dx = -1; dx <= 1; ++dx)
       for (long dy = -1; dy <= 1; ++dy)
         for (long dz = -1; dz <= 1; ++dz) {
@@ -46,7 +56,7 @@ class CentroidGrid {
           if (it == cells_.end()) continue;
           for (int k = it->second.first; k < it->second.second; ++k) {
             const int j = order_[k];
-            const double d = (centre_.row(j) - centre_.row(i)).norm();
+            const double d = (centre_.row(j) - p).norm();
             if (d < r_) scratch.push_back({j, d});
           }
         }
@@ -55,9 +65,10 @@ class CentroidGrid {
   }
 
  private:
-  std::array<long, 3> cell(long i) const {
+  std::array<long, 3> cell(long i) const { return cell_of(centre_.row(i)); }
+  std::array<long, 3> cell_of(const Eigen::RowVector3d& p) const {
     std::array<long, 3> c;
-    for (int a = 0; a < 3; ++a) c[a] = static_cast<long>(std::floor((centre_(i, a) - lo_[a]) / r_));
+    for (int a = 0; a < 3; ++a) c[a] = static_cast<long>(std::floor((p[a] - lo_[a]) / r_));
     return c;
   }
   /// A cell's exact key: 21 bits an axis (cells −1 .. 2²¹−2, far beyond any mesh/radius ratio).
@@ -77,6 +88,53 @@ class CentroidGrid {
 double weight(FilterKind kind, double r, double d) {
   const double sigma = r / 3.0;
   return kind == FilterKind::Cone ? r - d : std::exp(-d * d / (2 * sigma * sigma));
+}
+
+/// The part's free boundary faces (filter.h, FilterParams::pad_free_faces) as ghost samples of
+/// the void beyond them: per face, layers of thickness h along its outward normal out to the
+/// radius r, a sample at each layer's middle above the face's centroid holding the layer's
+/// volume (face area × h). Returns the samples (#G by 3) and their volumes (#G).
+std::pair<MatX3d, VecXd> void_ghosts(const TetMesh& mesh, const std::vector<int>& design, double r,
+                                     const std::vector<char>& held) {
+  std::unordered_set<FaceKey, FaceKeyHash> fixed;  // faces of non-design tets
+  std::vector<char> is_design(static_cast<size_t>(mesh.T.rows()), 0);
+  for (int t : design) is_design[t] = 1;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (!is_design[t])
+      for (int a = 0; a < 4; ++a)
+        fixed.insert(face_key(mesh.T(t, (a + 1) % 4), mesh.T(t, (a + 2) % 4), mesh.T(t, (a + 3) % 4)));
+  const MatX3i faces = boundary_triangles(mesh.T);
+  const int layers = std::max(2, static_cast<int>(std::ceil(2 * r / std::max(1e-12, mean_edge_length(mesh, design)))));
+  const double h = r / layers;
+  std::vector<Eigen::RowVector3d> at;
+  std::vector<double> vol;
+  for (long f = 0; f < faces.rows(); ++f) {
+    const int a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
+    if (fixed.count(face_key(a, b, c))) continue;
+    if (!held.empty() && held[a] && held[b] && held[c]) continue;
+    const Eigen::RowVector3d n = (mesh.V.row(b) - mesh.V.row(a)).cross(mesh.V.row(c) - mesh.V.row(a));
+    const double area = n.norm() / 2;
+    if (!(area > 0)) continue;
+    const Eigen::RowVector3d centre = (mesh.V.row(a) + mesh.V.row(b) + mesh.V.row(c)) / 3;
+    for (int k = 0; k < layers; ++k) at.push_back(centre + (k + 0.5) * h * n / (2 * area)), vol.push_back(area * h);
+  }
+  MatX3d G(static_cast<long>(at.size()), 3);
+  for (size_t g = 0; g < at.size(); ++g) G.row(static_cast<long>(g)) = at[g];
+  return {G, Eigen::Map<VecXd>(vol.data(), static_cast<long>(vol.size()))};
+}
+
+/// Per design element (centroids `centre`, #D by 3) the kernel mass Σ_g w(d_ig) v_g of the
+/// ghost samples (G, their volumes vg) within r.
+VecXd ghost_mass(const MatX3d& centre, const MatX3d& G, const VecXd& vg, FilterKind kind, double r, int threads) {
+  VecXd mass = VecXd::Zero(centre.rows());
+  if (G.rows() == 0) return mass;
+  const CentroidGrid grid(G, r);
+  parallel_for(centre.rows(), threads, [&](long b, long e) {
+    std::vector<std::pair<int, double>> scratch;
+    for (long i = b; i < e; ++i)
+      grid.for_each_near(centre.row(i), scratch, [&](int g, double d) { mass[i] += weight(kind, r, d) * vg[g]; });
+  });
+  return mass;
 }
 
 }  // namespace
@@ -101,7 +159,7 @@ MatX3d tet_centroids(const TetMesh& mesh) {
 }
 
 DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                             const FilterParams& params)
+                             const FilterParams& params, const std::vector<char>& held)
     : kind_(params.kind == FilterKind::Cone ? "cone" : "Gaussian"), radius_(params.radius) {
   const long nd = static_cast<long>(design.size());
   volume_.resize(nd);
@@ -137,6 +195,11 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
   }
   weighted_sum_ = W_ * volume_;
   plain_sum_ = W_ * VecXd::Ones(nd);
+  padded_ = params.pad_free_faces && r > 0 && nd > 0;
+  if (padded_) {
+    const auto [G, vg] = void_ghosts(mesh, design, r, held);
+    weighted_sum_ += ghost_mass(centre, G, vg, params.kind, r, thread_count(params.threads));
+  }
 }
 
 VecXd DensityFilter::apply(const VecXd& x) const { return (W_ * volume_.cwiseProduct(x)).cwiseQuotient(weighted_sum_); }
@@ -156,6 +219,7 @@ double DensityFilter::mean_neighbours() const {
 std::string DensityFilter::describe() const {
   std::ostringstream s;
   s << kind_ << " filter, radius " << radius_ << " mm, " << mean_neighbours() << " neighbours per element";
+  if (padded_) s << ", free faces padded with void";
   return s.str();
 }
 

@@ -14,8 +14,10 @@ namespace topopt::simp {
 class DensityFilter final : public Filter {
  public:
   /// mesh: the tagged mesh; design: #D indices of the design tets in mesh.T (the order of the
-  /// design variables); volume: #T element volumes; params.kind Gaussian or Cone.
-  DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params);
+  /// design variables); volume: #T element volumes; params.kind Gaussian or Cone; held: #V or
+  /// empty, the nodes whose faces params.pad_free_faces leaves unpadded (filter.h).
+  DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params,
+                const std::vector<char>& held = {});
 
   VecXd apply(const VecXd& x) const override;
   VecXd apply_transpose(const VecXd& g) const override;
@@ -28,10 +30,11 @@ class DensityFilter final : public Filter {
  private:
   Eigen::SparseMatrix<double, Eigen::RowMajor> W_;  // raw weights, symmetric, diagonal included
   VecXd volume_;                                    // #D v_j
-  VecXd weighted_sum_;                              // #D Σ_j w_ij v_j
+  VecXd weighted_sum_;                              // #D Σ_j w_ij v_j (+ the void padding's mass)
   VecXd plain_sum_;                                 // #D Σ_j w_ij
   std::string kind_;
   double radius_ = 0;
+  bool padded_ = false;
 };
 
 /// #T element volumes (positive for positively oriented tets).

@@ -33,10 +33,11 @@ FilterKind choose_filter_kind(FilterKind requested, bool automatic, double pairs
 }
 
 std::unique_ptr<Filter> make_filter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                                    const FilterParams& params, const Progress& progress) {
+                                    const FilterParams& params, const Progress& progress,
+                                    const std::vector<char>& held) {
   if (params.kind == FilterKind::Helmholtz && params.radius > 0)
     return std::make_unique<HelmholtzFilter>(mesh, design, volume, params, progress);
-  return std::make_unique<DensityFilter>(mesh, design, volume, params);
+  return std::make_unique<DensityFilter>(mesh, design, volume, params, held);
 }
 
 }  // namespace topopt::simp

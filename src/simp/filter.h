@@ -35,6 +35,14 @@ struct FilterParams {
   /// length matches the Gaussian's instead of the cone's (helmholtz_length).
   bool like_gaussian = false;
   HelmholtzSolver helmholtz_solver = HelmholtzSolver::Auto;  ///< Helmholtz only
+  /// Explicit kinds: the part's free faces are padded with void. Without it the weights are
+  /// normalised over the part, so next to a face the filter sees a member along it as if
+  /// mirrored there (twice as thick); with it an element's weights are normalised by the mass
+  /// its kernel would have with the part continued as void beyond its free faces (ghost layers
+  /// along each face's outward normal, out to the radius). A face is free unless it belongs to a
+  /// non-design tet or all its nodes are held (make_filter's `held`: supports and loads, whose
+  /// faces the design must keep reaching). The minimum member size sets it (member_size.h).
+  bool pad_free_faces = false;
 };
 
 /// The length ℓ of the Helmholtz filter for a radius r (mm): r/(2√3), Lazarov & Sigmund's match
@@ -80,8 +88,10 @@ FilterKind choose_filter_kind(FilterKind requested, bool automatic, double pairs
 
 /// Builds the filter `params` name. mesh: the tagged mesh; design: #D indices of the design
 /// tets in mesh.T (the order of the design variables); volume: #T element volumes; progress:
-/// cancellation (the Helmholtz filter checks it while it solves).
+/// cancellation (the Helmholtz filter checks it while it solves); held: #V (or empty), nonzero
+/// at the nodes whose faces params.pad_free_faces leaves unpadded.
 std::unique_ptr<Filter> make_filter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                                    const FilterParams& params, const Progress& progress = {});
+                                    const FilterParams& params, const Progress& progress = {},
+                                    const std::vector<char>& held = {});
 
 }  // namespace topopt::simp

@@ -72,7 +72,9 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   FilterParams fp = params.filter;
   fp.radius =
       robust_ ? robust_filter_radius(member.min_size, fp.kind, eta_, fp.like_gaussian) : filter_radius(mesh, fp);
-  filter_ = make_filter(mesh, design_, volume, fp, progress);
+  fp.pad_free_faces = robust_ && member.pad_faces;  // a member along a free face held too (member_size.h)
+  filter_ = make_filter(mesh, design_, volume, fp, progress,
+                        fp.pad_free_faces ? held_nodes(mesh.V.rows(), supports.dofs, loads) : std::vector<char>{});
   progress.info("filter: " + filter_->describe());
   const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
   controls_ = std::make_unique<DesignMap>(mesh, design_, params.controls, tolerance);

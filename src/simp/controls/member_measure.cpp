@@ -2,6 +2,7 @@
 #include "simp/controls/member_measure.h"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <unordered_set>
 
@@ -11,72 +12,123 @@
 namespace topopt::simp {
 namespace {
 
-/// Distance from p to the segment [a, b].
-double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+/// The point of the segment [a, b] nearest to p.
+Eigen::Vector3d segment_closest(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double len2 = ab.squaredNorm();
   const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (p - (a + s * ab)).norm();
+  return a + s * ab;
 }
 
-/// Distance from p to the triangle (a, b, c): to its plane where p projects inside it, else to
-/// the nearest of its edges.
-double triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& c) {
+/// The point of the triangle (a, b, c) nearest to p: p's projection on its plane where that lies
+/// inside it, else the nearest point of its edges.
+Eigen::Vector3d triangle_closest(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 const Eigen::Vector3d& c) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
   const double n2 = n.squaredNorm();
   if (n2 > 0) {
     const Eigen::Vector3d q = p - n * ((p - a).dot(n) / n2);  // p's projection on the plane
     const double u = (b - q).cross(c - q).dot(n), v = (c - q).cross(a - q).dot(n), w = (a - q).cross(b - q).dot(n);
-    if (u >= 0 && v >= 0 && w >= 0) return (p - q).norm();
+    if (u >= 0 && v >= 0 && w >= 0) return q;
   }
-  return std::min({segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+  Eigen::Vector3d best = segment_closest(p, a, b);
+  for (const Eigen::Vector3d& q : {segment_closest(p, b, c), segment_closest(p, c, a)})
+    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+  return best;
 }
 
-/// The boundary triangles of the solid tets (#B by 3), without the part's own boundary unless
-/// `part_boundary`.
-MatX3i solid_boundary(const TetMesh& mesh, const std::vector<int>& solid, bool part_boundary) {
-  MatX4i T(static_cast<long>(solid.size()), 4);
-  for (size_t k = 0; k < solid.size(); ++k) T.row(static_cast<long>(k)) = mesh.T.row(solid[k]);
-  const MatX3i all = boundary_triangles(T);
-  if (part_boundary) return all;
-  std::unordered_set<FaceKey, FaceKeyHash> outer;
-  const MatX3i part = boundary_triangles(mesh.T);
-  for (long f = 0; f < part.rows(); ++f) outer.insert(face_key(part(f, 0), part(f, 1), part(f, 2)));
-  std::vector<long> keep;
-  for (long f = 0; f < all.rows(); ++f)
-    if (!outer.count(face_key(all(f, 0), all(f, 1), all(f, 2)))) keep.push_back(f);
-  MatX3i out(static_cast<long>(keep.size()), 3);
-  for (size_t k = 0; k < keep.size(); ++k) out.row(static_cast<long>(k)) = all.row(keep[k]);
+/// Where the ray p + s u (s > 0, u a unit vector) meets the triangle (a, b, c): s, or +inf
+/// when it misses (Möller–Trumbore).
+double ray_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+               const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, h = u.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d s = p - a, q = s.cross(e1);
+  const double bu = s.dot(h) / det, bv = u.dot(q) / det, t = e2.dot(q) / det;
+  if (bu < 0 || bv < 0 || bu + bv > 1 || t <= 0) return std::numeric_limits<double>::infinity();
+  return t;
+}
+
+/// The rows of F whose node triple is (`keep` true) or is not (false) in `set`.
+MatX3i rows_in(const MatX3i& F, const std::unordered_set<FaceKey, FaceKeyHash>& set, bool keep) {
+  std::vector<long> rows;
+  for (long f = 0; f < F.rows(); ++f)
+    if (static_cast<bool>(set.count(face_key(F(f, 0), F(f, 1), F(f, 2)))) == keep) rows.push_back(f);
+  MatX3i out(static_cast<long>(rows.size()), 3);
+  for (size_t k = 0; k < rows.size(); ++k) out.row(static_cast<long>(k)) = F.row(rows[k]);
   return out;
 }
 
-/// Distance from each point (rows of P) to the nearest triangle of F; `none` where F is empty.
-/// Triangles are skipped when the distance to their centre less their reach cannot beat the best.
-VecXd distance_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, double none) {
-  const long nf = F.rows();
-  MatX3d centre(nf, 3);
-  VecXd reach(nf);
-  for (long f = 0; f < nf; ++f) {
-    centre.row(f) = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3;
-    reach[f] = 0;
-    for (int a = 0; a < 3; ++a) reach[f] = std::max(reach[f], (V.row(F(f, a)) - centre.row(f)).norm());
+/// The boundary triangles of the tets `phase` (#B by 3): with the part's own boundary
+/// (`part_boundary`, the triangles of `part`) or without it.
+MatX3i phase_boundary(const TetMesh& mesh, const std::vector<int>& phase, const MatX3i& part, bool part_boundary) {
+  MatX4i T(static_cast<long>(phase.size()), 4);
+  for (size_t k = 0; k < phase.size(); ++k) T.row(static_cast<long>(k)) = mesh.T.row(phase[k]);
+  const MatX3i all = boundary_triangles(T);
+  if (part_boundary) return all;
+  std::unordered_set<FaceKey, FaceKeyHash> outer;
+  for (long f = 0; f < part.rows(); ++f) outer.insert(face_key(part(f, 0), part(f, 1), part(f, 2)));
+  return rows_in(all, outer, false);
+}
+
+/// The triangles of F (V's rows) as bounding spheres: centres and radii.
+struct Spheres {
+  MatX3d centre;
+  VecXd radius;
+  Spheres(const MatX3d& V, const MatX3i& F) : centre(F.rows(), 3), radius(F.rows()) {
+    for (long f = 0; f < F.rows(); ++f) {
+      centre.row(f) = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3;
+      radius[f] = 0;
+      for (int a = 0; a < 3; ++a) radius[f] = std::max(radius[f], (V.row(F(f, a)) - centre.row(f)).norm());
+    }
   }
+};
+
+/// Distance from each point (rows of P) to the nearest triangle of F; `none` where F is empty.
+/// Q (optional): #P by 3, that nearest point (P's own row where F is empty). Triangles are
+/// skipped when the distance to their centre less their reach cannot beat the best.
+VecXd distance_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, double none, MatX3d* Q = nullptr) {
+  const Spheres sphere(V, F);
   VecXd d = VecXd::Constant(P.rows(), none);
+  if (Q) *Q = P;
   for (long i = 0; i < P.rows(); ++i) {
     const Eigen::Vector3d p = P.row(i).transpose();
-    for (long f = 0; f < nf; ++f) {
-      if ((P.row(i) - centre.row(f)).norm() - reach[f] >= d[i]) continue;
-      d[i] = std::min(d[i], triangle_distance(p, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
-                                              V.row(F(f, 2)).transpose()));
+    for (long f = 0; f < F.rows(); ++f) {
+      if ((P.row(i) - sphere.centre.row(f)).norm() - sphere.radius[f] >= d[i]) continue;
+      const Eigen::Vector3d q =
+          triangle_closest(p, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+      if ((q - p).norm() >= d[i]) continue;
+      d[i] = (q - p).norm();
+      if (Q) Q->row(i) = q.transpose();
     }
   }
   return d;
 }
 
-/// The local thickness of each point: 2 max r_f over the balls (centre C_f, radius r_f) that
-/// hold it within `reach`. Points sorted by x, so each ball visits the points within its x range only.
-VecXd local_thickness(const MatX3d& C, const VecXd& r, double reach) {
+/// Per point p (rows of P) with its direction u (rows of U, unit or zero) the distance along the
+/// ray p + s u to the first triangle of F, at most limit[i] (also where u is zero or the ray
+/// misses). Triangles whose bounding sphere lies beyond the limit or off the ray are skipped.
+VecXd ray_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, const MatX3d& U, const VecXd& limit) {
+  const Spheres sphere(V, F);
+  VecXd s = limit;
+  for (long i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose(), u = U.row(i).transpose();
+    if (u.squaredNorm() == 0) continue;
+    for (long f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d to = sphere.centre.row(f).transpose() - p;
+      if (to.norm() - sphere.radius[f] >= s[i] || (to - to.dot(u) * u).norm() > sphere.radius[f]) continue;
+      s[i] = std::min(
+          s[i], ray_hit(p, u, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose()));
+    }
+  }
+  return s;
+}
+
+/// The local thickness of each point: max w_f over the balls (centre C_f, radius r_f, width w_f)
+/// that hold it within `reach`. Points sorted by x, so each ball visits the points within its x
+/// range only.
+VecXd local_thickness(const MatX3d& C, const VecXd& r, const VecXd& w, double reach) {
   const long n = C.rows();
   std::vector<long> order(static_cast<size_t>(n));
   std::iota(order.begin(), order.end(), 0L);
@@ -88,7 +140,7 @@ VecXd local_thickness(const MatX3d& C, const VecXd& r, double reach) {
     auto k = std::lower_bound(xs.begin(), xs.end(), C(f, 0) - r[f] - reach) - xs.begin();
     for (; k < n && xs[k] <= C(f, 0) + r[f] + reach; ++k) {
       const long e = order[k];
-      if ((C.row(e) - C.row(f)).norm() <= r[f] + reach) t[e] = std::max(t[e], 2 * r[f]);
+      if ((C.row(e) - C.row(f)).norm() <= r[f] + reach) t[e] = std::max(t[e], w[f]);
     }
   }
   return t;
@@ -98,26 +150,41 @@ VecXd local_thickness(const MatX3d& C, const VecXd& r, double reach) {
 
 MemberMeasure measure_members(const TetMesh& mesh, const VecXd& density, const MemberMeasureParams& params) {
   const long nt = mesh.T.rows();
-  std::vector<int> solid;
+  auto design = [&](long t) { return mesh.domain.size() != nt || mesh.domain[t] == 0; };
+  std::vector<int> phase;
   for (long t = 0; t < nt; ++t)
-    if (density[t] >= params.threshold) solid.push_back(static_cast<int>(t));
-  const long ns = static_cast<long>(solid.size());
+    if (params.gaps ? design(t) && density[t] < params.threshold : density[t] >= params.threshold)
+      phase.push_back(static_cast<int>(t));
+  const long ns = static_cast<long>(phase.size());
   MatX3d C(ns, 3);
   for (long k = 0; k < ns; ++k) {
     C.row(k).setZero();
-    for (int a = 0; a < 4; ++a) C.row(k) += mesh.V.row(mesh.T(solid[k], a)) / 4;
+    for (int a = 0; a < 4; ++a) C.row(k) += mesh.V.row(mesh.T(phase[k], a)) / 4;
   }
   const double diagonal = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
-  const VecXd r = distance_to_triangles(mesh.V, solid_boundary(mesh, solid, params.part_boundary), C, diagonal);
-  const VecXd thick = local_thickness(C, r, params.reach);
+  const MatX3i part = boundary_triangles(mesh.T);
+  const bool wall = params.part_faces == PartFaces::Wall;
+  MatX3d Q;  // each centroid's nearest point of its phase's boundary
+  const VecXd r = distance_to_triangles(mesh.V, phase_boundary(mesh, phase, part, wall), C, diagonal, &Q);
+  VecXd width = 2 * r;
+  if (!wall) {  // clipped: the ball's width inside the part along the way from that point through its centre
+    MatX3d U = C - Q;
+    for (long k = 0; k < ns; ++k)
+      if (r[k] > 0 && r[k] < diagonal)
+        U.row(k) /= r[k];
+      else
+        U.row(k).setZero();
+    width = r + ray_to_triangles(mesh.V, part, C, U, r);
+  }
+  const VecXd thick = local_thickness(C, r, width, params.reach);
   MemberMeasure m;
   m.inscribed = VecXd::Zero(nt);
   m.thickness = VecXd::Zero(nt);
-  m.smallest_member = ns ? diagonal : 0;
+  m.smallest_member = ns ? 2 * diagonal : 0;
   for (long k = 0; k < ns; ++k) {
-    const int t = solid[k];
+    const int t = phase[k];
     m.inscribed[t] = r[k], m.thickness[t] = thick[k];
-    if (mesh.domain.size() == nt && mesh.domain[t] != 0) continue;
+    if (!design(t)) continue;
     ++m.solid_design;
     m.smallest_member = std::min(m.smallest_member, thick[k]);
     m.largest_ball = std::max(m.largest_ball, 2 * r[k]);

@@ -83,6 +83,14 @@ double robust_filter_radius(double min_size, FilterKind kind, const RobustThresh
   return min_size / robust_size_ratio(kind, t, like_gaussian);
 }
 
+std::vector<char> held_nodes(long num_nodes, const std::vector<int>& supported_dofs, const Eigen::MatrixXd& loads) {
+  std::vector<char> held(static_cast<size_t>(num_nodes), 0);
+  for (int dof : supported_dofs) held[dof / 3] = 1;
+  for (long i = 0; i < loads.rows() && i / 3 < num_nodes; ++i)
+    if (loads.row(i).cwiseAbs().maxCoeff() > 0) held[i / 3] = 1;
+  return held;
+}
+
 void check_member_size(const MemberSizeParams& p, double mesh_size, bool projection) {
   auto bad = [](const std::string& key, const std::string& what) {
     throw Error(ErrorCode::InvalidParameter, "controls." + key + " " + what);

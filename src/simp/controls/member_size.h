@@ -48,6 +48,11 @@ double robust_size_ratio(FilterKind kind, const RobustThresholds& t, bool like_g
 /// robust_size_ratio.
 double robust_filter_radius(double min_size, FilterKind kind, const RobustThresholds& t, bool like_gaussian = false);
 
+/// #V flags, nonzero at the nodes that carry a support (`supported_dofs`, 3 per node) or a load
+/// (`loads`, 3#V by cases, nonzero in any case): the faces the minimum size's filter does not pad
+/// with void (FilterParams::pad_free_faces), so the design keeps reaching its supports and loads.
+std::vector<char> held_nodes(long num_nodes, const std::vector<int>& supported_dofs, const Eigen::MatrixXd& loads);
+
 /// Throws Error(InvalidParameter), naming the job key and what to change, for member sizes
 /// that cannot work on a mesh of mean edge length `mesh_size` (mm): a minimum size below two
 /// mesh sizes (a member must span elements), a maximum size below three mesh sizes or not above

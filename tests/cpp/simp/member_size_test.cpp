@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <iostream>
+#include <numeric>
 #include <random>
 
 #include "common/error.h"
@@ -87,35 +89,93 @@ double share_thinner(const TetMesh& mesh, const VecXd& crisp, const MemberMeasur
   return solid ? static_cast<double>(thin) / solid : 0.0;
 }
 
+/// The smallest member and gap of a crisp design (#T) on the beam, the shares of its solid
+/// design tets thinner than 4 and 2 mm, printed under `label`; the measure's reach half a cell.
+struct Sizes {
+  MemberMeasure members, gaps;
+  double thinner4 = 0, thinner2 = 0;
+};
+Sizes measure_sizes(const Cantilever& b, const VecXd& crisp, const std::string& label) {
+  MemberMeasureParams mp;
+  mp.reach = b.cell() / 2;
+  Sizes s;
+  s.members = measure_members(b.mesh, crisp, mp);
+  mp.gaps = true;
+  s.gaps = measure_members(b.mesh, crisp, mp);
+  s.thinner4 = share_thinner(b.mesh, crisp, s.members, 4.0);
+  s.thinner2 = share_thinner(b.mesh, crisp, s.members, 2.0);
+  std::cout << label << ": smallest member " << s.members.smallest_member << " mm, smallest gap "
+            << s.gaps.smallest_member << " mm, " << 100 * s.thinner4
+            << " % of the solid design tets thinner than 4 mm, " << 100 * s.thinner2 << " % thinner than 2 mm\n";
+  return s;
+}
+
 TEST(MemberSize, MinimumSizeThickensTheCleanedResult) {
-  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm) with
-  // β run to its end (32), against the free design with a 2 mm filter
+  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm, the
+  // part's faces not padded: the default) with β run to its end (32), against the free design
+  // with a 2 mm filter
   Cantilever b({24, 8, 8});
   SimpParams p = run_params();
   const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   p.controls.member.min_size = 4;
   p.max_iterations = 120;
   const SimpResult robust = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  MemberMeasureParams mp;
-  mp.reach = b.cell() / 2;
-  const VecXd free_crisp = crisp_after_hygiene(b, free_run.density),
-              robust_crisp = crisp_after_hygiene(b, robust.density);
-  const MemberMeasure free_m = measure_members(b.mesh, free_crisp, mp),
-                      robust_m = measure_members(b.mesh, robust_crisp, mp);
-  const double free_thin = share_thinner(b.mesh, free_crisp, free_m, 2.0),
-               robust_thin = share_thinner(b.mesh, robust_crisp, robust_m, 2.0);
-  std::cout << "smallest member after hygiene: free " << free_m.smallest_member << " mm (" << 100 * free_thin
-            << " % of its solid tets thinner than 2 mm), min size 4 mm: " << robust_m.smallest_member << " mm ("
-            << 100 * robust_thin << " %), beta " << robust.history.back().beta << ", grey "
-            << robust.history.back().grey << "\n";
+  const Sizes free_s = measure_sizes(b, crisp_after_hygiene(b, free_run.density), "free");
+  const Sizes robust_s = measure_sizes(b, crisp_after_hygiene(b, robust.density), "min size 4 mm");
   EXPECT_EQ(robust.history.back().beta, 32) << "the continuation should reach its end";
   EXPECT_LE(robust.history.back().grey, 0.03);
-  // the target, the set size to the mesh size (2.75 mm), is not reached: 1.875 mm
-  // measured, at tets in the bottom layer of cells along the part's face (docs/optimization.md)
-  EXPECT_GE(robust_m.smallest_member, 1.5);
-  EXPECT_LT(free_m.smallest_member, 1.0) << "the free design should hold a thinner member";
-  EXPECT_LE(robust_thin, 0.02);
-  EXPECT_GE(free_thin, 0.3);
+  // the target (the set size, less a cell for the measure: 2.75 mm) is NOT reached:
+  // 1.25 mm measured, 10.5 % of the solid tets thinner than 2 mm (docs/optimization.md); the
+  // bounds hold what is reached, so that the test fails if the control stops working
+  EXPECT_GE(robust_s.members.smallest_member, 1.0);
+  EXPECT_LE(robust_s.thinner2, 0.15);
+  EXPECT_LT(free_s.members.smallest_member, 1.0) << "the free design should hold a thinner member";
+  EXPECT_GE(free_s.thinner2, 0.5);
+}
+
+TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
+  // a 12 mm cube of 1 mm cells, Gaussian filter of radius 3 mm; its face x = 12 held (a support)
+  mesh::StructuredBoxParams box;
+  box.size = {12, 12, 12};
+  box.cells = {12, 12, 12};
+  const TetMesh mesh = mesh::structured_box_mesh(box);
+  std::vector<int> design(static_cast<size_t>(mesh.T.rows()));
+  std::iota(design.begin(), design.end(), 0);
+  std::vector<char> held(static_cast<size_t>(mesh.V.rows()), 0);
+  for (long v = 0; v < mesh.V.rows(); ++v) held[v] = mesh.V(v, 0) > 12 - 1e-9;
+  FilterParams fp;
+  fp.radius = 3;
+  const DensityFilter plain(mesh, design, tet_volumes(mesh), fp);
+  fp.pad_free_faces = true;
+  const DensityFilter padded(mesh, design, tet_volumes(mesh), fp, held);
+  const MatX3d c = tet_centroids(mesh);
+  // the largest filtered value over the central column (y, z within 1 mm of the middle) for x in [lo, hi]
+  auto peak = [&](const VecXd& f, double lo, double hi) {
+    double m = 0;
+    for (long t = 0; t < c.rows(); ++t)
+      if (std::abs(c(t, 1) - 6) < 1 && std::abs(c(t, 2) - 6) < 1 && c(t, 0) > lo && c(t, 0) < hi) m = std::max(m, f[t]);
+    return m;
+  };
+  auto plate = [&](double lo, double hi) {
+    VecXd x(c.rows());
+    for (long t = 0; t < c.rows(); ++t) x[t] = c(t, 0) > lo && c(t, 0) < hi ? 1 : 0;
+    return x;
+  };
+  const VecXd middle = plate(5, 7), face = plate(0, 2);
+  const double middle_peak = padded.apply(middle).maxCoeff();
+  // padded, a 2 mm plate along the free face x = 0 peaks as the same plate in the middle (the
+  // ghost layers stand in for the void beyond the face to a few per cent) ...
+  EXPECT_NEAR(peak(padded.apply(face), 0, 2), middle_peak, 0.05 * middle_peak);
+  // ... normalised over the part it peaks as a plate twice as thick would (the mirror image)
+  EXPECT_GT(peak(plain.apply(face), 0, 2), 1.3 * middle_peak);
+  EXPECT_NEAR(peak(plain.apply(face), 0, 2), peak(plain.apply(plate(4, 8)), 4, 8), 0.05);
+  // a full design: about 1/2 at the free faces, 1 in the middle and at the held face
+  const VecXd full = padded.apply(VecXd::Ones(c.rows()));
+  EXPECT_NEAR(peak(full, 5.5, 6.5), 1.0, 0.02);
+  EXPECT_NEAR(peak(full, 11, 12), 1.0, 0.05);
+  EXPECT_LT(peak(full, 0, 0.4), 0.7);  // the tets whose centroid lies 0.25 mm from the face
+  EXPECT_GT(peak(full, 0, 0.4), 0.45);
+  EXPECT_NE(padded.describe().find("padded"), std::string::npos);
 }
 
 TEST(MemberSize, RatioMatchesTheHelmholtzFiltersClosedForm) {
@@ -188,25 +248,59 @@ TEST(MemberSize, LocalVolumeGradientMatchesFiniteDifferences) {
   EXPECT_LT(local.evaluate(VecXd::Constant(rho.size(), 0.5)), 0);
 }
 
-TEST(MemberSize, MeasureFindsAPlatesThicknessAndTheWidestBall) {
-  // a plate 4 cells (4 mm) thick across a 20 mm cube of 1 mm cells, void around it
+/// A crisp design on a 20 mm cube of 1 mm cells: the tets whose centroid `inside` holds solid.
+VecXd box_design(const TetMesh& mesh, const std::function<bool(const Eigen::RowVector3d&)>& inside) {
+  VecXd rho(mesh.T.rows());
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+    for (int a = 0; a < 4; ++a) c += mesh.V.row(mesh.T(t, a)) / 4;
+    rho[t] = inside(c) ? 1 : 0;
+  }
+  return rho;
+}
+
+TEST(MemberSize, MeasureFindsKnownThicknessesInTheMiddleAndAlongThePartsFace) {
+  // designs of known size on a 20 mm cube of 1 mm cells: each measured to half a cell
   mesh::StructuredBoxParams box;
   box.size = {20, 20, 20};
   box.cells = {20, 20, 20};
   const TetMesh mesh = mesh::structured_box_mesh(box);
-  VecXd rho = VecXd::Zero(mesh.T.rows());
-  for (long t = 0; t < mesh.T.rows(); ++t) {
-    double x = 0;
-    for (int a = 0; a < 4; ++a) x += mesh.V(mesh.T(t, a), 0) / 4;
-    rho[t] = x > 8 && x < 12 ? 1 : 0;
+  MemberMeasureParams mp;
+  mp.reach = 1.0;  // a cell: a tet in a staircase corner or a tooth of the tet staircase lies within it
+  auto smallest = [&](const VecXd& rho, const MemberMeasureParams& p) {
+    return measure_members(mesh, rho, p).smallest_member;
+  };
+  for (double t : {1.0, 2.0, 4.0, 6.0}) {
+    // a plate in the middle, and one against the part's face x = 0: a member along the face is
+    // as thick as it is (a mirror image across the face would read it 2t), and the part's edges
+    // and corners it fills do not read thin
+    const VecXd middle = box_design(mesh, [&](const auto& c) { return c[0] > 8 && c[0] < 8 + t; });
+    const VecXd face = box_design(mesh, [&](const auto& c) { return c[0] < t; });
+    EXPECT_NEAR(smallest(middle, mp), t, 0.5) << "plate of " << t << " mm in the middle";
+    EXPECT_NEAR(smallest(face, mp), t, 0.5) << "plate of " << t << " mm against the part's face";
+    // the same as gaps: a slot of t in the solid, and a void layer of t along the face
+    MemberMeasureParams gaps = mp;
+    gaps.gaps = true;
+    EXPECT_NEAR(smallest((1 - middle.array()).matrix(), gaps), t, 0.5) << "gap of " << t << " mm in the middle";
+    EXPECT_NEAR(smallest((1 - face.array()).matrix(), gaps), t, 0.5) << "gap of " << t << " mm along the face";
   }
-  const MemberMeasure m = measure_members(mesh, rho);
-  EXPECT_NEAR(m.smallest_member, 4.0, 0.5);
-  MemberMeasureParams with_part;
-  with_part.part_boundary = true;
-  const MemberMeasure b = measure_members(mesh, rho, with_part);
-  EXPECT_NEAR(b.largest_ball, 4.0, 0.5);  // the plate's thickness bounds every ball
-  EXPECT_LT(b.smallest_member, 2.0);      // ... and the part's corners the thickness there
+  // square bars of 4 and 6 mm along z, in the middle and in the part's edge x, y = 0: their
+  // width (the section's corners lie within the reach of the inscribed ball)
+  for (double d : {4.0, 6.0}) {
+    const VecXd bar =
+        box_design(mesh, [&](const auto& c) { return std::max(std::abs(c[0] - 10), std::abs(c[1] - 10)) < d / 2; });
+    const VecXd edge = box_design(mesh, [&](const auto& c) { return c[0] < d && c[1] < d; });
+    EXPECT_NEAR(smallest(bar, mp), d, 0.5) << "square bar of " << d << " mm";
+    EXPECT_NEAR(smallest(edge, mp), d, 0.5) << "square bar of " << d << " mm in the part's edge";
+  }
+  // with the part's faces as walls (the maximum size) the plate bounds every ball, and the
+  // part's edges the thickness there
+  MemberMeasureParams walls;
+  walls.part_faces = PartFaces::Wall;
+  const VecXd plate = box_design(mesh, [](const auto& c) { return c[0] > 8 && c[0] < 12; });
+  const MemberMeasure w = measure_members(mesh, plate, walls);
+  EXPECT_NEAR(w.largest_ball, 4.0, 0.5);
+  EXPECT_LT(w.smallest_member, 2.0);
 }
 
 TEST(MemberSize, MaximumSizeHoldsOnTheResultAndIsBrokenWithout) {
@@ -220,7 +314,7 @@ TEST(MemberSize, MaximumSizeHoldsOnTheResultAndIsBrokenWithout) {
   p.controls.member.max_size = size;
   const SimpResult bounded = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   MemberMeasureParams mp;
-  mp.part_boundary = true;
+  mp.part_faces = PartFaces::Wall;
   const MemberMeasure free_m = measure_members(b.mesh, free_run.density, mp);
   const MemberMeasure bounded_m = measure_members(b.mesh, bounded.density, mp);
   std::cout << "widest solid ball: free " << free_m.largest_ball << " mm, max size " << size
