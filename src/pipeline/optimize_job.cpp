@@ -223,7 +223,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
 
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress,
                             const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                            const SimpRunner& runner) {
+                            const SimpRunner& runner, const JobShapes& shapes) {
   const OptimizeSettings& set = job.optimization;
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
@@ -258,9 +258,9 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
   const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;
-  // the input's curved faces (read again from the job's files; none without them): splits inside
-  // them put their points on the true surfaces
-  const result::SourceFaces source = source_faces(job);
+  // the input's curved faces (the run's shapes, else the job's files read again; none without
+  // them): splits inside them put their points on the true surfaces
+  const result::SourceFaces source = source_faces(job, shapes);
   r.surface =
       result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold, anchor_nodes(mesh, job),
                      set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report, &source);

@@ -8,6 +8,7 @@
 
 #include "common/progress.h"
 #include "pipeline/job.h"
+#include "pipeline/job_mesh.h"
 #include "result/design_hygiene.h"
 #include "result/design_surface.h"
 #include "result/iso_surface.h"
@@ -45,10 +46,12 @@ struct OptimizeResult {
 /// filter that would not fit in memory (problem_checks.h); then what fem and simp throw
 /// (NoSupport, Cancelled). runner: the SIMP run (empty: simp::optimize). With
 /// job.optimization.keep_loaded_faces, SIMP sees the loaded_face_layer of the loaded and
-/// supported faces as non-design (solid, density 1; a warning names the faces).
+/// supported faces as non-design (solid, density 1; a warning names the faces). `shapes`: the
+/// run's own part and non-design shapes (empty: the job's files are read again) — their curved
+/// faces let the surface's remeshing put new points on the true surfaces (source_faces).
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {},
-                            const SimpRunner& runner = {});
+                            const SimpRunner& runner = {}, const JobShapes& shapes = {});
 
 /// The faces of Ω a support or a force or pressure of `job` acts on (1-based, ascending;
 /// gravity has none).

@@ -24,7 +24,7 @@ RunResult run_job(const Job& job, const JobShapes& shapes, const Progress& progr
   r.seconds_mesh = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   watched.say("mesh", 1, std::to_string(r.mesh.V.rows()) + " nodes, " + std::to_string(r.mesh.T.rows()) + " tets");
   watched.check_cancel("meshing");
-  r.optimization = optimize_job(job, r.mesh, watched, on_iteration, options.simp);
+  r.optimization = optimize_job(job, r.mesh, watched, on_iteration, options.simp, shapes);
   r.optimization.ranks = options.ranks;
   if (!options.write_outputs) return r;
   r.written = write_optimize_outputs(r.mesh, r.optimization, job.output.directory);
