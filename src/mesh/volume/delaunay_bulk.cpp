@@ -82,42 +82,38 @@ class Tets {
   }
 
   /// Inserts node p, lying in tet t: the tets whose circumsphere holds it strictly (connected,
-  /// never through a wall) are replaced by the star of p on their boundary. Refused, mesh
-  /// unchanged, when p is an existing node, does not see every boundary face strictly (a
-  /// wall in the way) or comes nearer than sqrt(min_dist2) to a node of those faces (the
-  /// only nodes it would be joined to). The new tets go to `created` when given.
-  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0) {
+  /// never through a wall) are replaced by the star of p on their boundary. With `repair`, a
+  /// tet of that cavity with a boundary face p does not see strictly (a wall nearby turns the
+  /// cavity away from p) leaves the cavity, until p sees all of its boundary — the star is
+  /// then valid but not always Delaunay. Refused, mesh unchanged, when p is an existing node,
+  /// does not see every boundary face strictly (without `repair`, or t itself would have to
+  /// leave) or comes nearer than sqrt(min_dist2) to a node of those faces (the only nodes it
+  /// would be joined to). The new tets go to `created` when given.
+  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0, bool repair = false) {
     const double* q = x(p);
     auto in_sphere = [&](int s) {
       const auto& w = v[s];
       return insphere(x(w[0]), x(w[1]), x(w[2]), x(w[3]), q) > 0;
     };
     if (!in_sphere(t)) return false;
-    ticket_ += 2;
-    const unsigned in = ticket_, out = ticket_ + 1;
-    cavity_.clear(), boundary_.clear();
+    ticket_ += 3;
+    const unsigned in = ticket_ - 2, out = ticket_ - 1;
+    cavity_.clear();
     stamp_[t] = in;
     cavity_.push_back(t);
-    for (size_t k = 0; k < cavity_.size(); ++k) {
-      const int s = cavity_[k];
+    for (size_t k = 0; k < cavity_.size(); ++k)
       for (int i = 0; i < 4; ++i) {
-        const int n = nb[s][i];
-        if (n >= 0 && stamp_[n] == in) continue;
-        if (n >= 0 && stamp_[n] != out && in_sphere(n)) {
-          stamp_[n] = in;
-          cavity_.push_back(n);
-        } else {
-          if (n >= 0) stamp_[n] = out;
-          boundary_.push_back({s, i});
-        }
+        const int n = nb[cavity_[k]][i];
+        if (n < 0 || stamp_[n] == in || stamp_[n] == out) continue;
+        stamp_[n] = in_sphere(n) ? in : out;
+        if (stamp_[n] == in) cavity_.push_back(n);
       }
-    }
+    while (!seen_cavity(t, q, in, out))
+      if (!repair || stamp_[t] != in) return false;
     for (const auto& [s, i] : boundary_) {
       const int* f = kFace[i];
-      const int a = v[s][f[0]], b = v[s][f[1]], c = v[s][f[2]];
-      if (orient3d(x(a), x(b), x(c), q) >= 0) return false;  // p must be strictly inside
       if (min_dist2 > 0)
-        for (int w : {a, b, c})
+        for (int w : {v[s][f[0]], v[s][f[1]], v[s][f[2]]})
           if ((P_[w] - P_[p]).squaredNorm() < min_dist2) return false;
     }
     edges_.clear();
@@ -148,6 +144,37 @@ class Tets {
     for (int s : cavity_) kill(s);
     return true;
   }
+  /// The cavity's boundary faces (boundary_) from its tets (stamped `in`, listed in cavity_,
+  /// connected to t); true when q sees every one strictly. Otherwise the tets with a face q
+  /// does not see are stamped `out`, cavity_ keeps the tets still connected to t through
+  /// tets stamped `in`, and false is returned (t itself may have left).
+  bool seen_cavity(int t, const double* q, unsigned in, unsigned out) {
+    boundary_.clear();
+    bool all = true;
+    for (int s : cavity_)
+      for (int i = 0; i < 4; ++i) {
+        const int n = nb[s][i];
+        if (n >= 0 && stamp_[n] == in) continue;
+        boundary_.push_back({s, i});
+        const int* f = kFace[i];
+        if (orient3d(x(v[s][f[0]]), x(v[s][f[1]]), x(v[s][f[2]]), q) < 0) continue;  // strictly inside
+        all = false;
+        stamp_[s] = out;
+      }
+    if (all || stamp_[t] != in) return all;
+    const unsigned reach = in + 2;  // the tets still in, reached from t
+    const std::vector<int> was = cavity_;
+    cavity_.assign(1, t);
+    stamp_[t] = reach;
+    for (size_t k = 0; k < cavity_.size(); ++k)
+      for (int n : nb[cavity_[k]])
+        if (n >= 0 && stamp_[n] == in) stamp_[n] = reach, cavity_.push_back(n);
+    for (int s : was)
+      if (stamp_[s] == in) stamp_[s] = out;  // cut off from t
+    for (int s : cavity_) stamp_[s] = in;
+    return false;
+  }
+
   /// The tet made last (alive after a successful insertion).
   int last() const { return last_; }
 
@@ -376,10 +403,15 @@ void keep_inside(Tets& m, const HeldBoundary& held, const std::vector<char>& rem
         if (n >= 0 && m.dead[n]) n = -1;
 }
 
-/// Refinement: circumcentres of the tets too large for the size, largest ratio first. The
-/// size at a point: each node of its tet allows its own size (hs) plus kGrading × the
-/// distance to it (a small boundary feature sets the size around it, growing away from it);
-/// the size function, where given, caps that. Returns the points inserted.
+/// Refinement: circumcentres of the tets too large for the size, largest ratio first (a tet
+/// whose circumcentre lies outside the region or behind a hole gets its centroid instead).
+/// Each point is inserted with the cavity repaired (Tets::insert): next to walls the Delaunay
+/// cavity of a point is often not star-shaped from it, and refusing those points left the
+/// tets along the boundary as coarse as the tetrahedralisation of the boundary nodes made
+/// them — NIST 6's slivers (BENCHMARKS.md, issue 20). The size at a point: each node of its
+/// tet allows its own size (hs) plus kGrading × the distance to it (a small boundary feature
+/// sets the size around it, growing away from it); the size function, where given, caps
+/// that. Returns the points inserted.
 long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const DelaunayBulkParams& params,
             const Progress& progress) {
   auto size_at = [&](int t, const Vec3& c) {
@@ -413,14 +445,18 @@ long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const Delaun
     if (++popped % 20000 == 0) progress.check_cancel("volume meshing");
     Vec3 c;
     const double R = circumcentre(m, P, it.t, c);
-    const int t = m.locate(it.t, c.data());
-    if (t < 0) continue;  // outside, or behind a hole
+    int t = m.locate(it.t, c.data());
+    if (t < 0) {  // outside, or behind a hole: the tet's centroid instead
+      const auto& w = m.v[it.t];
+      c = (P[w[0]] + P[w[1]] + P[w[2]] + P[w[3]]) / 4;
+      t = it.t;
+    }
     const double h = size_at(t, c);
     if (R <= params.refine_above * h) continue;
     P.push_back(c);
     hs.push_back(h);
     const int p = static_cast<int>(P.size()) - 1;
-    if (!m.insert(p, t, &created, kClearance * kClearance * h * h)) {
+    if (!m.insert(p, t, &created, kClearance * kClearance * h * h, true)) {
       P.pop_back(), hs.pop_back();
       continue;
     }

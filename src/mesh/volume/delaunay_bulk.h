@@ -1,11 +1,12 @@
 // The bulk of a volume by Delaunay refinement, for the 3D advancing front to finish (the
 // hybrid that Netgen also uses): the Delaunay tetrahedralisation of the boundary's nodes, the
 // tets inside the boundary kept where it contains the boundary triangles, and refined by
-// inserting circumcentres until the tets meet the size. Where a boundary triangle is missing
-// from the tetrahedralisation, every tet that could meet it is left out: the advancing front
-// (volume_front.h) fills those holes from their faces, so the boundary is never recovered
-// by flips or Steiner points and the hybrid is exactly as reliable as the front alone.
-// Every decision goes through the exact predicates.
+// inserting circumcentres (centroids where those lie outside) until the tets meet the size;
+// next to the boundary a point's cavity is cut back to what the point sees, so that the
+// refinement reaches the boundary instead of leaving it the coarse tets of its own nodes. Where a boundary triangle is
+// missing from the tetrahedralisation, every tet that could meet it is left out: the advancing front (volume_front.h)
+// fills those holes from their faces, so the boundary is never recovered by flips or Steiner points and the hybrid is
+// exactly as reliable as the front alone. Every decision goes through the exact predicates.
 #pragma once
 #include <array>
 #include <functional>
