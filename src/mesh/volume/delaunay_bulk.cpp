@@ -20,6 +20,9 @@ using predicates::orient3d;
 
 constexpr auto& kFace = kTetFace;
 
+/// Rounds of taking unseen tets out of a point's cavity before its insertion is refused.
+constexpr int kMaxPeels = 3;
+
 /// A tet mesh with face adjacency (nb[t][i]: the tet across face i, -1 for none: a wall) and
 /// Bowyer–Watson insertion. Slots of removed tets are reused; gen[t] counts the reuses so that
 /// queued references to a slot can tell they are stale.
@@ -82,14 +85,16 @@ class Tets {
   }
 
   /// Inserts node p, lying in tet t: the tets whose circumsphere holds it strictly (connected,
-  /// never through a wall) are replaced by the star of p on their boundary. With `repair`, a
-  /// tet of that cavity with a boundary face p does not see strictly (a wall nearby turns the
-  /// cavity away from p) leaves the cavity, until p sees all of its boundary — the star is
-  /// then valid but not always Delaunay. Refused, mesh unchanged, when p is an existing node,
-  /// does not see every boundary face strictly (without `repair`, or t itself would have to
-  /// leave) or comes nearer than sqrt(min_dist2) to a node of those faces (the only nodes it
-  /// would be joined to). The new tets go to `created` when given.
-  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0, bool repair = false) {
+  /// never through a wall) are replaced by the star of p on their boundary. With repair >= 0
+  /// (a tet of that cavity), a tet of the cavity with a boundary face p does not see strictly
+  /// (a wall nearby turns the cavity away from p) leaves it, until p sees all of its boundary
+  /// (at most kMaxPeels rounds: each costs a pass over the cavity) — the star is then valid
+  /// but not always Delaunay. Refused, mesh unchanged, when p is an
+  /// existing node, does not see every boundary face strictly (without repair, or t or the
+  /// tet `repair` would have to leave: the point is there to remove that tet) or comes
+  /// nearer than sqrt(min_dist2) to a node of those faces (the only nodes it would be joined
+  /// to). The new tets go to `created` when given.
+  bool insert(int p, int t, std::vector<int>* created, double min_dist2 = 0, int repair = -1) {
     const double* q = x(p);
     auto in_sphere = [&](int s) {
       const auto& w = v[s];
@@ -108,8 +113,8 @@ class Tets {
         stamp_[n] = in_sphere(n) ? in : out;
         if (stamp_[n] == in) cavity_.push_back(n);
       }
-    while (!seen_cavity(t, q, in, out))
-      if (!repair || stamp_[t] != in) return false;
+    for (int peel = 0; !seen_cavity(t, q, in, out); ++peel)
+      if (repair < 0 || peel == kMaxPeels || stamp_[t] != in || stamp_[repair] != in) return false;
     for (const auto& [s, i] : boundary_) {
       const int* f = kFace[i];
       if (min_dist2 > 0)
@@ -456,7 +461,7 @@ long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const Delaun
     P.push_back(c);
     hs.push_back(h);
     const int p = static_cast<int>(P.size()) - 1;
-    if (!m.insert(p, t, &created, kClearance * kClearance * h * h, true)) {
+    if (!m.insert(p, t, &created, kClearance * kClearance * h * h, it.t)) {
       P.pop_back(), hs.pop_back();
       continue;
     }
