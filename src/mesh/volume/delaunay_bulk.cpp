@@ -100,6 +100,7 @@ class Tets {
       const auto& w = v[s];
       return insphere(x(w[0]), x(w[1]), x(w[2]), x(w[3]), q) > 0;
     };
+    unseen_ = false;
     if (!in_sphere(t)) return false;
     ticket_ += 3;
     const unsigned in = ticket_ - 2, out = ticket_ - 1;
@@ -113,8 +114,11 @@ class Tets {
         stamp_[n] = in_sphere(n) ? in : out;
         if (stamp_[n] == in) cavity_.push_back(n);
       }
-    for (int peel = 0; !seen_cavity(t, q, in, out); ++peel)
-      if (repair < 0 || peel == kMaxPeels || stamp_[t] != in || stamp_[repair] != in) return false;
+    peels_ = 0;
+    unseen_ = true;
+    for (; !seen_cavity(t, q, in, out); ++peels_)
+      if (repair < 0 || peels_ == kMaxPeels || stamp_[t] != in || stamp_[repair] != in) return false;
+    unseen_ = false;
     for (const auto& [s, i] : boundary_) {
       const int* f = kFace[i];
       if (min_dist2 > 0)
@@ -182,6 +186,10 @@ class Tets {
 
   /// The tet made last (alive after a successful insertion).
   int last() const { return last_; }
+  /// Rounds the last insertion took out of its cavity (0: its Delaunay cavity as it was).
+  int peels() const { return peels_; }
+  /// Whether the last insertion was refused because its point did not see its cavity.
+  bool unseen() const { return unseen_; }
 
  private:
   struct Edge {
@@ -194,7 +202,8 @@ class Tets {
   std::vector<unsigned> stamp_;
   unsigned ticket_ = 0, seed_ = 12345;
   long alive_ = 0;
-  int last_ = -1;
+  int last_ = -1, peels_ = 0;
+  bool unseen_ = false;
 };
 
 /// A new point keeps this × the size from every node it is joined to. A Delaunay cavity's
@@ -409,16 +418,16 @@ void keep_inside(Tets& m, const HeldBoundary& held, const std::vector<char>& rem
 }
 
 /// Refinement: circumcentres of the tets too large for the size, largest ratio first (a tet
-/// whose circumcentre lies outside the region or behind a hole gets its centroid instead).
-/// Each point is inserted with the cavity repaired (Tets::insert): next to walls the Delaunay
-/// cavity of a point is often not star-shaped from it, and refusing those points left the
-/// tets along the boundary as coarse as the tetrahedralisation of the boundary nodes made
-/// them — NIST 6's slivers (BENCHMARKS.md, issue 20). The size at a point: each node of its
-/// tet allows its own size (hs) plus kGrading × the distance to it (a small boundary feature
-/// sets the size around it, growing away from it); the size function, where given, caps
-/// that. Returns the points inserted.
-long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const DelaunayBulkParams& params,
-            const Progress& progress) {
+/// whose circumcentre lies outside the region or behind a hole is left as it is). Each point
+/// is inserted with the cavity repaired (Tets::insert): next to walls the Delaunay cavity of a
+/// point is often not star-shaped from it, and refusing those points left the tets along the
+/// boundary as coarse as the tetrahedralisation of the boundary nodes made them — NIST 6's
+/// slivers (BENCHMARKS.md, issue 20). The size at a point: each node of its tet allows its
+/// own size (hs) plus kGrading × the distance to it (a small boundary feature sets the size
+/// around it, growing away from it); the size function, where given, caps that. Counts the
+/// points inserted, repaired and refused for their cavity in `out`.
+void refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const DelaunayBulkParams& params,
+            const Progress& progress, DelaunayBulkResult& out) {
   auto size_at = [&](int t, const Vec3& c) {
     double h = params.size ? params.size(c.data()) : INFINITY;
     for (int x : m.v[t]) h = std::min(h, hs[x] + kGrading * (P[x] - c).norm());
@@ -442,7 +451,7 @@ long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const Delaun
   for (size_t t = 0; t < m.v.size(); ++t)
     if (!m.dead[t]) consider(static_cast<int>(t));
   std::vector<int> created;
-  long popped = 0, points = 0;
+  long popped = 0;
   while (!work.empty() && m.alive() < params.max_tets) {
     const Item it = work.top();
     work.pop();
@@ -450,25 +459,22 @@ long refine(Tets& m, std::vector<Vec3>& P, std::vector<double>& hs, const Delaun
     if (++popped % 20000 == 0) progress.check_cancel("volume meshing");
     Vec3 c;
     const double R = circumcentre(m, P, it.t, c);
-    int t = m.locate(it.t, c.data());
-    if (t < 0) {  // outside, or behind a hole: the tet's centroid instead
-      const auto& w = m.v[it.t];
-      c = (P[w[0]] + P[w[1]] + P[w[2]] + P[w[3]]) / 4;
-      t = it.t;
-    }
+    const int t = m.locate(it.t, c.data());
+    if (t < 0) continue;  // outside, or behind a hole
     const double h = size_at(t, c);
     if (R <= params.refine_above * h) continue;
     P.push_back(c);
     hs.push_back(h);
     const int p = static_cast<int>(P.size()) - 1;
-    if (!m.insert(p, t, &created, kClearance * kClearance * h * h, it.t)) {
+    if (!m.insert(p, t, &created, kClearance * kClearance * h * h, params.repair_cavities ? it.t : -1)) {
       P.pop_back(), hs.pop_back();
+      out.refused_unseen += m.unseen();
       continue;
     }
-    ++points;
+    ++out.points;
+    out.repaired += m.peels() > 0;
     for (int n : created) consider(n);
   }
-  return points;
 }
 
 }  // namespace
@@ -491,7 +497,7 @@ DelaunayBulkResult delaunay_bulk(std::vector<Vec3>& P, const std::vector<std::ar
     return out;
   }
   keep_inside(m, held, tets_near_missing(m, P, B, held.found), far0);
-  out.points = refine(m, P, hs, params, progress);
+  refine(m, P, hs, params, progress, out);
   for (size_t t = 0; t < m.v.size(); ++t) {
     if (m.dead[t]) continue;
     out.tets.push_back(m.v[t]);
