@@ -87,9 +87,7 @@ TEST(DelaunayBulk, HoldsTheRockersSurfaceAndLiesInside) {
   }
   for (const auto& [f, n] : faces) ASSERT_LE(n, 2) << "a face of the bulk is shared by " << n << " tets";
   // the surface's volume by the divergence theorem
-  double volume = 0;
-  for (long t = 0; t < s.F.rows(); ++t)
-    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const double volume = surface_volume(s.V, s.F);
   EXPECT_LE(sum, volume * (1 + 1e-9));  // no overlap, nothing outside
   EXPECT_GT(sum, 0.99 * volume);
   // refined to the size: a tet is refined while its circumradius exceeds 0.95 h, so an edge
@@ -306,9 +304,7 @@ TEST(DelaunayBulk, HoledPlateFillsWithoutSlivers) {
   VolumeFillParams p;
   p.size = [](const double*) { return 5.0; };
   const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i(), p);
-  double volume = 0;
-  for (long t = 0; t < s.F.rows(); ++t)
-    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const double volume = surface_volume(s.V, s.F);
   check_fill(s.V, s.F, MatX4i(), r, volume);
   TetMesh m;
   m.V = r.V, m.T = r.T;

@@ -87,6 +87,14 @@ inline double winding_number(const MatX3d& V, const MatX3i& F, const Eigen::Vect
   return sum / (4 * M_PI);
 }
 
+/// The volume a closed surface (triangles F on nodes V, normals out) bounds, by the
+/// divergence theorem.
+inline double surface_volume(const MatX3d& V, const MatX3i& F) {
+  double volume = 0;
+  for (long t = 0; t < F.rows(); ++t) volume += V.row(F(t, 0)).dot(V.row(F(t, 1)).cross(V.row(F(t, 2)))) / 6;
+  return volume;
+}
+
 /// Our surface mesh of a part of ../shared/data at its default size (diagonal / 50, also
 /// returned in `size`).
 inline SurfaceMesh default_surface(const std::string& file, double* size = nullptr) {

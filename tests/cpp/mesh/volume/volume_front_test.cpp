@@ -184,9 +184,7 @@ TEST(VolumeFill, RockerAtOneMillimetreMeetsIssueFoursQualityBounds) {
   VolumeFillParams p;
   p.size = [](const double*) { return 1.0; };
   const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i(), p);
-  double volume = 0;
-  for (long t = 0; t < s.F.rows(); ++t)
-    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const double volume = surface_volume(s.V, s.F);
   check_fill(s.V, s.F, MatX4i(), r, volume);
   TetMesh m;
   m.V = r.V, m.T = r.T;
@@ -204,9 +202,7 @@ TEST(VolumeFill, GradesFromAFineBoundaryWithoutASize) {
   // from the boundary's spacing
   const SurfaceMesh s = default_surface("occt/CrankArm.brep");
   ASSERT_TRUE(s.failed_faces.empty());
-  double volume = 0;
-  for (long t = 0; t < s.F.rows(); ++t)
-    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const double volume = surface_volume(s.V, s.F);
   const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i());
   check_fill(s.V, s.F, MatX4i(), r, volume);
   EXPECT_LT(r.T.rows(), 150000);  // about 42 000; the runaway passed a million in 30 s
@@ -218,9 +214,7 @@ TEST(VolumeFill, GradesFromAFineBoundaryWithoutASize) {
 void expect_no_sliver(const std::string& file, double floor = 0.1, double share = 0) {
   const SurfaceMesh s = default_surface(file);
   ASSERT_TRUE(s.failed_faces.empty()) << file;
-  double volume = 0;
-  for (long t = 0; t < s.F.rows(); ++t)
-    volume += s.V.row(s.F(t, 0)).dot(s.V.row(s.F(t, 1)).cross(s.V.row(s.F(t, 2)))) / 6;
+  const double volume = surface_volume(s.V, s.F);
   const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i());
   check_fill(s.V, s.F, MatX4i(), r, volume);
   TetMesh m;
