@@ -42,6 +42,8 @@ struct DelaunayBulkResult {
   long points = 0;             ///< points inserted inside
   long repaired = 0;           ///< of those, points whose cavity was cut back to what they see (not all Delaunay)
   long refused_unseen = 0;     ///< refinement points refused: they did not see their cavity even cut back
+  long refused_poor = 0;       ///< refinement points refused: their cut-back cavity's star had a tet below 0.02
+                               ///< (radius ratio) worse than every tet it would remove
   bool gave_up = false;        ///< over max_missing_share missing: no tets, P as it was
 };
 

@@ -149,7 +149,8 @@ class FrontFill {
     progress_.info("volume: Delaunay bulk of " + std::to_string(tets_.size()) + " tets (" +
                    std::to_string(bulk.points) + " points, " + std::to_string(bulk.repaired) +
                    " with their cavity cut back to what they see, " + std::to_string(bulk.refused_unseen) +
-                   " refused for it); the front fills around " + std::to_string(bulk.missing_triangles) +
+                   " refused for it, " + std::to_string(bulk.refused_poor) +
+                   " for a poor star); the front fills around " + std::to_string(bulk.missing_triangles) +
                    " boundary triangles it did not hold");
     return std::move(bulk.free_faces);  // only these can meet the boundary or T0's faces
   }

@@ -279,13 +279,17 @@ TEST(DelaunayBulk, RefinementPointsNextToWallsGetInWithTheirCavityCutBack) {
   // did not see their Delaunay cavity (a wall turns it away from them) and were refused,
   // leaving the coarse tets of the boundary nodes there (NIST 6 refused 18 195: its slivers,
   // issue 20); cut back, all but a few get in (a point whose cut would lose the tet it is
-  // there to remove, or that needs over kMaxPeels rounds, is still refused)
+  // there to remove, or that needs over kMaxPeels rounds, is still refused); of those that
+  // see it cut back, the ones whose star would hold a tet below 0.02 worse than the tets they
+  // remove are refused for that (43 of 56 here: next to a wall the star is often flat)
   double size = 0;
   const SurfaceMesh rocker = default_surface("examples/rocker.step", &size);
   ASSERT_TRUE(rocker.failed_faces.empty());
   const auto run = bulk_both_ways(rocker.V, rocker.F, size / 2);
   EXPECT_GT(run[0].refused_unseen, 30) << "the rocker no longer makes points that do not see their cavity";
-  EXPECT_GT(run[1].repaired, run[0].refused_unseen / 2);
+  EXPECT_GT(run[1].repaired, 0);
+  EXPECT_GT(run[1].repaired + run[1].refused_poor, run[0].refused_unseen / 2);
+  EXPECT_EQ(run[0].refused_poor, 0);
   EXPECT_LT(run[1].refused_unseen, run[0].refused_unseen / 4);
   EXPECT_GT(run[1].points, run[0].points);
   // the plate built here: fewer such points (its walls are flat or gently curved), none left
