@@ -305,14 +305,7 @@ TEST(DelaunayBulk, HoledPlateFillsWithoutSlivers) {
   // tet below radius ratio 0.1 (issue 20's bound), conformal, the surface's volume
   const SurfaceMesh s = holed_plate_surface();
   ASSERT_TRUE(s.failed_faces.empty());
-  VolumeFillParams p;
-  p.size = [](const double*) { return 5.0; };
-  const VolumeFillResult r = fill_volume(s.V, s.F, MatX4i(), p);
-  const double volume = surface_volume(s.V, s.F);
-  check_fill(s.V, s.F, MatX4i(), r, volume);
-  TetMesh m;
-  m.V = r.V, m.T = r.T;
-  const QualityReport q = tet_quality(m);
+  const QualityReport q = fill_at_size(s.V, s.F, 5.0);
   EXPECT_GE(q.min_radius_ratio, 0.1);
   EXPECT_GT(q.mean_radius_ratio, 0.65);  // 0.687: a 1 mm boundary graded to 5 mm inside
 }
