@@ -187,11 +187,11 @@ def product_parts():
     return out + [("linkrods", os.path.join(data, "occt", "linkrods.step"), None)]
 
 
-def product_row(topopt, part, nd, factor, tmp):
-    """One `topopt mesh --mesher native` on one CPU: its row, or its error."""
+def product_row(topopt, part, nd, factor, tmp, cpu_id=0):
+    """One `topopt mesh --mesher native` on one CPU (cpu_id): its row, or its error."""
     import json, subprocess
     msh, stats = os.path.join(tmp, "m.msh"), os.path.join(tmp, "m.json")
-    cmd = ["taskset", "-c", "0", topopt, "mesh", "--part", part, "--mesher", "native", "--out", msh, "--stats", stats]
+    cmd = ["taskset", "-c", str(cpu_id), topopt, "mesh", "--part", part, "--mesher", "native", "--out", msh, "--stats", stats]
     cmd += ["--non-design", nd] if nd else []
     if factor != 1.0:
         info = json.loads(subprocess.run([topopt, "info", "--part", part, "--json"], capture_output=True, text=True,
@@ -234,7 +234,7 @@ def product(args):
                 for topopt, path in runs:
                     if key in rows[path]:
                         continue
-                    rows[path][key] = product_row(topopt, part, nd, f, tmp)
+                    rows[path][key] = product_row(topopt, part, nd, f, tmp, args.cpu)
                     print(key, topopt, json.dumps(rows[path][key]), file=sys.stderr, flush=True)
                     json.dump(rows[path], open(path, "w"), indent=1)
 
@@ -344,6 +344,7 @@ def main():
     ap.add_argument("--product", help="a topopt executable: its product path on every shared part (see above)")
     ap.add_argument("--before", help="with --product: an older topopt run on each row just before --product")
     ap.add_argument("--factors", default="1.0,0.6", help="with --product: sizes as factors of the default")
+    ap.add_argument("--cpu", type=int, default=0, help="with --product: the CPU the runs are pinned to")
     ap.add_argument("--parts", default="", help="with --product: only these parts (names as in the table)")
     ap.add_argument("--json", default="product.json", help="with --product: rows kept here (a rerun skips them)")
     ap.add_argument("--table", help="old.json,new.json: the two --product runs as one Markdown table")

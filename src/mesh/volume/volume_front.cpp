@@ -147,8 +147,11 @@ class FrontFill {
     tets_ = std::move(bulk.tets);
     for (const Tri& f : bulk.free_faces) covered[face_key(f[0], f[1], f[2])]++;
     progress_.info("volume: Delaunay bulk of " + std::to_string(tets_.size()) + " tets (" +
-                   std::to_string(bulk.points) + " points); the front fills around " +
-                   std::to_string(bulk.missing_triangles) + " boundary triangles it did not hold");
+                   std::to_string(bulk.points) + " points, " + std::to_string(bulk.repaired) +
+                   " with their cavity cut back to what they see, " + std::to_string(bulk.refused_unseen) +
+                   " refused for it, " + std::to_string(bulk.refused_poor) +
+                   " for a poor star); the front fills around " + std::to_string(bulk.missing_triangles) +
+                   " boundary triangles it did not hold");
     return std::move(bulk.free_faces);  // only these can meet the boundary or T0's faces
   }
 

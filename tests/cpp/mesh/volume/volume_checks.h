@@ -11,6 +11,7 @@
 #include "brep/shape_io.h"
 #include "io/msh.h"
 #include "mesh/core/conformity.h"
+#include "mesh/core/tet_quality.h"
 #include "mesh/surface/surface_mesher.h"
 #include "mesh/volume/volume_front.h"
 #include "simp/density_filter.h"
@@ -87,6 +88,14 @@ inline double winding_number(const MatX3d& V, const MatX3i& F, const Eigen::Vect
   return sum / (4 * M_PI);
 }
 
+/// The volume a closed surface (triangles F on nodes V, normals out) bounds, by the
+/// divergence theorem.
+inline double surface_volume(const MatX3d& V, const MatX3i& F) {
+  double volume = 0;
+  for (long t = 0; t < F.rows(); ++t) volume += V.row(F(t, 0)).dot(V.row(F(t, 1)).cross(V.row(F(t, 2)))) / 6;
+  return volume;
+}
+
 /// Our surface mesh of a part of ../shared/data at its default size (diagonal / 50, also
 /// returned in `size`).
 inline SurfaceMesh default_surface(const std::string& file, double* size = nullptr) {
@@ -96,6 +105,20 @@ inline SurfaceMesh default_surface(const std::string& file, double* size = nullp
   sp.size = topo.diagonal() / 50;
   if (size) *size = sp.size;
   return mesh_surface(topo, sp);
+}
+
+/// Fills the closed surface (V: #V by 3, F: #F by 3, outward) with no existing tets at the
+/// uniform edge length `size`, checks the fill (check_fill: against the surface's volume) and
+/// returns the quality of its tets; `tets`, when given, gets their number.
+inline QualityReport fill_at_size(const MatX3d& V, const MatX3i& F, double size, long* tets = nullptr) {
+  VolumeFillParams p;
+  p.size = [size](const double*) { return size; };
+  const VolumeFillResult r = fill_volume(V, F, MatX4i(), p);
+  check_fill(V, F, MatX4i(), r, surface_volume(V, F));
+  if (tets) *tets = r.T.rows();
+  TetMesh m;
+  m.V = r.V, m.T = r.T;
+  return tet_quality(m);
 }
 
 }  // namespace topopt::mesh
