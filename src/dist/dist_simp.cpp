@@ -179,10 +179,8 @@ simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, 
     VecXd dc, dv;
     const double c = problem.compliance(x, dc);
     const double vol = problem.volume_fraction(x, &dv);
-    // ---- update: OC, its multiplier's bisection on the global volume linearised at x (as the
-    // serial loop without controls: simp::linearised_excess), one all-reduce per step
-    const auto excess = simp::linearised_excess(x, dv, vol - params.volume_fraction,
-                                                [&](double local) { return sum_all(session, local); });
+    // ---- update: OC, its multiplier's bisection on the global volume
+    auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn, nullptr) - params.volume_fraction; };
     const VecXd xnew = simp::oc_update(x, dc, dv.cwiseMax(1e-30), moves.at(x), excess);
     const double change = max_all(session, num_design ? (xnew - x).cwiseAbs().maxCoeff() : 0.0);
     simp::IterationRecord rec;

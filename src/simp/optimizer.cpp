@@ -207,15 +207,6 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
   return volume_scale_ * volume_of(project(s.tilde, eta_.dilated));
 }
 
-bool ComplianceProblem::volume_nearly_linear() const {
-  // Measured (BENCHMARKS.md, branch bisect): with the projection alone the linearised step's
-  // volume error stays small; through the draw direction's and the overhang's running maxima it
-  // reached 0.009 and 0.002 at the final β and cost iterations, and with a minimum member size
-  // (the dilated design's rescaled volume) MemberSize.MinimumSizeThickensTheCleanedResult's
-  // thinnest member fell to 1.35 mm (bound 1.5): those bisect on the real volume.
-  return !draw_ && !overhang_ && !robust_;
-}
-
 double ComplianceProblem::grey_share(const VecXd& x) const { return grey_of(physical(x)); }
 
 double ComplianceProblem::last_grey_share() const {
@@ -250,19 +241,11 @@ class DesignUpdate {
   DesignUpdate(const SimpParams& params, int num_design, int num_constraints)
       : params_(params), mma_(num_design, num_constraints, params.move), moves_(move_limits(params, num_design)) {}
 
-  /// The next design from x (#D) with compliance sensitivities dc, the volume fraction vol at x
-  /// and its sensitivities dv (#D) for OC, or the objective and constraints `mma`
-  /// (responses/responses.h) for MMA. OC bisects on the volume linearised at x unless the
-  /// problem says its volume is too nonlinear for that (then on the real volume: a filter
-  /// application and projection per bisection step).
-  VecXd step(const ComplianceProblem& problem, const VecXd& x, double vol, const VecXd& dc, const VecXd& dv,
-             const MmaTerms& mma) {
+  /// The next design from x (#D) with compliance sensitivities dc and volume ones dv (#D) for
+  /// OC, or the objective and constraints `mma` (responses/responses.h) for MMA.
+  VecXd step(const ComplianceProblem& problem, const VecXd& x, const VecXd& dc, const VecXd& dv, const MmaTerms& mma) {
     if (params_.update == UpdateKind::OC) {
-      const double target = params_.volume_fraction;
-      std::function<double(const VecXd&)> excess = [&](const VecXd& xn) {
-        return problem.volume_fraction(xn) - target;
-      };
-      if (problem.volume_nearly_linear()) excess = linearised_excess(x, dv, vol - target);
+      auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params_.volume_fraction; };
       return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess, &multiplier_);
     }
     return mma_.update(x, mma.f0, mma.df0, mma.f, mma.df);
@@ -354,7 +337,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     // ---- update
     MmaTerms mma = params.update == UpdateKind::MMA ? responses.terms(problem, c, dc, vol, dv) : MmaTerms{};
     add_local_volume(problem, local.get(), x, mma);
-    const VecXd xnew = update.step(problem, x, vol, dc, dv, mma);
+    const VecXd xnew = update.step(problem, x, dc, dv, mma);
     IterationRecord rec{it,
                         c,
                         vol,

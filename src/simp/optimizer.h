@@ -99,11 +99,6 @@ class ComplianceProblem {
   double compliance(const VecXd& x, VecXd* dc = nullptr);
   /// Volume fraction of the design domain with the physical densities, and d/dx (#N) if asked.
   double volume_fraction(const VecXd& x, VecXd* dv = nullptr) const;
-  /// Whether OC may bisect on the volume linearised at the current design (linearised_excess in
-  /// update.h) rather than on the real volume of every candidate: the one place that decides.
-  /// True unless a draw direction or an overhang control (running maxima) or a minimum member
-  /// size (the dilated design's rescaled volume) makes the linearisation miss by too much.
-  bool volume_nearly_linear() const;
   /// Physical densities ρ̄ (#D) of x (#N): the design returned (the intermediate one with a
   /// minimum member size).
   VecXd physical(const VecXd& x) const;

@@ -59,12 +59,6 @@ VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& m
   return xnew;
 }
 
-std::function<double(const VecXd&)> linearised_excess(const VecXd& x, const VecXd& dv, double excess_at_x,
-                                                      std::function<double(double)> sum) {
-  if (!sum) sum = [](double v) { return v; };
-  return [x, dv, excess_at_x, sum](const VecXd& xn) { return excess_at_x + sum(dv.dot(xn - x)); };
-}
-
 MoveLimits::MoveLimits(int n, double largest, double smallest, double shrink, double grow)
     : largest_(largest), smallest_(std::min(smallest, largest)), shrink_(shrink), grow_(grow) {
   limit_ = VecXd::Constant(n, largest);

@@ -15,23 +15,10 @@ namespace topopt::simp {
 /// material). The Lagrange multiplier is found by bisection (to 1e-6 relative) so the
 /// constraint is met. multiplier (optional, in/out): the last iteration's multiplier, > 0, to
 /// bracket around (about 24 volume evaluations instead of ~40 from a blind bracket: each is a
-/// filter application with the projection on unless volume_excess is linearised_excess's);
-/// receives this one's. Null or <= 0: a blind bracket from 1e9.
+/// filter application with the projection on); receives this one's. Null or <= 0: a blind
+/// bracket from 1e9.
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
                 const std::function<double(const VecXd&)>& volume_excess, double* multiplier = nullptr);
-
-/// OC's volume constraint linearised at the current design, for oc_update's bisection: the
-/// excess of a candidate x_new is excess_at_x + Σ dv_i (x_new_i − x_i). x: #N current design;
-/// dv: #N gradient of the volume fraction at x (the sensitivity OC already takes);
-/// excess_at_x: the real volume fraction at x minus the target (> 0: too much material);
-/// sum (optional): turns a rank's partial sum into the global one (an MPI all-reduce), the
-/// identity when empty. Returns the excess function. Each bisection step is then one dot
-/// product instead of a filter application and projection of the candidate. The constant term
-/// is the real excess, so a step's linearisation error is corrected at the next iteration and
-/// the volume cannot drift; where the volume is strongly nonlinear in x the step can still miss
-/// the target by that error (ComplianceProblem::volume_nearly_linear decides which to use).
-std::function<double(const VecXd&)> linearised_excess(const VecXd& x, const VecXd& dv, double excess_at_x,
-                                                      std::function<double(double)> sum = {});
 
 /// Move limits per variable for OC that let an oscillating design settle: a variable whose
 /// last two steps went opposite ways gets its limit multiplied by `shrink`, one that kept

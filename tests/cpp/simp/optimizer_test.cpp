@@ -172,57 +172,6 @@ TEST(Simp, OcMeetsTheVolumeAndKeepsNonDesignSolid) {
   EXPECT_LT(r.history.back().compliance, 0.7 * r.history.front().compliance);
 }
 
-/// The design domain's volume fraction of the physical densities of x, summed here from the tet
-/// volumes (not through ComplianceProblem::volume_fraction, the function the update linearises).
-double exact_volume(const Case& c, const ComplianceProblem& prob, const VecXd& x) {
-  const VecXd rho = prob.physical(x), vol = tet_volumes(c.mesh);
-  double kept = 0, total = 0;
-  for (size_t i = 0; i < prob.design().size(); ++i) {
-    kept += vol[prob.design()[i]] * rho[static_cast<long>(i)];
-    total += vol[prob.design()[i]];
-  }
-  return kept / total;
-}
-
-TEST(Simp, OcOnTheLinearisedVolumeMeetsTheTargetAfterAStep) {
-  // OC steps at β = 1 from a random design that misses the target (by about 0.1), each on the
-  // volume linearised at its own design: the bisection costs no filter application, and two
-  // steps bring the real volume to within 0.005. Not asserted because it does not hold: from
-  // this start at β = 4 the error is 0.017 after one step and 0.028 after two (the projection's
-  // curvature; the loop meets it only near a settled design, BENCHMARKS.md branch bisect).
-  Case c = cantilever();
-  SimpParams p;
-  p.volume_fraction = 0.4;
-  p.filter.radius = 5;
-  ComplianceProblem prob(c.mesh, c.mat, c.supports, c.loads, {}, p);
-  ASSERT_TRUE(prob.volume_nearly_linear());
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(0.3, 0.7);
-  VecXd start(prob.num_variables());
-  for (long i = 0; i < start.size(); ++i) start[i] = u(rng);
-  for (double beta : {1.0}) {
-    prob.set_beta(beta);
-    VecXd x = start;
-    double error_before = 0;
-    for (int step = 1; step <= 2; ++step) {
-      VecXd dc, dv;
-      prob.compliance(x, &dc);
-      const double vol = prob.volume_fraction(x, &dv);
-      ASSERT_NEAR(vol, exact_volume(c, prob, x), 1e-12);
-      if (step == 1) {
-        error_before = std::abs(vol - p.volume_fraction);
-        ASSERT_GT(error_before, 0.05) << "the start must miss the target for the test to mean anything";
-      }
-      const auto excess = linearised_excess(x, dv, vol - p.volume_fraction);
-      x = oc_update(x, dc, dv.cwiseMax(1e-30), VecXd::Constant(x.size(), p.move), excess);
-      EXPECT_NEAR(excess(x), 0, 1e-4) << "the bisection meets the linearised volume; beta " << beta;
-    }
-    const double error_after = std::abs(exact_volume(c, prob, x) - p.volume_fraction);
-    EXPECT_LT(error_after, 0.005) << "beta " << beta;
-    EXPECT_LT(error_after, 0.05 * error_before) << "beta " << beta;
-  }
-}
-
 TEST(Simp, MmaReachesAboutTheSameDesignAsOc) {
   Case c = cantilever();
   SimpParams p;
