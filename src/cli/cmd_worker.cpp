@@ -251,10 +251,9 @@ void write_result(const fs::path& dir, const json& result);
 /// the same report (pipeline::add_verification); result.json is written again at the end with
 /// every file.
 void put_result_files_first(json& result, const fs::path& dir, const pipeline::Job& job, const pipeline::RunResult& run,
-                            const pipeline::JobShapes& shapes, std::vector<std::string>& warnings, WorkerChannel& ch,
-                            const Progress& progress) {
+                            std::vector<std::string>& warnings, WorkerChannel& ch, const Progress& progress) {
   pipeline::ResultFiles files =
-      pipeline::write_result_step_first(job, run.optimization, dir.string(), {}, progress, shapes);
+      pipeline::write_result_step_first(job, run.optimization, dir.string(), {}, progress, run.source);
   list_result_files(result, files);
   result["warnings"] = warnings;
   write_result(dir, result);
@@ -266,7 +265,8 @@ void put_result_files_first(json& result, const fs::path& dir, const pipeline::J
 /// optimize: mesh, SIMP and the result shape; iterations are streamed as they come.
 json op_optimize(const Request& r, WorkerChannel& ch) {
   const pipeline::Job job = job_of(r);
-  // the request's shapes, read once: the mesh and result.step's curved faces come from them
+  // the request's shapes, read once: the mesh, the surface's and result.step's curved faces
+  // (run.source) come from them
   const auto [part, nd] = read_shapes(r, ch);
   const pipeline::JobShapes shapes{part, nd};
   std::vector<std::string> warnings;
@@ -292,10 +292,10 @@ json op_optimize(const Request& r, WorkerChannel& ch) {
   put_array(result, r.output, "densities", o.simp.density);
   put_result_surface(result, r.output, o.surface);
   if (job.output.verification && param(r, "result_first", 0) != 0)
-    put_result_files_first(result, r.output, job, run, shapes, warnings, ch, progress);
+    put_result_files_first(result, r.output, job, run, warnings, ch, progress);
   else
-    list_result_files(result,
-                      pipeline::write_result_files(job, run.mesh, run.optimization, r.output, {}, progress, shapes));
+    list_result_files(
+        result, pipeline::write_result_files(job, run.mesh, run.optimization, r.output, {}, progress, run.source));
   result["warnings"] = warnings;  // with those of the last iterate's analysis and the result files
   return result;
 }

@@ -14,7 +14,6 @@
 #include "io/vtu.h"
 #include "pipeline/output_files.h"
 #include "pipeline/problem_checks.h"
-#include "pipeline/result_files.h"
 #include "result/curved_faces.h"
 #include "result/iso_surface_refine.h"
 #include "simp/density_filter.h"
@@ -223,7 +222,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
 
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress,
                             const std::function<void(const simp::IterationRecord&)>& on_iteration,
-                            const SimpRunner& runner, const JobShapes& shapes) {
+                            const SimpRunner& runner, const result::SourceFaces* source) {
   const OptimizeSettings& set = job.optimization;
   if (job.load_cases.empty())
     throw Error(ErrorCode::InvalidParameter, "the job has no load case: add \"load_cases\" with at least one load");
@@ -258,12 +257,9 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
   const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;
-  // the input's curved faces (the run's shapes, else the job's files read again; none without
-  // them): splits inside them put their points on the true surfaces
-  const result::SourceFaces source = source_faces(job, shapes);
   r.surface =
       result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold, anchor_nodes(mesh, job),
-                     set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report, &source);
+                     set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report, source);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();

@@ -8,7 +8,6 @@
 
 #include "common/progress.h"
 #include "pipeline/job.h"
-#include "pipeline/job_mesh.h"
 #include "result/design_hygiene.h"
 #include "result/design_surface.h"
 #include "result/iso_surface.h"
@@ -46,12 +45,12 @@ struct OptimizeResult {
 /// filter that would not fit in memory (problem_checks.h); then what fem and simp throw
 /// (NoSupport, Cancelled). runner: the SIMP run (empty: simp::optimize). With
 /// job.optimization.keep_loaded_faces, SIMP sees the loaded_face_layer of the loaded and
-/// supported faces as non-design (solid, density 1; a warning names the faces). `shapes`: the
-/// run's own part and non-design shapes (empty: the job's files are read again) — their curved
-/// faces let the surface's remeshing put new points on the true surfaces (source_faces).
+/// supported faces as non-design (solid, density 1; a warning names the faces). `source`
+/// (optional): the input's curved faces (pipeline::source_faces, made once per run by run_job),
+/// on whose true surfaces the surface's remeshing puts the points it adds inside them.
 OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress& progress = {},
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {},
-                            const SimpRunner& runner = {}, const JobShapes& shapes = {});
+                            const SimpRunner& runner = {}, const result::SourceFaces* source = nullptr);
 
 /// The faces of Ω a support or a force or pressure of `job` acts on (1-based, ascending;
 /// gravity has none).

@@ -101,7 +101,8 @@ result::SourceFaces source_faces(const Job& job, const JobShapes& shapes, const 
         job.nondesign.empty() ? TopoDS_Shape() : brep::read_shape_file(job.nondesign, "non-design input");
     return {part, nondesign};
   } catch (const Error& e) {
-    progress.warn(std::string("result.step: the part's curved faces stay facets, its files could not be read again: ") +
+    progress.warn(std::string("the part's files could not be read again, so its curved faces stay facets in "
+                              "result.step and the result surface adds no point on them: ") +
                   e.what());
     return {};
   }
@@ -127,7 +128,7 @@ void write_report(ResultFiles& files, const fs::path& dir) {
 
 ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, const std::string& dir,
                                     const ResultFilesParams& params, const Progress& progress,
-                                    const JobShapes& shapes) {
+                                    const result::SourceFaces& source) {
   ResultFiles out;
   if (!job.output.step && !job.output.verification) return out;
   const fs::path d(dir);
@@ -139,7 +140,6 @@ ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, con
         "result.step (the result as a CAD solid)", "step",
         [&]() {
           const std::string path = (d / "result.step").string();
-          const result::SourceFaces source = source_faces(job, shapes, progress);
           out.written.push_back(write_replacing(path, [&](const std::string& p) {
             out.step = result::write_result_step(p, r.surface, params.step, progress, &source);
           }));
@@ -175,8 +175,9 @@ void add_verification(ResultFiles& files, const Job& job, const TetMesh& mesh, c
 }
 
 ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
-                               const ResultFilesParams& params, const Progress& progress, const JobShapes& shapes) {
-  ResultFiles out = write_result_step_first(job, r, dir, params, progress, shapes);
+                               const ResultFilesParams& params, const Progress& progress,
+                               const result::SourceFaces& source) {
+  ResultFiles out = write_result_step_first(job, r, dir, params, progress, source);
   add_verification(out, job, mesh, r, dir, params, progress);
   return out;
 }

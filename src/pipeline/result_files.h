@@ -33,10 +33,11 @@ struct ResultFiles {
   nlohmann::json report = nlohmann::json::object();  ///< verification.json as written last (step, figures, failed)
 };
 
-/// The input's curved analytic faces for result.step (result/step_export_analytic.h): those of
-/// `shapes` when given (the run's own shapes), else of the job's part and non-design files read
-/// again; none (a warning through progress) when the job names no part or its files cannot be
-/// read, so that the STEP is still written, with those faces as facets.
+/// The input's curved analytic faces for the result surface and result.step
+/// (result/step_export_analytic.h): those of `shapes` when given (the run's own shapes), else of
+/// the job's part and non-design files read again; none (a warning through progress) when the
+/// job names no part or its files cannot be read, so that the STEP is still written, with those
+/// faces as facets. run_job makes them once per run (RunResult::source).
 result::SourceFaces source_faces(const Job& job, const JobShapes& shapes = {}, const Progress& progress = {});
 
 /// The job's problem (material, supports, load cases) as the verification solves it.
@@ -46,12 +47,12 @@ result::VerificationProblem verification_problem(const Job& job);
 /// DIR/verification.json for the optimisation `r` on the FE `mesh`; `dir` exists
 /// (prepare_output_folder). verification.json is written whenever either step was asked for,
 /// with what succeeded and the error of what failed. Warnings also go to progress.warn.
-/// The input's curved faces come back as analytic faces (source_faces: `shapes`, or the job's
-/// files). Throws only Error(Cancelled) when progress says so. The same as
+/// The input's curved faces (`source`: source_faces of the run) come back as analytic faces.
+/// Throws only Error(Cancelled) when progress says so. The same as
 /// write_result_step_first followed by add_verification.
 ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const OptimizeResult& r, const std::string& dir,
                                const ResultFilesParams& params = {}, const Progress& progress = {},
-                               const JobShapes& shapes = {});
+                               const result::SourceFaces& source = {});
 
 /// The first part of write_result_files, for a caller that shows the result before it is
 /// verified: DIR/result.step when job.output.step asks for it, and DIR/verification.json
@@ -59,7 +60,7 @@ ResultFiles write_result_files(const Job& job, const TetMesh& mesh, const Optimi
 /// so far; add_verification continues them. Throws only Error(Cancelled).
 ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, const std::string& dir,
                                     const ResultFilesParams& params = {}, const Progress& progress = {},
-                                    const JobShapes& shapes = {});
+                                    const result::SourceFaces& source = {});
 
 /// The second part: when job.output.verification asks for it, verifies `r`'s result solid
 /// against the FE `mesh`, writes DIR/verification.vtu and adds the figures (or the failure)

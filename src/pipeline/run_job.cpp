@@ -24,12 +24,13 @@ RunResult run_job(const Job& job, const JobShapes& shapes, const Progress& progr
   r.seconds_mesh = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   watched.say("mesh", 1, std::to_string(r.mesh.V.rows()) + " nodes, " + std::to_string(r.mesh.T.rows()) + " tets");
   watched.check_cancel("meshing");
-  r.optimization = optimize_job(job, r.mesh, watched, on_iteration, options.simp, shapes);
+  r.source = source_faces(job, shapes, watched);  // once: the surface and result.step use them
+  r.optimization = optimize_job(job, r.mesh, watched, on_iteration, options.simp, &r.source);
   r.optimization.ranks = options.ranks;
   if (!options.write_outputs) return r;
   r.written = write_optimize_outputs(r.mesh, r.optimization, job.output.directory);
   r.files =
-      write_result_files(job, r.mesh, r.optimization, job.output.directory, options.result_files, watched, shapes);
+      write_result_files(job, r.mesh, r.optimization, job.output.directory, options.result_files, watched, r.source);
   r.written.insert(r.written.end(), r.files.written.begin(), r.files.written.end());
   return r;
 }

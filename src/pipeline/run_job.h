@@ -33,6 +33,7 @@ struct RunResult {
   TetMesh mesh;                       ///< the job's mesh (nodes numbered to follow space)
   mesh::MeshRun mesh_run;             ///< the mesher used and its stages ("file" for mesh.file)
   double seconds_mesh = 0;            ///< meshing (or reading mesh.file) wall time
+  result::SourceFaces source;         ///< the input's curved faces (source_faces): the surface's and result.step's
   OptimizeResult optimization;        ///< SIMP, threshold, smoothed surface, their times
   std::vector<std::string> warnings;  ///< what the run warned about (e.g. the Gmsh fallback)
   std::vector<std::string> written;   ///< the result files written (RunOptions::write_outputs)
