@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 
+#include "common/adjacency.h"
 #include "mesh/core/predicates.h"
 #include "simp/controls/draw_filter.h"
 
@@ -70,13 +71,12 @@ TetCast::TetCast(const TetMesh& mesh, const std::vector<int>& design, const TetC
   for (const auto& [lower, upper] : pairs_along(mesh, design, d))
     if (below[lower] == below[upper])
       edges.push_back(below[lower] ? std::array<int, 2>{upper, lower} : std::array<int, 2>{lower, upper});
-  std::vector<long> by_source(n + 1, 0);
-  for (const auto& e : edges) ++by_source[e[1] + 1];
-  for (int i = 0; i < n; ++i) by_source[i + 1] += by_source[i];
-  std::vector<long> dependents(edges.size()), fill(by_source.begin(), by_source.end() - 1);
+  // the edges by their source tet, in edge order
+  const Adjacency dependents = group_pairs(n, [&](auto emit) {
+    for (size_t e = 0; e < edges.size(); ++e) emit(edges[e][1], static_cast<int>(e));
+  });
   std::vector<int> pending(n, 0);
-  for (size_t e = 0; e < edges.size(); ++e)
-    dependents[fill[edges[e][1]]++] = static_cast<long>(e), ++pending[edges[e][0]];
+  for (const auto& e : edges) ++pending[e[0]];
   // Kahn's order; a cycle is broken at its highest remaining tet (its sources not yet placed dropped)
   std::vector<char> alive(edges.size(), 1), queued(n, 0);
   std::vector<int> ready;
@@ -96,20 +96,15 @@ TetCast::TetCast(const TetMesh& mesh, const std::vector<int>& design, const TetC
     const int t = ready.back();
     ready.pop_back();
     order_.push_back(t), placed[t] = 1;
-    for (long m = by_source[t]; m < by_source[t + 1]; ++m) {
-      const long e = dependents[m];
+    for (const int e : dependents.row(t)) {
       if (alive[e] && --pending[edges[e][0]] == 0 && !queued[edges[e][0]])
         ready.push_back(edges[e][0]), queued[edges[e][0]] = 1;
     }
   }
-  start_.assign(n + 1, 0);
-  for (size_t e = 0; e < edges.size(); ++e)
-    if (alive[e]) ++start_[edges[e][0] + 1];
-  for (int i = 0; i < n; ++i) start_[i + 1] += start_[i];
-  from_.resize(start_[n]);
-  std::vector<long> at(start_.begin(), start_.end() - 1);
-  for (size_t e = 0; e < edges.size(); ++e)
-    if (alive[e]) from_[at[edges[e][0]]++] = edges[e][1];
+  takes_from_ = group_pairs(n, [&](auto emit) {
+    for (size_t e = 0; e < edges.size(); ++e)
+      if (alive[e]) emit(edges[e][0], edges[e][1]);
+  });
 }
 
 VecXd TetCast::sweep(const VecXd& z, std::vector<double>* da, std::vector<double>* db) const {
@@ -117,8 +112,8 @@ VecXd TetCast::sweep(const VecXd& z, std::vector<double>* da, std::vector<double
   double ignore_a, ignore_b;
   for (const int t : order_) {
     double m = z[t];
-    for (long e = start_[t]; e < start_[t + 1]; ++e)
-      m = smooth_max(m, out[from_[e]], eps_, da ? &(*da)[e] : &ignore_a, db ? &(*db)[e] : &ignore_b);
+    for (int e = takes_from_.offset[t]; e < takes_from_.offset[t + 1]; ++e)
+      m = smooth_max(m, out[takes_from_.index[e]], eps_, da ? &(*da)[e] : &ignore_a, db ? &(*db)[e] : &ignore_b);
     out[t] = m;
   }
   return out;
@@ -127,13 +122,13 @@ VecXd TetCast::sweep(const VecXd& z, std::vector<double>* da, std::vector<double
 VecXd TetCast::apply(const VecXd& z) const { return sweep(z, nullptr, nullptr); }
 
 VecXd TetCast::apply_transpose(const VecXd& z, const VecXd& g) const {
-  std::vector<double> da(from_.size()), db(from_.size());
+  std::vector<double> da(takes_from_.index.size()), db(takes_from_.index.size());
   sweep(z, &da, &db);
   VecXd a = g, dz = VecXd::Zero(z.size());
   for (auto t = order_.rbegin(); t != order_.rend(); ++t) {
     double carried = a[*t];  // d/d out[t]: complete, every tet taking from t came later
-    for (long e = start_[*t + 1] - 1; e >= start_[*t]; --e) {
-      a[from_[e]] += carried * db[e];
+    for (int e = takes_from_.offset[*t + 1] - 1; e >= takes_from_.offset[*t]; --e) {
+      a[takes_from_.index[e]] += carried * db[e];
       carried *= da[e];
     }
     dz[*t] += carried;

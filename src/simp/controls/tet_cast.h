@@ -12,6 +12,7 @@
 #pragma once
 #include <vector>
 
+#include "common/adjacency.h"
 #include "common/types.h"
 
 namespace topopt::simp {
@@ -36,14 +37,13 @@ class TetCast {
   /// Chain rule: dF/dz (#D) at z (#D) given dF/d apply(z) (#D).
   VecXd apply_transpose(const VecXd& z, const VecXd& g) const;
   /// Number of ordered pairs (tet, tet it takes from), and of pairs dropped to break cycles.
-  long num_pairs() const { return static_cast<long>(from_.size()); }
+  long num_pairs() const { return static_cast<long>(takes_from_.index.size()); }
   long num_dropped() const { return dropped_; }
 
  private:
   double eps_;
-  std::vector<int> order_;   // #D: each tet after the tets it takes from
-  std::vector<long> start_;  // #D + 1: tet i takes from from_[start_[i] … start_[i+1])
-  std::vector<int> from_;
+  std::vector<int> order_;  // #D: each tet after the tets it takes from
+  Adjacency takes_from_;    // row i: the tets tet i takes from
   long dropped_ = 0;
   /// The cast values; with da, db (#pairs) the smooth maximum's partial derivatives per pair.
   VecXd sweep(const VecXd& z, std::vector<double>* da, std::vector<double>* db) const;
