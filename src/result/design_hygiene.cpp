@@ -11,6 +11,7 @@
 
 #include "common/adjacency.h"
 #include "common/face_key.h"
+#include "common/triangle_closest.h"
 #include "result/iso_surface.h"
 
 namespace topopt::result {
@@ -31,27 +32,6 @@ double tet_volume(const TetMesh& mesh, long t) {
   return std::abs(
              (node(mesh, mesh.T(t, 1)) - a).cross(node(mesh, mesh.T(t, 2)) - a).dot(node(mesh, mesh.T(t, 3)) - a)) /
          6;
-}
-
-/// The point of triangle abc nearest to p (Ericson, Real-Time Collision Detection, 5.1.5).
-Point closest_on_triangle(const Point& p, const Point& a, const Point& b, const Point& c) {
-  const Point ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Point bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Point cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const double denom = 1 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 /// "non-design solid 2", "non-design solids 2 and 3", "non-design solids 1, 2 and 4".

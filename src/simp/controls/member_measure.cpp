@@ -8,34 +8,10 @@
 
 #include "common/face_key.h"
 #include "common/tet_boundary.h"
+#include "common/triangle_closest.h"
 
 namespace topopt::simp {
 namespace {
-
-/// The point of the segment [a, b] nearest to p.
-Eigen::Vector3d segment_closest(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return a + s * ab;
-}
-
-/// The point of the triangle (a, b, c) nearest to p: p's projection on its plane where that lies
-/// inside it, else the nearest point of its edges.
-Eigen::Vector3d triangle_closest(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                 const Eigen::Vector3d& c) {
-  const Eigen::Vector3d n = (b - a).cross(c - a);
-  const double n2 = n.squaredNorm();
-  if (n2 > 0) {
-    const Eigen::Vector3d q = p - n * ((p - a).dot(n) / n2);  // p's projection on the plane
-    const double u = (b - q).cross(c - q).dot(n), v = (c - q).cross(a - q).dot(n), w = (a - q).cross(b - q).dot(n);
-    if (u >= 0 && v >= 0 && w >= 0) return q;
-  }
-  Eigen::Vector3d best = segment_closest(p, a, b);
-  for (const Eigen::Vector3d& q : {segment_closest(p, b, c), segment_closest(p, c, a)})
-    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
-  return best;
-}
 
 /// Where the ray p + s u (s > 0, u a unit vector) meets the triangle (a, b, c): s, or +inf
 /// when it misses (Möller–Trumbore).
@@ -97,7 +73,7 @@ VecXd distance_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, d
     for (long f = 0; f < F.rows(); ++f) {
       if ((P.row(i) - sphere.centre.row(f)).norm() - sphere.radius[f] >= d[i]) continue;
       const Eigen::Vector3d q =
-          triangle_closest(p, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+          closest_on_triangle(p, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
       if ((q - p).norm() >= d[i]) continue;
       d[i] = (q - p).norm();
       if (Q) Q->row(i) = q.transpose();
