@@ -4,7 +4,7 @@ of ../shared/data/README.md, steel, volume fraction 0.3) through `topopt optimiz
 and once with each geometry control (docs/optimization.md, "controls"; member sizes on the
 cantilever only — with a minimum size the compliance is the eroded design's, what SIMP minimises). For each run: tets,
 iterations, final compliance (SIMP's, on the tet mesh), SIMP wall time, whole-command wall
-time, all with OMP_NUM_THREADS=1 and one run after another in this one script; the overhang
+and CPU time (user + sys), all with OMP_NUM_THREADS=1 and one run after another in this one script; the overhang
 share of the result surface built along +x and +y (45°); and a picture of the result surface
 (result.stl, rendered with matplotlib) in the work folder.
 
@@ -12,7 +12,7 @@ usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--onl
                              [--controls free,draw]  (labels containing one of these words)
 Prints Markdown for BENCHMARKS.md.
 """
-import argparse, json, os, re, subprocess, sys, time
+import argparse, json, os, re, resource, subprocess, sys, time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import benchlib  # noqa: E402
 
@@ -76,10 +76,15 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
 
 
 def run(cmd):
+    """cmd with OpenMP and OpenBLAS held to one thread: (wall s, CPU s (user + sys of the command), the
+    completed process)."""
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    return time.perf_counter() - t0, p
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), p
 
 
 def main():
@@ -100,7 +105,7 @@ def main():
         return
     os.makedirs(a.work, exist_ok=True)
     topopt = os.path.join(a.build, "topopt")
-    print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP (s) | command (s) | "
+    print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP wall (s) | command wall / CPU (s) | "
           "overhang share, build +x / +y / +z | picture |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name, (size, case) in EXAMPLES.items():
@@ -122,7 +127,7 @@ def main():
             job.update(case)
             path = out + ".json"
             json.dump(job, open(path, "w"), indent=1)
-            wall, p = run([topopt, "optimize", path, "--verbose"])
+            wall, cpu, p = run([topopt, "optimize", path, "--verbose"])
             if p.returncode:
                 print("| %s | %s | failed: %s |" % (name, label, (p.stderr or p.stdout).strip().splitlines()[-1]))
                 continue
@@ -136,9 +141,9 @@ def main():
             benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
             stl = os.path.join(out, "result.stl")
             shares = " / ".join("%.1f %%" % (100 * overhang_share(stl, up)) for up in BUILDS.values())
-            print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f | %s | %s |" % (
+            print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f / %.1f | %s | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
-                "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, shares, os.path.basename(png)))
+                "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, cpu, shares, os.path.basename(png)))
             sys.stdout.flush()
 
 

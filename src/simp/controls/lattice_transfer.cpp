@@ -40,6 +40,7 @@ void LatticeTransfer::build_to_grid(const Eigen::MatrixX3d& local, const VecXd& 
   std::vector<long> members(num_elements), fill(start.begin(), start.end() - 1);
   for (long e = 0; e < num_elements; ++e) members[fill[node_of[e]]++] = e;
   fixed_ = VecXd::Zero(G);
+  offset_ = Eigen::MatrixX3d::Zero(G, 3);
   active_.assign(G, 0);
   std::vector<Eigen::Triplet<double>> w;
   w.reserve(num_elements + G);
@@ -55,9 +56,17 @@ void LatticeTransfer::build_to_grid(const Eigen::MatrixX3d& local, const VecXd& 
       for (int i = 0; i < n_[0]; ++i) {
         const long q = node_id({i, j, k}, n_);
         if (start[q + 1] > start[q]) {  // the mean over the dual cell
-          double vol = 0;
-          for (long m = start[q]; m < start[q + 1]; ++m) vol += volumes[members[m]];
+          double vol = 0, kind_vol[2] = {0, 0};
+          Eigen::Vector3d kind_sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+          for (long m = start[q]; m < start[q + 1]; ++m) {
+            const long e = members[m];
+            vol += volumes[e];
+            kind_vol[variable[e] >= 0] += volumes[e];
+            kind_sum[variable[e] >= 0] += volumes[e] * local.row(e).transpose();
+          }
           for (long m = start[q]; m < start[q + 1]; ++m) take(q, members[m], volumes[members[m]] / vol);
+          if (kind_vol[0] > 0 && kind_vol[1] > 0)
+            offset_.row(q) = (kind_sum[1] / kind_vol[1] - kind_sum[0] / kind_vol[0]).transpose();
           continue;
         }
         const Eigen::Vector3d x(i * spacing[0], j * spacing[1], k * spacing[2]);

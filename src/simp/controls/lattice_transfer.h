@@ -46,12 +46,17 @@ class LatticeTransfer {
   const VecXd& fixed_share() const { return fixed_; }
   /// #G: 1 for the nodes that some element reaches.
   const std::vector<char>& active() const { return active_; }
+  /// #G by 3: where a node's variable elements lie against its fixed ones, in lattice
+  /// coordinates: the volume-weighted mean centroid of the variable elements in its dual cell
+  /// minus that of the fixed elements there (0 unless the dual cell holds both kinds).
+  const Eigen::MatrixX3d& variable_offset() const { return offset_; }
 
  private:
   std::array<int, 3> n_;
   Eigen::SparseMatrix<double> to_grid_;      // #G by #D
   Eigen::SparseMatrix<double> to_elements_;  // #D by #G
   VecXd fixed_;                              // #G: the fixed elements' share
+  Eigen::MatrixX3d offset_;                  // #G by 3: see variable_offset()
   std::vector<char> active_;
   void build_to_grid(const Eigen::MatrixX3d& local, const VecXd& volumes, const std::vector<int>& variable,
                      int num_variables, const Eigen::Vector3d& spacing);

@@ -148,6 +148,14 @@ void OverhangFilter::build_lattice(const TetMesh& mesh, const std::vector<int>& 
                                                spacing, n);
   anchored_.resize(lattice_->num_nodes());
   for (long q = 0; q < lattice_->num_nodes(); ++q) anchored_[q] = lattice_->fixed_share()[q] > kAnchored;
+  // the design elements of an anchored node's dual cell rest on the solid when they lie more
+  // above its elements than beside them; beside or under it a sub-cell shelf of them would hang
+  // from the solid's wall unchecked (a ceiling beside a load pad)
+  carries_design_.resize(lattice_->num_nodes());
+  for (long q = 0; q < lattice_->num_nodes(); ++q) {
+    const Eigen::Vector3d o = lattice_->variable_offset().row(q);
+    carries_design_[q] = o[2] > o.head<2>().norm();
+  }
 }
 
 VecXd OverhangFilter::print(const VecXd& g, VecXd* adjoint) const {
@@ -161,7 +169,10 @@ VecXd OverhangFilter::print(const VecXd& g, VecXd* adjoint) const {
       for (int i = 0; i < ni; ++i) {
         const long q = k * layer + static_cast<long>(j) * ni + i, below = q - layer;
         if (anchored_[q]) {  // non-design material: printed as it is
-          d_own[q] = 1;
+          if (carries_design_[q])
+            d_own[q] = 1;  // and the design material resting on it
+          else
+            xi[q] = lattice_->fixed_share()[q];  // the design beside or under it is not carried by it
           continue;
         }
         long* s = &support[q * kSupports];

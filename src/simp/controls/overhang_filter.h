@@ -8,7 +8,10 @@
 // material may stand out by one cell per layer: a slope of angle + margin from the plate (the
 // margin keeps the result surface's facets of a wall at the filter's limit above `angle`). Nodes more than a quarter
 // inside the non-design solids are printed material whatever lies below them (they are kept)
-// and support what stands on them fully. Sits after the density
+// and support what stands on them fully; the design elements in such a node's dual cell are
+// printed as given only where they rest on the solid (their centroid lies more above the
+// solid's than beside it), else the node hands the elements the solid's share of it alone, so
+// that no sub-cell shelf hangs from a non-design wall. Sits after the density
 // filter (and the draw direction), before the projection; the chain rule is the adjoint of the
 // layer recursion.
 #pragma once
@@ -48,7 +51,10 @@ class OverhangFilter {
   double q_ = 1;         // Q of the smooth maximum
   int base_layers_ = 1;  // layers 0 … base_layers_−1 lie on or below the plate: printed as given
   std::unique_ptr<LatticeTransfer> lattice_;
-  std::vector<char> anchored_;  // #G: nodes in the non-design solids: printed as given, full support
+  std::vector<char> anchored_;  // #G: nodes in the non-design solids: full support
+  /// #G: anchored nodes whose design share rests on the solid: printed as given; the others
+  /// print the solid's share alone
+  std::vector<char> carries_design_;
   std::string summary_;
   void build_lattice(const TetMesh& mesh, const std::vector<int>& design, double cell);
   /// The printed lattice values of lattice values g (#G); with adjoint != nullptr, also

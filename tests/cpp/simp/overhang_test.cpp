@@ -64,15 +64,16 @@ OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double ang
 }
 
 /// The property test's settings and bound. NOT the target (<= 1 % with the control):
-/// measured on the result surface the user gets, facets within 3 degrees of the limit not
-/// counted, β at its end: 3.0 % with a margin of 20° (the default), 7.7 % with 10°, 14.7 % with
-/// 5°, 15.8 % without a margin, 32.7 % free (docs/optimization.md, "Overhang": what is left is
-/// the mesh's staircase on ceilings next to the pad and at the fixed wall). The test holds
-/// what is reached, with the default margin.
+/// measured on the result surface the user gets, every triangle of it (the pad's faces too),
+/// facets within 3 degrees of the limit not counted, β at its end: 1.5 % with the default margin
+/// of 20° since the non-design pad's lattice nodes carry only the design resting on them (3.0 %
+/// before: a shelf beside the pad), 32.7 % free (docs/optimization.md, "Overhang": what is left
+/// are ceilings of the lattice's staircase next to the pad, x = 23 … 27). The test holds what is
+/// reached, with the default margin.
 constexpr int kBeamIterations = 200;
 constexpr double kBeamTolerance = 3;
 constexpr double kBeamMargin = 20;
-constexpr double kBeamShareBound = 0.04;
+constexpr double kBeamShareBound = 0.02;
 
 TEST(Overhang, SmoothMinAndMaxBoundTheExactOnes) {
   double da, db, dx[5];
@@ -213,6 +214,28 @@ TEST(Overhang, NonDesignSolidsAndThePickedPlateSupport) {
   }
 }
 
+TEST(Overhang, NoShelfHangsFromANonDesignWall) {
+  // a non-design wall standing on the plate (x in [8, 12]); a sheet of design half a lattice
+  // cell thick along its side (x in (7.5, 8)), 3 mm above the plate with nothing under it: the
+  // wall's lattice nodes hold wall and sheet, and printing them as given would keep the sheet
+  // (its bottom a ceiling). Only what rests on top of a non-design solid is carried by it: the
+  // sheet prints as an empty design does there (the wall's own share, the same at every height)
+  const TetMesh m = box_mesh({12, 4, 10}, {{{8, 0, 0, 12, 4, 10}}});
+  const std::vector<int> design = design_of(m);
+  const VecXd sheet =
+      field(m, design, [](const Eigen::Vector3d& p) { return p.x() > 7.5 && p.z() > 3 && p.z() < 6; });
+  const OverhangFilter f(m, design, control(), 1.0);
+  const VecXd printed = f.apply(sheet), empty = f.apply(VecXd::Zero(sheet.size()));
+  const Eigen::MatrixX3d c = design_centroids(m, design);
+  long in_sheet = 0;
+  for (long i = 0; i < c.rows(); ++i)
+    if (sheet[i] > 0) {
+      ++in_sheet;
+      EXPECT_LE(printed[i], empty[i] + 0.01) << "a shelf on the wall's side kept at " << c.row(i);
+    }
+  EXPECT_GT(in_sheet, 20);
+}
+
 TEST(Overhang, BadSettingsNameWhatToFix) {
   const TetMesh m = box_mesh({4, 4, 4});
   const std::vector<int> design = design_of(m);
@@ -304,10 +327,11 @@ Beam test_beam() {
   return b;
 }
 
-/// The share of the design's own surface (tag 0: not Ω's faces, not the pad's) on the result
-/// surface the user gets (pipeline::result_surface with the product's defaults: the threshold
-/// that keeps the volume fraction, hygiene, smoothing, remeshing), built along +z from z = −5;
-/// a facet counts when it rises less than angle − tolerance from the plate.
+/// The overhang share of the result surface the user gets (pipeline::result_surface with the
+/// product's defaults: the threshold that keeps the volume fraction, hygiene, smoothing,
+/// remeshing), every triangle of it (Ω's faces and the pad's too: an exposed face of the pad
+/// that faces down needs supports as much as the design's own), built along +z from z = −5; a
+/// facet counts when it rises less than angle − tolerance from the plate.
 OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, double angle,
                                double tolerance) {
   const result::TriSurface s =
@@ -316,7 +340,7 @@ OverhangShare product_overhang(const Beam& b, const VecXd& density, double volum
   m.angle = angle;
   m.plate = -5;
   m.tolerance = tolerance;
-  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag);
+  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m);
 }
 
 TEST(Overhang, MeasureCountsTheDesignsOwnSurfaceOnly) {
