@@ -297,16 +297,18 @@ void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult
 }
 
 /// With a minimum member size: warns, in the user's terms, when the eroded design (the one
-/// analysed) has come apart, its compliance above 1e3 × the first iteration's (E_min carries the
-/// load then): no member of that size fits the volume fraction between supports and loads.
+/// analysed) has come apart, its last compliance above 1e3 × the lowest of the run (E_min carries
+/// the load then; the first iteration's is no reference: at a low volume its eroded design is
+/// weak already): no member of that size fits the part and the volume between supports and loads.
 void warn_if_eroded_apart(const SimpParams& params, const SimpResult& res, const Progress& progress) {
   if (params.controls.member.min_size <= 0 || res.history.size() < 2) return;
-  if (!(res.history.back().compliance > 1e3 * res.history.front().compliance)) return;
+  double lowest = res.history.front().compliance;
+  for (const IterationRecord& r : res.history) lowest = std::min(lowest, r.compliance);
+  if (!(res.history.back().compliance > 1e3 * lowest)) return;
   std::ostringstream msg;
   msg << "controls.min_member_size " << params.controls.member.min_size
-      << " mm: the eroded design came apart (compliance " << res.history.back().compliance << " against "
-      << res.history.front().compliance
-      << " at the start): the volume fraction cannot hold members of that size from the supports to the loads; raise "
+      << " mm: the eroded design came apart (compliance " << res.history.back().compliance << ", " << lowest
+      << " at its lowest): no member of that size carries the load within the part and the volume fraction; raise "
          "the volume fraction or lower the size";
   progress.warn(msg.str());
 }

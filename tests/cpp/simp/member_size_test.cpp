@@ -146,6 +146,33 @@ TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
   EXPECT_LE(half.thinner2, 0.15);
 }
 
+TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
+  // volume 0.9, min size 8 mm padded on the 10 × 10 mm section (8 × 4 × 4 cells of 2.5 mm): the
+  // radius (10.9 mm) is wider than the section, no member survives erosion and the run says what
+  // to change; 4 mm on 1.25 mm cells (16 × 8 × 8) fits and is not named
+  auto run = [](std::array<int, 3> cells, double size, std::string& warnings) {
+    Cantilever b(cells);
+    SimpParams p;
+    p.volume_fraction = 0.9;
+    p.max_iterations = 30;
+    p.controls.member.min_size = size;
+    Progress progress;
+    progress.log = [&](LogLevel level, const std::string& m) {
+      if (level == LogLevel::Warning) warnings += m + "\n";
+    };
+    const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p, progress);
+    std::cout << size << " mm: compliance " << r.history.front().compliance << " -> " << r.history.back().compliance
+              << "\n";
+    return r.history.back().compliance / r.history.front().compliance;
+  };
+  std::string apart, fits;
+  EXPECT_GT(run({8, 4, 4}, 8, apart), 1e3);
+  EXPECT_NE(apart.find("controls.min_member_size 8 mm: the eroded design came apart"), std::string::npos) << apart;
+  EXPECT_NE(apart.find("raise the volume fraction or lower the size"), std::string::npos) << apart;
+  EXPECT_LT(run({16, 8, 8}, 4, fits), 10);
+  EXPECT_EQ(fits.find("came apart"), std::string::npos) << fits;
+}
+
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
   // a 12 mm cube of 1 mm cells, Gaussian filter of radius 3 mm; its face x = 12 held (a support)
   mesh::StructuredBoxParams box;
