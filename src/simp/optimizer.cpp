@@ -296,6 +296,23 @@ void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult
   progress.say("simp", static_cast<double>(rec.iteration) / max_iterations, msg.str());
 }
 
+/// With a minimum member size: warns, in the user's terms, when the eroded design (the one
+/// analysed) has come apart, its last compliance above 1e3 × the lowest of the run (E_min carries
+/// the load then; the first iteration's is no reference: at a low volume its eroded design is
+/// weak already): no member of that size fits the part and the volume between supports and loads.
+void warn_if_eroded_apart(const SimpParams& params, const SimpResult& res, const Progress& progress) {
+  if (params.controls.member.min_size <= 0 || res.history.size() < 2) return;
+  double lowest = res.history.front().compliance;
+  for (const IterationRecord& r : res.history) lowest = std::min(lowest, r.compliance);
+  if (!(res.history.back().compliance > 1e3 * lowest)) return;
+  std::ostringstream msg;
+  msg << "controls.min_member_size " << params.controls.member.min_size
+      << " mm: the eroded design came apart (compliance " << res.history.back().compliance << ", " << lowest
+      << " at its lowest): no member of that size carries the load within the part and the volume fraction; raise "
+         "the volume fraction or lower the size";
+  progress.warn(msg.str());
+}
+
 }  // namespace
 
 SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fem::Supports& supports,
@@ -363,6 +380,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     if (next == NextStep::RaiseBeta) update.restart();
   }
   if (!res.converged) res.status = "iteration cap (" + std::to_string(params.max_iterations) + ") reached";
+  warn_if_eroded_apart(params, res, progress);
   res.variables = problem.design_field(x);
   problem.set_beta(schedule.beta());
   const VecXd rho = problem.physical(x);

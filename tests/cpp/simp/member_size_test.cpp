@@ -2,8 +2,8 @@
 // asks for against a closed form, the robust formulation's and the local volume constraint's
 // sensitivities against finite differences, and the maximum size measured on the optimised
 // design (member_measure.h), with a run without the control that breaks it; the minimum size
-// measured on the cleaned crisp design against the free design's (its bound is below the set
-// size: docs/optimization.md says why).
+// measured on the cleaned crisp design against the free design's (to within the mesh's cells:
+// docs/optimization.md says how far).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -89,48 +89,88 @@ double share_thinner(const TetMesh& mesh, const VecXd& crisp, const MemberMeasur
   return solid ? static_cast<double>(thin) / solid : 0.0;
 }
 
-/// The smallest member and gap of a crisp design (#T) on the beam, the shares of its solid
-/// design tets thinner than 4 and 2 mm, printed under `label`; the measure's reach half a cell.
+/// The smallest member and gap of a crisp design (#T) on the beam with the measure's reach
+/// `reach` (mm), and the shares of its solid design tets thinner than `size` less a cell and
+/// than 2 mm, printed under `label`.
 struct Sizes {
   MemberMeasure members, gaps;
-  double thinner4 = 0, thinner2 = 0;
+  double thinner_than_size = 0, thinner2 = 0;
 };
-Sizes measure_sizes(const Cantilever& b, const VecXd& crisp, const std::string& label) {
+Sizes measure_sizes(const Cantilever& b, const VecXd& crisp, double size, double reach, const std::string& label) {
   MemberMeasureParams mp;
-  mp.reach = b.cell() / 2;
+  mp.reach = reach;
   Sizes s;
   s.members = measure_members(b.mesh, crisp, mp);
   mp.gaps = true;
   s.gaps = measure_members(b.mesh, crisp, mp);
-  s.thinner4 = share_thinner(b.mesh, crisp, s.members, 4.0);
+  s.thinner_than_size = share_thinner(b.mesh, crisp, s.members, size - b.cell());
   s.thinner2 = share_thinner(b.mesh, crisp, s.members, 2.0);
-  std::cout << label << ": smallest member " << s.members.smallest_member << " mm, smallest gap "
-            << s.gaps.smallest_member << " mm, " << 100 * s.thinner4
-            << " % of the solid design tets thinner than 4 mm, " << 100 * s.thinner2 << " % thinner than 2 mm\n";
+  std::cout << label << ", reach " << reach << " mm: smallest member " << s.members.smallest_member
+            << " mm, smallest gap " << s.gaps.smallest_member << " mm, " << 100 * s.thinner_than_size
+            << " % of the solid design tets thinner than " << size - b.cell() << " mm, " << 100 * s.thinner2
+            << " % thinner than 2 mm\n";
   return s;
 }
 
-TEST(MemberSize, MinimumSizeThickensTheCleanedResult) {
-  // 24 × 8 × 8 cells of 1.25 mm, volume 0.2; min_member_size 4 mm (filter radius 5.45 mm, the
-  // part's faces not padded: the default) with β run to its end (32), against the free design
-  // with a 2 mm filter
+TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
+  // 24 × 8 × 8 cells of 1.25 mm, volume 0.4; min_member_size 4 mm (filter radius 5.45 mm, the
+  // part's free faces padded: the default) with β run to its end (32), against the free design
+  // with a 2 mm filter. Volume 0.4, not 0.2: padded, no member whose eroded design carries the
+  // load fits 20 mm² of the 10 × 10 mm section (a square bar must be 5.3 mm wide to survive
+  // erosion), and the eroded design came apart there (docs/optimization.md)
   Cantilever b({24, 8, 8});
+  const double size = 4;
   SimpParams p = run_params();
+  p.volume_fraction = 0.4;
   const SimpResult free_run = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  p.controls.member.min_size = 4;
+  p.controls.member.min_size = size;
   p.max_iterations = 120;
   const SimpResult robust = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  const Sizes free_s = measure_sizes(b, crisp_after_hygiene(b, free_run.density), "free");
-  const Sizes robust_s = measure_sizes(b, crisp_after_hygiene(b, robust.density), "min size 4 mm");
+  const VecXd free_crisp = crisp_after_hygiene(b, free_run.density), crisp = crisp_after_hygiene(b, robust.density);
   EXPECT_EQ(robust.history.back().beta, 32) << "the continuation should reach its end";
-  EXPECT_LE(robust.history.back().grey, 0.03);
-  // the target (the set size, less a cell for the measure: 2.75 mm) is NOT reached:
-  // 1.25 mm measured, 10.5 % of the solid tets thinner than 2 mm (docs/optimization.md); the
-  // bounds hold what is reached, so that the test fails if the control stops working
-  EXPECT_GE(robust_s.members.smallest_member, 1.0);
-  EXPECT_LE(robust_s.thinner2, 0.15);
-  EXPECT_LT(free_s.members.smallest_member, 1.0) << "the free design should hold a thinner member";
-  EXPECT_GE(free_s.thinner2, 0.5);
+  EXPECT_LE(robust.history.back().grey, 0.10);
+  // the eroded design still carries the load (it came apart unpadded at this volume, and padded at 0.2)
+  EXPECT_LT(robust.history.back().compliance, 1e3 * robust.history.front().compliance);
+  // with the reach of a cell, what the measure needs to read a square bar's corners on a tet
+  // staircase (MeasureFindsKnownThicknessesInTheMiddleAndAlongThePartsFace): the set size to
+  // within two cells everywhere, and to within one cell on all but 1 % of the solid tets
+  // (measured: 2.34 mm, 0.1 %; the thinnest lie in the staircase along the bottom face)
+  const Sizes robust_s = measure_sizes(b, crisp, size, b.cell(), "min size 4 mm");
+  const Sizes free_s = measure_sizes(b, free_crisp, size, b.cell(), "free");
+  EXPECT_GE(robust_s.members.smallest_member, size - 2 * b.cell());
+  EXPECT_LE(robust_s.thinner_than_size, 0.01);
+  EXPECT_GE(free_s.thinner_than_size, 0.1) << "the free design should hold thinner members";
+  // with half a cell (the bound this test held before the padding, at volume 0.2)
+  const Sizes half = measure_sizes(b, crisp, size, b.cell() / 2, "min size 4 mm");
+  EXPECT_GE(half.members.smallest_member, 1.0);
+  EXPECT_LE(half.thinner2, 0.15);
+}
+
+TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
+  // volume 0.9, min size 8 mm padded on the 10 × 10 mm section (8 × 4 × 4 cells of 2.5 mm): the
+  // radius (10.9 mm) is wider than the section, no member survives erosion and the run says what
+  // to change; 4 mm on 1.25 mm cells (16 × 8 × 8) fits and is not named
+  auto run = [](std::array<int, 3> cells, double size, std::string& warnings) {
+    Cantilever b(cells);
+    SimpParams p;
+    p.volume_fraction = 0.9;
+    p.max_iterations = 30;
+    p.controls.member.min_size = size;
+    Progress progress;
+    progress.log = [&](LogLevel level, const std::string& m) {
+      if (level == LogLevel::Warning) warnings += m + "\n";
+    };
+    const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p, progress);
+    std::cout << size << " mm: compliance " << r.history.front().compliance << " -> " << r.history.back().compliance
+              << "\n";
+    return r.history.back().compliance / r.history.front().compliance;
+  };
+  std::string apart, fits;
+  EXPECT_GT(run({8, 4, 4}, 8, apart), 1e3);
+  EXPECT_NE(apart.find("controls.min_member_size 8 mm: the eroded design came apart"), std::string::npos) << apart;
+  EXPECT_NE(apart.find("raise the volume fraction or lower the size"), std::string::npos) << apart;
+  EXPECT_LT(run({16, 8, 8}, 4, fits), 10);
+  EXPECT_EQ(fits.find("came apart"), std::string::npos) << fits;
 }
 
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
@@ -203,6 +243,11 @@ TEST(MemberSize, RobustGradientsMatchFiniteDifferences) {
   p.solver.recycle_factor = false;
   p.projection.beta_start = 4;
   p.controls.member.min_size = 8;  // two mean edges; a radius of 10.9 mm
+  // the filter normalised over the part: padded, this 10 mm section under a 10.9 mm radius reads
+  // below η_e nearly everywhere, the eroded design is E_min and the solve's round-off reached
+  // 8e-4 of a derivative; the padding changes only the filter's constant row sums, whose chain
+  // the padded problem's dilated volume checks at the end
+  p.controls.member.pad_faces = false;
   ComplianceProblem prob(b.mesh, b.mat, b.supports, b.loads, {}, p);
   const VecXd x = random_field(prob.num_variables(), 11);
   VecXd dc, dv;
@@ -221,6 +266,13 @@ TEST(MemberSize, RobustGradientsMatchFiniteDifferences) {
   prob.compliance(x);
   EXPECT_LT(prob.physical_densities().sum(), rho_i.sum());
   EXPECT_TRUE((prob.physical_densities().array() <= rho_i.array() + 1e-12).all());
+  // the padded filter (the default) through the dilated volume
+  p.controls.member.pad_faces = true;
+  ComplianceProblem padded(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  padded.compliance(x);
+  VecXd dvp;
+  padded.volume_fraction(x, &dvp);
+  expect_gradient([&](const VecXd& y) { return padded.volume_fraction(y); }, x, dvp, 1e-5, "padded dilated volume");
 }
 
 TEST(MemberSize, LocalVolumeGradientMatchesFiniteDifferences) {
@@ -322,6 +374,11 @@ TEST(MemberSize, MaximumSizeHoldsOnTheResultAndIsBrokenWithout) {
             << ", bounded " << bounded.history.back().compliance << "\n";
   EXPECT_LE(bounded_m.largest_ball, size);
   EXPECT_GT(free_m.largest_ball, size) << "the free design should hold a wider ball";
+  // and on the design the user gets (hygiene, then the tets whose node densities reach 0.5): the
+  // set size plus a mesh size (the node average moves the boundary by up to half a cell a side)
+  const MemberMeasure user_m = measure_members(b.mesh, crisp_after_hygiene(b, bounded.density), mp);
+  std::cout << "widest solid ball of the cleaned result: " << user_m.largest_ball << " mm\n";
+  EXPECT_LE(user_m.largest_ball, size + b.cell());
   // the volume fraction is an upper bound; with the widest ball bounded the design may not fill it
   EXPECT_LE(bounded.history.back().volume_fraction, p.volume_fraction + 0.01);
 }
