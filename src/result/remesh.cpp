@@ -28,6 +28,8 @@ class Remesher {
   Remesher(TriSurface& s, const RemeshParams& p, const FaceProjector& onto)
       : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
     if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
+    if (onto_.nondesign_faces && onto_.onto_nondesign) nd_face_ = onto_.nondesign_faces(s_);
+    nd_face_.resize(s_.F.rows(), -1);
   }
 
   /// Sweeps until a sweep changes nothing or params.passes sweeps ran.
@@ -64,6 +66,12 @@ class Remesher {
  private:
   double angle(int t) const { return angle_of(m_.tri(t)); }
   double angle_of(const Tri& t) const { return min_triangle_angle(s_.V, t[0], t[1], t[2]); }
+  /// The curved non-design face triangle t is a chord of (FaceProjector::nondesign_faces), or -1.
+  int nd_face(int t) const { return m_.tag(t) < 0 ? nd_face_[t] : -1; }
+  /// The curved non-design face both triangles e (an edge's two) are chords of, or -1.
+  int shared_nd_face(const std::vector<int>& e) const {
+    return e.size() == 2 && m_.tag(e[0]) == m_.tag(e[1]) && nd_face(e[0]) == nd_face(e[1]) ? nd_face(e[0]) : -1;
+  }
   bool planar(int tag) const {
     return tag > 0 && tag < static_cast<int>(s_.face_plane.size()) && s_.face_plane[tag].head<3>().norm() > 0;
   }
@@ -95,11 +103,10 @@ class Remesher {
     if (e.size() != 2 || (!p_.planar_faces && (m_.tag(e[0]) != 0 || m_.tag(e[1]) != 0))) return false;
     const int f0 = m_.tag(e[0]), f1 = m_.tag(e[1]);
     at = 0.5 * (s_.V.row(a) + s_.V.row(b)).transpose();
-    if (f0 < 0 || f1 < 0) return nondesign_split(e, lock, face);
+    if (f0 < 0 || f1 < 0) return nondesign_split(e, lock, face) || onto_nondesign_face(e, a, b, lock, face, at);
     if (f0 > 0 && f0 == f1 && !planar(f0)) {  // inside a curved face: onto its surface
       lock = 1, face = 0;
-      const Eigen::Vector3d mid = at;
-      return onto_ && onto_(f0, at) && (at - mid).norm() < 0.25 * (s_.V.row(a) - s_.V.row(b)).norm();
+      return onto_.onto_face && projected(at, a, b, [&](Eigen::Vector3d& x) { return onto_.onto_face(f0, x); });
     }
     if (f0 > 0 && f1 > 0 && planar(f0) != planar(f1)) return on_curved_and_plane(f0, f1, a, b, lock, face, at);
     for (int t : e)
@@ -119,7 +126,7 @@ class Remesher {
     const double len = (s_.V.row(a) - s_.V.row(b)).norm();
     const Eigen::Vector3d mid = at;
     lock = 1, face = 0;
-    if (!onto_ || !onto_(curved, at) || (at - mid).norm() > 0.25 * len) return false;
+    if (!onto_.onto_face || !onto_.onto_face(curved, at) || (at - mid).norm() > 0.25 * len) return false;
     const Eigen::Vector4d& plane = s_.face_plane[flat];
     return std::abs(plane.head<3>().dot(at) - plane[3]) <= 1e-9 * len * plane.head<3>().norm();
   }
@@ -136,6 +143,25 @@ class Remesher {
     if (n0.norm() == 0 || n1.norm() == 0 || n0.normalized().dot(n1.normalized()) < 1 - kCoplanar) return false;
     lock = 2, face = 0;
     return true;
+  }
+
+  /// Moves the midpoint `at` of edge ab onto a curved face's true surface (`onto`); true when that
+  /// worked and moved it less than a quarter of the edge (the edge is a chord of that surface).
+  template <class Onto>
+  bool projected(Eigen::Vector3d& at, int a, int b, const Onto& onto) const {
+    const Eigen::Vector3d mid = at;
+    return onto(at) && (at - mid).norm() < 0.25 * (s_.V.row(a) - s_.V.row(b)).norm();
+  }
+
+  /// Whether edge ab of triangles e (two, non-design) may be split with the new point on the true
+  /// surface of the curved non-design face both triangles are chords of (nondesign_faces): `at`,
+  /// the midpoint, projected onto it. The new point is a fixed non-design point (lock 2) on the
+  /// solid's face as the input has it (not on the FE mesh's chord of it).
+  bool onto_nondesign_face(const std::vector<int>& e, int a, int b, int& lock, int& face, Eigen::Vector3d& at) const {
+    const int id = shared_nd_face(e);
+    if (!p_.planar_faces || id < 0) return false;
+    lock = 2, face = 0;
+    return projected(at, a, b, [&](Eigen::Vector3d& x) { return onto_.onto_nondesign(id, x); });
   }
 
   /// Adds a point at `at` with the given lock and cut-line face.
@@ -169,7 +195,9 @@ class Remesher {
     for (int u : m_.edge_triangles(a, b)) worst_before = std::min(worst_before, angle(u));
     for (int u : across) worst_before = std::min(worst_before, angle(u));
     add_point(at, lock, face);
+    const std::vector<int> halved = m_.edge_triangles(a, b);
     const int p = m_.split_edge(a, b);
+    for (int u : halved) nd_face_.push_back(nd_face_[u]);  // the new halves, in that order
     std::vector<int> flipped_to;  // the far corners of the edges flipped into edges of p, in order
     const int e = m_.third(across[0] == t ? across[1] : across[0], a, c);
     if (flip(a, c)) flipped_to.push_back(e);
@@ -314,15 +342,18 @@ class Remesher {
     return false;
   }
 
-  /// The cosine of the largest bend of an edge between two triangles of tag `tag` that a flip
+  /// The cosine of the largest bend of the edge between triangles t1 and t2 (one tag) that a flip
   /// may turn: flat_dihedral on the free-form region, curved_dihedral on a curved Ω face (its four
-  /// points stay on the face, the new triangles are chords of it as the old ones were), 90 on a
-  /// planar Ω face (its triangles lie in its plane), and one plane to kCoplanar on the
-  /// non-design solids' faces (a tag names a solid, not a face: the flip must not cut an edge).
-  double flip_min_cos(int tag) const {
+  /// points stay on the face, the new triangles are chords of it as the old ones were) and between
+  /// two chords of one curved non-design face (nondesign_faces), 90 on a planar Ω face (its
+  /// triangles lie in its plane), and one plane to kCoplanar on the non-design solids' other faces
+  /// (a tag names a solid, not a face: the flip must not cut an edge of it).
+  double flip_min_cos(int t1, int t2) const {
+    const int tag = m_.tag(t1);
+    const double curved = std::cos(p_.curved_dihedral * M_PI / 180);
     if (tag == 0) return std::cos(p_.flat_dihedral * M_PI / 180);
-    if (tag > 0 && p_.planar_faces) return planar(tag) ? 0 : std::cos(p_.curved_dihedral * M_PI / 180);
-    return 1 - kCoplanar;
+    if (tag > 0 && p_.planar_faces) return planar(tag) ? 0 : curved;
+    return p_.planar_faces && shared_nd_face({t1, t2}) >= 0 ? curved : 1 - kCoplanar;
   }
 
   /// Flips edge ab when its two triangles share a tag and bend less than flip_min_cos allows, and the
@@ -332,7 +363,7 @@ class Remesher {
     if (!m_.flip_of(a, b, f)) return false;
     const Eigen::Vector3d n1 = normal_of(s_.V, m_.tri(f.t1)), n2 = normal_of(s_.V, m_.tri(f.t2));
     if (n1.norm() == 0 || n2.norm() == 0) return false;
-    if (n1.normalized().dot(n2.normalized()) < flip_min_cos(m_.tag(f.t1))) return false;
+    if (n1.normalized().dot(n2.normalized()) < flip_min_cos(f.t1, f.t2)) return false;
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
     if (normal_of(s_.V, f.u).dot(m) <= 0 || normal_of(s_.V, f.w).dot(m) <= 0) return false;
     if (std::min(angle_of(f.u), angle_of(f.w)) <= std::min(angle(f.t1), angle(f.t2)) + 1e-9) return false;
@@ -363,12 +394,38 @@ class Remesher {
     return f != 0 && (s_.lock[v] == 2 || f > 0);
   }
 
+  /// Whether v, a point of the crease where the free-form surface meets a non-design solid's face
+  /// (lock 2, every triangle around it free-form or of that solid, at least one free-form), may go
+  /// into its non-design neighbour u across non-design triangles (both triangles on uv the solid's):
+  /// v's non-design triangles lie in one plane (to kCoplanar) or are chords of one curved face of
+  /// the solid (nondesign_faces), so with u in v's place they still lie on that face. No point moves:
+  /// the crease then runs through u; the free-form triangles around v follow it (collapse checks
+  /// their turn and angles). A needle whose other long edge is the crease is mended this way.
+  bool crease_removable(int v, int u) const {
+    if (!p_.planar_faces || s_.lock[v] != 2 || s_.lock[u] != 2) return false;
+    const std::vector<int> e = m_.edge_triangles(u, v);
+    if (e.size() != 2 || m_.tag(e[0]) >= 0 || m_.tag(e[1]) != m_.tag(e[0])) return false;
+    const int solid = m_.tag(e[0]), id = nd_face(e[0]);
+    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(e[0]));
+    if (n0.norm() == 0) return false;
+    bool crease = false;
+    for (int t : m_.star(v)) {
+      crease |= m_.tag(t) == 0;
+      if (m_.tag(t) == 0) continue;
+      if (m_.tag(t) != solid) return false;
+      const Eigen::Vector3d n = normal_of(s_.V, m_.tri(t));
+      const bool flat = n.norm() > 0 && n.normalized().dot(n0.normalized()) >= 1 - kCoplanar;
+      if (!flat && (id < 0 || nd_face(t) != id)) return false;
+    }
+    return crease;
+  }
+
   /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, removable from
-  /// inside a face (removable_inside), or on the cut line of an Ω face with uv along that line
+  /// inside a face (removable_inside) or from a non-design face's crease (crease_removable), or on the cut line of an Ω face with uv along that line
   /// (one triangle of the face and one of the free-form on it; on a curved face no point moves,
   /// the line keeps its other points).
   bool may_go(int v, int u) const {
-    if (s_.lock[v] == 0 || face_interior(v) != 0 || removable_inside(v)) return true;
+    if (s_.lock[v] == 0 || face_interior(v) != 0 || removable_inside(v) || crease_removable(v, u)) return true;
     if (s_.lock[v] != 1 || !p_.planar_faces) return false;
     const int f = s_.point_face.size() ? s_.point_face[v] : 0;
     if (f <= 0) return false;
@@ -407,6 +464,7 @@ class Remesher {
   const FaceProjector& onto_;
   EditableSurface m_;
   int given_points_;  ///< the points s had; split_needle adds points after them
+  std::vector<int> nd_face_;  ///< per triangle (index of m_): its curved non-design face (nondesign_faces) or -1
   RemeshReport report_;
 };
 

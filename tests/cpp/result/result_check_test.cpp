@@ -153,8 +153,9 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
     }
   }
   EXPECT_GT(on_planes, 0);
-  // a non-design point that went lay inside one plane of the non-design triangles (its triangles
-  // one tag, coplanar): the FE mesh's boundary re-triangulated within its plane
+  // a non-design point that went lay inside one plane of the non-design triangles (its non-design
+  // triangles one tag, coplanar; free-form ones too when it was on the crease where the free-form
+  // surface meets that plane): the FE mesh's boundary re-triangulated within its plane
   std::vector<char> stayed(V0.rows(), 0);
   for (int k : r.kept_points)
     if (k >= 0) stayed[k] = 1;
@@ -165,7 +166,7 @@ TEST(ResultCheck, RemeshRaisesTheSmallestAngleAndKeepsTheSolid) {
     std::vector<Eigen::Vector3d> normals;
     std::vector<int> tags;
     for (long t = 0; t < F0.rows(); ++t)
-      if (F0(t, 0) == i || F0(t, 1) == i || F0(t, 2) == i) {
+      if ((F0(t, 0) == i || F0(t, 1) == i || F0(t, 2) == i) && tag0[t] != 0) {
         const Eigen::Vector3d a = V0.row(F0(t, 0)), b = V0.row(F0(t, 1)), c = V0.row(F0(t, 2));
         normals.push_back((b - a).cross(c - a).normalized()), tags.push_back(tag0[t]);
       }
@@ -319,7 +320,9 @@ TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
   EXPECT_EQ(remesh_surface(unsplit).splits, 0);  // without the face's geometry, stuck
   EXPECT_LT(smallest_angle(unsplit), 7.0);
   TriSurface s = s0;
-  const RemeshReport r = remesh_surface(s, {}, onto_cylinder);
+  FaceProjector onto;
+  onto.onto_face = onto_cylinder;
+  const RemeshReport r = remesh_surface(s, {}, onto);
   EXPECT_GE(r.splits, 1);
   EXPECT_GT(smallest_angle(s), 10.0);
   // every point on the cylinder (the given ones unmoved, the added ones projected onto it, not
@@ -346,6 +349,109 @@ TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
     EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
   }
   for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+}
+
+/// needle_on_cylinder on the curved face of non-design solid 1 instead (tag -1, every point a fixed
+/// non-design point) next to the crease: (b, c, g) is free-form (tag 0, g a free point), so bc is
+/// the cut line where the free-form surface meets the solid's face. The FE mesh's chords of a
+/// boss's cylinder, as on the bracket (a 7.27° needle on non-design solid 5).
+TriSurface nondesign_needle_on_cylinder() {
+  TriSurface s = needle_on_cylinder();
+  s.tag.setConstant(-1);
+  s.tag[3] = 0;
+  s.lock.setConstant(2);
+  s.lock[5] = 0;
+  s.point_face.setZero();
+  return s;
+}
+
+/// The projector that knows nondesign_needle_on_cylinder's cylinder as non-design face 0.
+FaceProjector nondesign_cylinder() {
+  FaceProjector onto;
+  onto.nondesign_faces = [](const TriSurface& t) {
+    std::vector<int> id(t.F.rows(), -1);
+    for (long q = 0; q < t.F.rows(); ++q)
+      if (t.tag[q] < 0) id[q] = 0;
+    return id;
+  };
+  onto.onto_nondesign = [](int id, Eigen::Vector3d& p) { return id == 0 && onto_cylinder(1, p); };
+  return onto;
+}
+
+TEST(ResultCheck, RemeshMendsANeedleOnACurvedNonDesignFaceNextToTheCrease) {
+  const TriSurface s0 = nondesign_needle_on_cylinder();
+  ASSERT_LT(smallest_angle(s0), 7.0);
+  TriSurface unsplit = s0;
+  const RemeshReport r0 = remesh_surface(unsplit);  // without the face's geometry: no chord may change
+  EXPECT_EQ(r0.splits + r0.flips + r0.collapses, 0);
+  EXPECT_LT(smallest_angle(unsplit), 7.0);
+  TriSurface s = s0;
+  const RemeshReport r = remesh_surface(s, {}, nondesign_cylinder());
+  EXPECT_GE(r.splits, 1);
+  EXPECT_GE(r.flips, 1);  // ac, bent 0.1° on the cylinder, flipped into the new point's edge
+  EXPECT_GT(smallest_angle(s), 10.0);
+  // every non-design point on the cylinder to 1e-9 relative (the given ones unmoved, the added ones
+  // projected onto it: the chord's midpoint lies 3e-4 inside), fixed; the free-form point unmoved
+  ASSERT_EQ(static_cast<long>(r.kept_points.size()), s.V.rows());
+  long added = 0;
+  for (long i = 0; i < s.V.rows(); ++i) {
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
+      EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
+    } else {
+      ++added;
+      EXPECT_EQ(s.lock[i], 2);
+    }
+    if (s.lock[i] == 2) {
+      EXPECT_NEAR(std::hypot(s.V(i, 1), s.V(i, 2)), kCylinderRadius, 1e-9 * kCylinderRadius) << "point " << i;
+    }
+  }
+  EXPECT_EQ(added, r.splits - r.collapses);
+  // the crease stays: one free-form triangle on bc, the rest non-design
+  EXPECT_EQ((s.tag.array() == 0).count(), 1);
+  EXPECT_EQ((s.tag.array() == -1).count(), s.F.rows() - 1);
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
+    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
+    const Eigen::Vector3d centre = (a + b + c) / 3;
+    EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
+  }
+  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+}
+
+TEST(ResultCheck, RemeshRemovesACreasePointOfANonDesignPlaneIntoItsNeighbour) {
+  // stuck_needle on non-design solid 1 whose other long edge ac is the crease: (c, a, e) is
+  // free-form (e a free point below the plane), (a, c, b) and (b, c, g) lie in the plane z = 0, and
+  // (a, b, d) is bent up by 56° (b is on the solid's edge: it may not go, ab may not be split or
+  // flipped). The split of ab would need the flip of the crease; the crease point c goes into b
+  // instead (its non-design triangles in one plane, so b in its place keeps them there): no point
+  // moves, the crease then runs along ab. The cantilever's 1.5 mm result had this needle (8.52°).
+  TriSurface s0 = stuck_needle(-1);
+  s0.V.row(4) << 5, -6, -8;
+  s0.tag[2] = 0, s0.lock[4] = 0;
+  ASSERT_LT(smallest_angle(s0), 7.0);
+  TriSurface s = s0;
+  const RemeshReport r = remesh_surface(s);
+  EXPECT_EQ(r.collapses, 1);
+  EXPECT_EQ(r.splits, 0);
+  EXPECT_GT(smallest_angle(s), 10.0);
+  ASSERT_EQ(s.V.rows(), 4);  // a, b, d, e: g, on the triangle on bc only, went with it
+  for (long i = 0; i < s.V.rows(); ++i) {
+    ASSERT_GE(r.kept_points[i], 0);
+    EXPECT_NE(r.kept_points[i], 2) << "c went";
+    EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);  // nothing moved
+    EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
+  }
+  ASSERT_EQ(s.F.rows(), 2);  // (a, b, d) of the solid, (b, a, e) free-form: the crease along ab
+  EXPECT_EQ((s.tag.array() == 0).count(), 1);
+  EXPECT_EQ((s.tag.array() == -1).count(), 1);
+  // with (b, c, g) bent out of the plane (g raised), c's non-design triangles are not in one plane
+  // and no curved face is known: b in c's place would leave the solid's face, so c stays (stuck)
+  TriSurface bent = s0;
+  bent.V.row(5) << 14, 0, 3;
+  EXPECT_EQ(remesh_surface(bent).collapses, 0);
+  EXPECT_LT(smallest_angle(bent), 7.0);
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {

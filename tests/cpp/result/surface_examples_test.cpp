@@ -43,14 +43,14 @@ struct Example {
   double min_angle = 10.0;
 };
 
-/// The smallest angle asserted on the non-design solids' faces (issue 19 asks 10°, NOT met):
-/// measured 9.99° (bracket default: a needle on a curved non-design face whose other long edge is
-/// the crease to the free-form surface, so neither flip nor split mends it) to 14.3° on the
-/// meshes of 160487f; since the Delaunay bulk's cavity repair (sliver4) the bracket's 5 mm mesh,
-/// hence its design, differs and a cut-line triangle on a non-design face reads 7.27° at the
-/// default threshold. Their points never move, flips within one plane only, splits only between
-/// triangles in one plane: the cut line on curved non-design faces is what to mend next.
-constexpr double kMinAngleNondesign = 7.0;
+/// The smallest angle asserted on the non-design solids' faces (issue 19 asks 10°): the smallest
+/// angle of any triangle tagged -k (the exposed parts of the FE mesh's boundary triangles of the
+/// non-design solids, as the remesher left them). Measured 7.27° on the bracket at the default
+/// threshold (a needle on the boss cylinder of non-design solid 5 next to the crease, its long
+/// edge between two chords bent 2.2°) until splits between two chords of one curved non-design
+/// face put the new point on the face's true surface (SourceFaces) and flips across such bent
+/// edges were allowed.
+constexpr double kMinAngleNondesign = 10.0;
 
 pipeline::Job example_job(const Example& e) {
   const std::string dir = std::string(TOPOPT_SHARED_DATA) + "/examples/";
@@ -101,7 +101,17 @@ void check_design_surface(const TetMesh& mesh, const TriSurface& s, const VecXd&
   }
   EXPECT_LE(off_plane, 1e-9 * scale);
   // the non-design points are points of the unsmoothed surface, unmoved, or points a split added
-  // on an edge of its non-design triangles (on a triangle of the unsmoothed surface's non-design faces)
+  // on an edge of its non-design triangles: on a triangle of the unsmoothed surface's non-design
+  // faces (a split within one plane), or on the true surface of the curved non-design face the
+  // triangles around it lie on (a split between two chords of that face)
+  const std::vector<int> on = source.classify(s);
+  std::vector<double> to_curved(s.V.rows(), 1e300);  // per point: distance to its triangles' curved faces
+  for (long t = 0; t < s.F.rows(); ++t)
+    for (int k = 0; k < 3 && s.tag[t] < 0 && on[t] >= 0; ++k) {
+      const Eigen::Vector3d p = s.V.row(s.F(t, k)).transpose();
+      GeomAPI_ProjectPointOnSurf nearest(gp_Pnt(p.x(), p.y(), p.z()), source.surface(on[t]));
+      if (nearest.NbPoints() > 0) to_curved[s.F(t, k)] = std::min(to_curved[s.F(t, k)], nearest.LowerDistance());
+    }
   const TriSurface raw = extract_iso_surface(mesh, nd, threshold, SmoothParams{}.crossing_margin);
   std::set<std::array<double, 3>> fixed;
   for (long i = 0; i < raw.V.rows(); ++i)
@@ -112,14 +122,13 @@ void check_design_surface(const TetMesh& mesh, const TriSurface& s, const VecXd&
     ++locked;
     if (fixed.count({s.V(i, 0), s.V(i, 1), s.V(i, 2)})) continue;
     ++added;
-    off += testing::distance_to_nondesign(raw, s.V.row(i).transpose()) > 1e-9 * scale;
+    off += testing::distance_to_nondesign(raw, s.V.row(i).transpose()) > 1e-9 * scale && to_curved[i] > 1e-9 * scale;
   }
   EXPECT_GT(locked, 0);
   EXPECT_EQ(off, 0) << "of " << added << " non-design points added by splits";
   // the points splits added inside Ω's curved faces lie on the faces' true surfaces
   std::set<std::array<double, 3>> cut;
   for (long i = 0; i < raw.V.rows(); ++i) cut.insert({raw.V(i, 0), raw.V(i, 1), raw.V(i, 2)});
-  const std::vector<int> on = source.classify(s);
   double off_surface = 0;
   for (long t = 0; t < s.F.rows(); ++t)
     for (int k = 0; k < 3 && s.tag[t] > 0 && on[t] >= 0; ++k) {
