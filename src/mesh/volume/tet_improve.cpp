@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <unordered_map>
 
+#include "common/cpu_time.h"
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/tet_quality.h"
@@ -953,11 +956,18 @@ long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, in
 long remove_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress) {
   long left = static_cast<long>(tets_below(P, tets, floor).size());
+  if (left == 0) return 0;
   // first the plain rounds, then, for what they leave, the rounds with optimise_node and the
   // best flips (run first, those left NIST 5's fill with tets below 0.1 that these clear),
   // then for what those leave the wide reconnections (every triangulation of larger edge
-  // rings, multi-face removal: the slivers of boundary nodes that no point may take out)
-  for (const int phase : {0, 1, 2})
+  // rings, multi-face removal: the slivers of boundary nodes that no point may take out);
+  // what each phase leaves and the CPU it takes go to the volume stage's info line
+  constexpr const char* kPhase[] = {"perturbation, flips and refills", "optimisation", "wide reconnections"};
+  std::ostringstream report;
+  report << "volume: sliver removal: " << left << " tets below " << floor;
+  for (const int phase : {0, 1, 2}) {
+    if (left == 0) break;
+    const double cpu0 = thread_cpu_seconds();
     for (int round = 0; round < rounds && left > 0; ++round) {
       progress.check_cancel("volume meshing (slivers)");
       perturb_sliver_nodes(P, tets, first_new, floor, phase > 0);
@@ -968,6 +978,10 @@ long remove_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new,
       left = now;
       if (!fell) break;
     }
+    report << ", " << left << " after the " << kPhase[phase] << " (" << std::fixed << std::setprecision(2)
+           << thread_cpu_seconds() - cpu0 << " s CPU)";
+  }
+  progress.info(report.str());
   return left;
 }
 
