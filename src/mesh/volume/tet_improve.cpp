@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <unordered_map>
 
+#include "common/cpu_time.h"
 #include "common/face_key.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/tet_quality.h"
@@ -152,13 +155,64 @@ void TetSweep::end() {
   pending.clear();
 }
 
-TetReplacement plan_remove_edge(const TetSweep& s, int u, int w) {
+namespace {
+
+/// The best triangulation of the ring (oriented as in best_fan) over all its triangulations,
+/// by dynamic programming over its sub-polygons (Klincsek's; Shewchuk's edge removal): each
+/// triangle (r_i, r_j, r_l), i < j < l, makes the tets (r_i, r_j, r_l, w) and (r_i, r_l, r_j, u),
+/// and a triangulation scores the worst radius ratio of its tets. Returns those tets when the
+/// score is valid (every tet positive) and above `floor` (best_q: the score), else empty.
+std::vector<Tet> best_triangulation(const std::vector<Vec3>& P, int u, int w, const std::vector<int>& ring, double floor,
+                                    double& best_q) {
+  const int k = static_cast<int>(ring.size());
+  // Q[i][l]: the best worst tet over the sub-polygon r_i..r_l (1 for an edge: no tet), -1 when
+  // none is valid; J[i][l]: the apex that gives it
+  std::vector<double> Q(k * k, 1.0);
+  std::vector<int> J(k * k, -1);
+  auto triangle = [&](int i, int j, int l) {
+    const int x = ring[i], y = ring[j], z = ring[l];
+    if (orient3d(P[x].data(), P[y].data(), P[z].data(), P[w].data()) <= 0 ||
+        orient3d(P[x].data(), P[z].data(), P[y].data(), P[u].data()) <= 0)
+      return -1.0;
+    return std::min(radius_ratio(P[x], P[y], P[z], P[w]), radius_ratio(P[x], P[z], P[y], P[u]));
+  };
+  for (int gap = 2; gap < k; ++gap)
+    for (int i = 0; i + gap < k; ++i) {
+      const int l = i + gap;
+      double& q = Q[i * k + l];
+      q = -1;
+      for (int j = i + 1; j < l; ++j) {
+        const double sub = std::min(Q[i * k + j], Q[j * k + l]);
+        if (sub <= q) continue;
+        const double here = std::min(sub, triangle(i, j, l));
+        if (here > q) q = here, J[i * k + l] = j;
+      }
+    }
+  best_q = Q[k - 1];
+  std::vector<Tet> out;
+  if (!(best_q > floor)) return out;
+  std::vector<std::array<int, 2>> todo{{0, k - 1}};
+  while (!todo.empty()) {
+    const auto [i, l] = todo.back();
+    todo.pop_back();
+    if (l - i < 2) continue;
+    const int j = J[i * k + l];
+    out.push_back({ring[i], ring[j], ring[l], w});
+    out.push_back({ring[i], ring[l], ring[j], u});
+    todo.push_back({i, j}), todo.push_back({j, l});
+  }
+  return out;
+}
+
+}  // namespace
+
+TetReplacement plan_remove_edge(const TetSweep& s, int u, int w, bool optimal) {
   TetReplacement r;
   std::vector<int>& ring_tets = s.scratch.tets;
   std::vector<int>& ring = s.scratch.ring;
   s.tets_with(u, w, -1, ring_tets);
   const int k = static_cast<int>(ring_tets.size());
-  if (k < 3 || k > 7) return r;
+  if (k < 3 || k > (optimal ? kOptimalRing : 7)) return r;
   for (int rt : ring_tets)
     if (s.touched[rt]) return r;
   if (!ring_in_order(s.tets, ring_tets, u, w, ring, s.scratch)) return r;
@@ -170,7 +224,8 @@ TetReplacement plan_remove_edge(const TetSweep& s, int u, int w) {
   double before = 1;
   for (int rt : ring_tets) before = std::min(before, rho(s.P, s.tets[rt]));
   double after = before;
-  r.new_tets = best_fan(s.P, u, w, ring, before, after, s.scratch.fan);
+  r.new_tets = optimal ? best_triangulation(s.P, u, w, ring, before, after)
+                       : best_fan(s.P, u, w, ring, before, after, s.scratch.fan);
   if (r.empty()) return r;
   r.old_tets = ring_tets;
   r.before = before, r.after = after;
@@ -495,22 +550,24 @@ void apply(TetSweep& s, const CavityStar& c) {
 namespace {
 
 /// The edge removal or 2-3 flip at tet t: the first that improves (its edges, then its faces),
-/// or with `best` the one of them all whose new worst radius ratio is highest.
-TetReplacement plan_reconnection(const TetSweep& s, int t, bool best) {
+/// or with `best` the one of them all whose new worst radius ratio is highest. `wide`: edge
+/// removal over all triangulations of rings up to kOptimalRing, and multi-face removal (which
+/// includes the 2-3 flip) at its faces.
+TetReplacement plan_reconnection(const TetSweep& s, int t, bool best, bool wide) {
   const Tet v = s.tets[t];
   TetReplacement r;
   auto consider = [&r, best](TetReplacement c) {
     if (!c.empty() && (r.empty() || (best && c.after > r.after))) r = std::move(c);
   };
   for (int i = 0; i < 4 && (best || r.empty()); ++i)
-    for (int j = i + 1; j < 4 && (best || r.empty()); ++j) consider(plan_remove_edge(s, v[i], v[j]));
-  for (int fi = 0; fi < 4 && (best || r.empty()); ++fi) consider(plan_flip23(s, t, fi));
+    for (int j = i + 1; j < 4 && (best || r.empty()); ++j) consider(plan_remove_edge(s, v[i], v[j], wide));
+  for (int fi = 0; fi < 4 && (best || r.empty()); ++fi) consider(wide ? plan_remove_faces(s, t, fi) : plan_flip23(s, t, fi));
   return r;
 }
 
 }  // namespace
 
-long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad, bool best) {
+long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad, bool best, bool wide) {
   long flips = 0;
   for (int sweep = 0; sweep < 4; ++sweep) {
     long here = 0;
@@ -518,7 +575,7 @@ long flip_bad_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, double bad, boo
     const size_t n0 = tets.size();
     for (size_t t = 0; t < n0; ++t) {
       if (s.touched[t] || rho(P, tets[t]) >= bad) continue;
-      const TetReplacement r = plan_reconnection(s, static_cast<int>(t), best);
+      const TetReplacement r = plan_reconnection(s, static_cast<int>(t), best, wide);
       if (r.empty()) continue;
       apply(s, r);
       ++here;
@@ -647,6 +704,88 @@ int across(const TetSweep& s, int c, int face) {
     if (q != c && has(s.tets[q], b) && has(s.tets[q], d)) return q;
   return -1;
 }
+
+/// The replacement of a sandwich (the faces of `ring`'s triangulation, each with a tet to u and
+/// one to w: old_tets) by the tets (x, y, u, w) around the new edge uw, one per edge (x, y) of
+/// the ring; empty unless they are all positive with one orientation of the ring, fill the old
+/// tets' volume (uw crosses the sandwich once) and raise the worst radius ratio.
+TetReplacement sandwich_replacement(const std::vector<Vec3>& P, const std::vector<Tet>& tets,
+                                    const std::vector<int>& ring, const std::vector<int>& old_tets, int u, int w) {
+  TetReplacement r;
+  const int k = static_cast<int>(ring.size());
+  const int turn = orient3d(P[ring[0]].data(), P[ring[1]].data(), P[u].data(), P[w].data());
+  if (turn == 0) return r;
+  double before = 1, volume = 0, after = 1;
+  for (int q : old_tets) before = std::min(before, rho(P, tets[q])), volume += signed_volume(P, tets[q]);
+  std::vector<Tet> fresh;
+  double fresh_volume = 0;
+  for (int m = 0; m < k; ++m) {
+    const int x = ring[m], y = ring[(m + 1) % k];
+    if (orient3d(P[x].data(), P[y].data(), P[u].data(), P[w].data()) != turn) return r;
+    fresh.push_back(turn > 0 ? Tet{x, y, u, w} : Tet{y, x, u, w});
+    after = std::min(after, rho(P, fresh.back()));
+    fresh_volume += signed_volume(P, fresh.back());
+  }
+  if (!(after > before) || !(std::abs(fresh_volume - volume) <= 1e-9 * std::abs(volume))) return r;
+  r.old_tets = old_tets, r.new_tets = std::move(fresh), r.before = before, r.after = after;
+  return r;
+}
+
+}  // namespace
+
+TetReplacement plan_remove_faces(const TetSweep& s, int t, int face) {
+  const Tet& v = s.tets[t];
+  const int u = v[face];
+  const int q = s.touched[t] ? -1 : across(s, t, face);
+  if (q < 0 || s.touched[q]) return {};
+  int w = -1;
+  for (int x : s.tets[q])
+    if (!has(v, x)) w = x;
+  std::vector<int> uw;
+  s.tets_with(u, w, -1, uw);
+  if (!uw.empty() || s.locked[u] || s.locked[w]) return {};  // the new edge must not exist yet
+  // the sandwich: the ring of its faces' triangulation (a disc: each face added shares one
+  // edge with it and brings a new node) and its tets, two per face
+  std::vector<int> ring{v[kTetFace[face][0]], v[kTetFace[face][1]], v[kTetFace[face][2]]};
+  std::vector<int> old{t, q}, with_u, with_w;
+  for (int x : ring)
+    if (s.locked[x]) return {};
+  TetReplacement best = sandwich_replacement(s.P, s.tets, ring, old, u, w);
+  while (old.size() < 2 * static_cast<size_t>(kSandwichFaces)) {
+    // grow across the ring edge whose face gives the best replacement (or the first growable)
+    TetReplacement grown;
+    int at = -1, node = -1, tu = -1, tw = -1;
+    for (int m = 0; m < static_cast<int>(ring.size()); ++m) {
+      const int x = ring[m], y = ring[(m + 1) % ring.size()];
+      s.tets_with(x, y, u, with_u);
+      if (with_u.size() != 2) continue;
+      const int cu = std::find(old.begin(), old.end(), with_u[0]) == old.end() ? with_u[0] : with_u[1];
+      if (std::find(old.begin(), old.end(), cu) != old.end() || s.touched[cu]) continue;
+      int z = -1;
+      for (int y2 : s.tets[cu])
+        if (y2 != x && y2 != y && y2 != u) z = y2;
+      if (z == w || s.locked[z] || std::find(ring.begin(), ring.end(), z) != ring.end()) continue;
+      s.tets_with(x, y, z, with_w);
+      int cw = -1;
+      for (int c : with_w)
+        if (has(s.tets[c], w) && !s.touched[c]) cw = c;
+      if (cw < 0) continue;
+      std::vector<int> r2 = ring, o2 = old;
+      r2.insert(r2.begin() + m + 1, z);
+      o2.push_back(cu), o2.push_back(cw);
+      TetReplacement c = sandwich_replacement(s.P, s.tets, r2, o2, u, w);
+      if (at < 0 || (!c.empty() && (grown.empty() || c.after > grown.after)))
+        grown = std::move(c), at = m, node = z, tu = cu, tw = cw;
+    }
+    if (at < 0) break;
+    ring.insert(ring.begin() + at + 1, node);
+    old.push_back(tu), old.push_back(tw);
+    if (!grown.empty() && (best.empty() || grown.after > best.after)) best = std::move(grown);
+  }
+  return best;
+}
+
+namespace {
 
 /// Where a Steiner point may take sliver t out: its circumcentre (when within its longest
 /// edge of its centroid: a sliver's lies near its middle), and, for each face of t on the
@@ -817,19 +956,32 @@ long perturb_sliver_nodes(std::vector<Vec3>& P, const std::vector<Tet>& tets, in
 long remove_slivers(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress) {
   long left = static_cast<long>(tets_below(P, tets, floor).size());
+  if (left == 0) return 0;
   // first the plain rounds, then, for what they leave, the rounds with optimise_node and the
-  // best flips (run first, those left NIST 5's fill with tets below 0.1 that these clear)
-  for (const bool optimise : {false, true})
+  // best flips (run first, those left NIST 5's fill with tets below 0.1 that these clear),
+  // then for what those leave the wide reconnections (every triangulation of larger edge
+  // rings, multi-face removal: the slivers of boundary nodes that no point may take out);
+  // what each phase leaves and the CPU it takes go to the volume stage's info line
+  constexpr const char* kPhase[] = {"perturbation, flips and refills", "optimisation", "wide reconnections"};
+  std::ostringstream report;
+  report << "volume: sliver removal: " << left << " tets below " << floor;
+  for (const int phase : {0, 1, 2}) {
+    if (left == 0) break;
+    const double cpu0 = thread_cpu_seconds();
     for (int round = 0; round < rounds && left > 0; ++round) {
       progress.check_cancel("volume meshing (slivers)");
-      perturb_sliver_nodes(P, tets, first_new, floor, optimise);
-      flip_bad_tets(P, tets, floor, optimise);
+      perturb_sliver_nodes(P, tets, first_new, floor, phase > 0);
+      flip_bad_tets(P, tets, floor, phase > 0, phase == 2);
       remove_tets_below(P, tets, floor, 2, progress);
       const long now = static_cast<long>(tets_below(P, tets, floor).size());
       const bool fell = now < left;
       left = now;
       if (!fell) break;
     }
+    report << ", " << left << " after the " << kPhase[phase] << " (" << std::fixed << std::setprecision(2)
+           << thread_cpu_seconds() - cpu0 << " s CPU)";
+  }
+  progress.info(report.str());
   return left;
 }
 

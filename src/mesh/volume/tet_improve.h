@@ -69,13 +69,27 @@ struct TetReplacement {
 /// Edge removal (check-only): the untouched tets around the inner edge (u, w) — a closed ring
 /// of 3 to 7 of them, no node locked — replaced by the fan triangulation of their ring (from
 /// the ring node that gives the best worst tet) joined to u and w, when every new tet is
-/// positive and the worst radius ratio rises. A ring of three is the 3-2 flip.
-TetReplacement plan_remove_edge(const TetSweep& s, int u, int w);
+/// positive and the worst radius ratio rises. A ring of three is the 3-2 flip. With `optimal`:
+/// rings of up to kOptimalRing tets, triangulated by the best of ALL triangulations of the
+/// ring (dynamic programming, Shewchuk's edge removal) instead of the best fan.
+TetReplacement plan_remove_edge(const TetSweep& s, int u, int w, bool optimal = false);
+/// The largest ring plan_remove_edge takes with `optimal`.
+constexpr int kOptimalRing = 12;
 /// 2-3 flip (check-only): face `face` (0..3, opposite that node) of untouched tet t, shared
 /// with one other untouched tet, replaced by the edge joining the two apexes (which must not
 /// exist yet and must cross the face's interior), no node locked, when the worst radius
 /// ratio rises.
 TetReplacement plan_flip23(const TetSweep& s, int t, int face);
+/// Multi-face removal (check-only; Shewchuk's, the inverse of edge removal): u is the node of
+/// untouched tet t opposite `face`, w the apex of the tet across it; the faces between u and w
+/// (each with a tet to u and a tet to w, grown from `face` across the edge whose face gives the
+/// best result, up to kSandwichFaces of them) are replaced by the new edge uw and one tet per
+/// edge of their outline — 2m tets by m + 2 —, at the size that gives the best worst radius
+/// ratio, when it rises, every new tet is positive and the volume is kept. m = 1 is the 2-3
+/// flip. Takes out slivers whose nodes may not move and that no edge removal helps.
+TetReplacement plan_remove_faces(const TetSweep& s, int t, int face);
+/// The most faces plan_remove_faces removes at once.
+constexpr int kSandwichFaces = 10;
 /// Makes replacement r: the slots of its old tets are rewritten or removed, the extra tets
 /// appended; all of them are touched and every node of the old tets is locked.
 void apply(TetSweep& s, const TetReplacement& r);
@@ -155,8 +169,10 @@ constexpr size_t kConflictTets = 48;
 /// Sweeps of edge removal then 2-3 flips over the tets below `bad` (each tet changed at most
 /// once per sweep, up to 4 sweeps while any flip happens). `best`: every edge removal and
 /// 2-3 flip at a tet is planned and the one whose new worst radius ratio is highest is made;
-/// otherwise the first improving one (edges, then faces). Returns the number of changes.
-long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad, bool best = false);
+/// otherwise the first improving one (edges, then faces). `wide`: plan_remove_edge's optimal
+/// mode and plan_remove_faces in place of the 2-3 flip. Returns the number of changes.
+long flip_bad_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, double bad, bool best = false,
+                   bool wide = false);
 /// `iterations` sweeps of smooth_node over the nodes from first_new on.
 void smooth_nodes(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int first_new,
                   int iterations);
@@ -196,7 +212,8 @@ long remove_tets_below(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, 
 /// of the slivers perturbed (perturb_sliver_nodes, nodes from first_new on), edge removal and
 /// 2-3 flips at them, and wider cavities re-filled (remove_tets_below, 2 sweeps; the points it
 /// adds are the next round's to move); then, for the tets still below floor, the same rounds
-/// with perturb_sliver_nodes' optimise and flip_bad_tets' best (each phase up to `rounds`).
+/// with perturb_sliver_nodes' optimise and flip_bad_tets' best, then for what those leave the
+/// same with flip_bad_tets' wide reconnections too (each phase up to `rounds`).
 /// Returns the number of tets below floor left.
 long remove_slivers(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new, double floor, int rounds,
                     const Progress& progress = {});
