@@ -119,8 +119,9 @@ double corrected_linear_multiplier(Candidates& candidates, const VecXd& x, const
     const Bracket b = bisect([&](double lambda) { return g_at(lambda) - target; }, hint);
     hint = b.hi;
     const Sample s{g_at(b.hi), volume_excess(candidates.at(b.hi))};
-    // the exact bisection's result lies within the volume change across its last bracket
-    if (std::abs(s.r) <= zero.slope() * (g_at(b.lo) - s.g)) return b.hi;
+    // as the exact bisection's result: not too much material, and short of the target by less
+    // than the volume change across its last bracket
+    if (s.r <= 0 && -s.r <= zero.slope() * (g_at(b.lo) - s.g)) return b.hi;
     target = zero.next(s);
   }
   return 0;

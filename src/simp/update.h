@@ -30,8 +30,8 @@ struct OcLinearisation {
 /// under the projection is a filter application and a projection of every element — and the
 /// multiplier is corrected on the real volume (one volume_excess per round: the model's
 /// constant and slope along the candidates' path refitted through the real values, a secant)
-/// until the real volume is met as tightly as the exact bisection meets it (within the volume
-/// change across its last bracket). dv must then be the gradient of volume_excess at x. Rounds
+/// until the real volume is met as the exact bisection meets it (not over the target, and short
+/// of it by less than the volume change across the last bracket). dv must then be the gradient of volume_excess at x. Rounds
 /// that do not get there (a volume far from linear: draw direction, overhang) end in the exact
 /// bisection from the last multiplier, so the result meets the volume either way.
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
