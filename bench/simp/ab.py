@@ -6,6 +6,7 @@ Each side runs single-threaded (OMP_NUM_THREADS=1, OPENBLAS_NUM_THREADS=1) pinne
   cantilever_off  the cantilever job from the STEP files (1 mm), output step and verification off
   cantilever_on   the same with step and verification on (the job's defaults)
   rocker          the rocker job from the STEP files (1.15 mm, ~100 k tets), job defaults
+  rocker_off      the same with step and verification off
   solve           one `topopt solve` on the rocker meshed at 1.15 mm (by side A, the same MSH for
                   both sides) and one `ccx` of the same mesh and loads, interleaved
 --iterations N caps every study at N SIMP iterations and --from-mesh reads each example's mesh
@@ -124,8 +125,8 @@ def main():
                     _, t, wall, peak = benchlib.run(cmd, env)
                     record({"study": "ccx", "round": rnd, "side": side, "cpu": t, "wall": wall, "peak": peak})
                     continue
-                ex, size = ("rocker", 1.15) if name == "rocker" else ("cantilever", 1.0)
-                extra = {"output": off if name == "cantilever_off" else {}}
+                ex, size = ("rocker", 1.15) if name.startswith("rocker") else ("cantilever", 1.0)
+                extra = {"output": off if name.endswith("_off") else {}}
                 if a.iterations:
                     extra["optimization"] = {"max_iterations": a.iterations}
                 mesh = {"file": shared_mesh(a.a, a.work, ex, size)} if a.from_mesh else {"size": size}

@@ -179,9 +179,12 @@ simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, 
     VecXd dc, dv;
     const double c = problem.compliance(x, dc);
     const double vol = problem.volume_fraction(x, &dv);
-    // ---- update: OC, its multiplier's bisection on the global volume
+    // ---- update: OC, its multiplier's bisection on the global volume linearised at x (one
+    // all-reduce a step), corrected on the real global volume as the serial loop does
     auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn, nullptr) - params.volume_fraction; };
-    const VecXd xnew = simp::oc_update(x, dc, dv.cwiseMax(1e-30), moves.at(x), excess);
+    const simp::OcLinearisation linear{vol - params.volume_fraction,
+                                       [&](double local) { return sum_all(session, local); }};
+    const VecXd xnew = simp::oc_update(x, dc, dv.cwiseMax(1e-30), moves.at(x), excess, nullptr, &linear);
     const double change = max_all(session, num_design ? (xnew - x).cwiseAbs().maxCoeff() : 0.0);
     simp::IterationRecord rec;
     rec.iteration = it, rec.compliance = c, rec.volume_fraction = vol, rec.change = change;

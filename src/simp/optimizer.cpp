@@ -241,12 +241,16 @@ class DesignUpdate {
   DesignUpdate(const SimpParams& params, int num_design, int num_constraints)
       : params_(params), mma_(num_design, num_constraints, params.move), moves_(move_limits(params, num_design)) {}
 
-  /// The next design from x (#D) with compliance sensitivities dc and volume ones dv (#D) for
-  /// OC, or the objective and constraints `mma` (responses/responses.h) for MMA.
-  VecXd step(const ComplianceProblem& problem, const VecXd& x, const VecXd& dc, const VecXd& dv, const MmaTerms& mma) {
+  /// The next design from x (#D) with compliance sensitivities dc, the volume fraction vol at x
+  /// and its sensitivities dv (#D) for OC, or the objective and constraints `mma`
+  /// (responses/responses.h) for MMA. OC bisects on the volume linearised at x and corrects
+  /// the multiplier on the real volume, which it meets as the exact bisection does (update.h).
+  VecXd step(const ComplianceProblem& problem, const VecXd& x, double vol, const VecXd& dc, const VecXd& dv,
+             const MmaTerms& mma) {
     if (params_.update == UpdateKind::OC) {
       auto excess = [&](const VecXd& xn) { return problem.volume_fraction(xn) - params_.volume_fraction; };
-      return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess, &multiplier_);
+      const OcLinearisation linear{vol - params_.volume_fraction, {}};
+      return oc_update(x, dc, dv.cwiseMax(1e-30), moves_.at(x), excess, &multiplier_, &linear);
     }
     return mma_.update(x, mma.f0, mma.df0, mma.f, mma.df);
   }
@@ -354,7 +358,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     // ---- update
     MmaTerms mma = params.update == UpdateKind::MMA ? responses.terms(problem, c, dc, vol, dv) : MmaTerms{};
     add_local_volume(problem, local.get(), x, mma);
-    const VecXd xnew = update.step(problem, x, dc, dv, mma);
+    const VecXd xnew = update.step(problem, x, vol, dc, dv, mma);
     IterationRecord rec{it,
                         c,
                         vol,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace topopt::simp {
 
@@ -25,38 +26,119 @@ void bracket_near(double hint, const Excess& excess_at, double& l1, double& l2) 
   }
 }
 
+/// The multiplier's last bracket: too much material at lo (or lo = 0), not too much at hi.
+struct Bracket {
+  double lo = 0, hi = 1e9;
+};
+
+/// Brackets the multiplier (around hint when it is a usable one, else blind from 1e9: compliance
+/// sensitivities can be far from 1 in scale) and bisects it to 1e-6 relative.
+template <class Excess>
+Bracket bisect(const Excess& excess_at, double hint) {
+  Bracket b;
+  if (hint > 0 && std::isfinite(hint))
+    bracket_near(hint, excess_at, b.lo, b.hi);
+  else
+    while (excess_at(b.hi) > 0 && b.hi <= 1e300) b.lo = b.hi, b.hi *= 1e3;
+  while ((b.hi - b.lo) / (b.lo + b.hi) > 1e-6) {
+    const double mid = 0.5 * (b.lo + b.hi);
+    (excess_at(mid) > 0 ? b.lo : b.hi) = mid;
+  }
+  return b;
+}
+
+/// OC's candidate design for a multiplier λ: x_i sqrt(−dc_i / (λ dv_i)) within the move limits
+/// and [0, 1] (top88's heuristic update).
+class Candidates {
+ public:
+  Candidates(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move)
+      : x_(x), dc_(dc), dv_(dv), move_(move), xnew_(x.size()) {}
+  const VecXd& at(double lambda) {
+    for (long i = 0; i < x_.size(); ++i) {
+      const double b = std::sqrt(std::max(-dc_[i], 0.0) / (lambda * dv_[i]));
+      xnew_[i] = std::clamp(x_[i] * b, std::max(0.0, x_[i] - move_[i]), std::min(1.0, x_[i] + move_[i]));
+    }
+    return xnew_;
+  }
+
+ private:
+  const VecXd &x_, &dc_, &dv_, &move_;
+  VecXd xnew_;
+};
+
+/// The real volume's excess r at a candidate whose linear part Σ dv_i x_i(λ) is g.
+struct Sample {
+  double g, r;
+};
+
+/// Where the real volume's excess is zero, on g, from its samples: regula falsi with the
+/// Illinois rule once samples of both signs bracket it (r falls as g falls, so the bracket
+/// always holds the zero), else the secant through the last two samples, else the tangent at x
+/// (slope 1: the volume linearised at x).
+class ZeroOnG {
+ public:
+  /// The g to try after sample s.
+  double next(const Sample& s) {
+    const bool repeat = last_ && (last_->r > 0) == (s.r > 0);
+    std::optional<Sample>& same = s.r > 0 ? above_ : below_;
+    std::optional<Sample>& other = s.r > 0 ? below_ : above_;
+    if (repeat && other) other->r *= 0.5;  // Illinois: the far end stayed twice, halve its weight
+    const double secant = last_ && s.g != last_->g ? (s.r - last_->r) / (s.g - last_->g) : 0;
+    if (secant > 0 && std::isfinite(secant)) slope_ = secant;  // the volume grows with g: else keep it
+    same = s, last_ = s;
+    if (above_ && below_) {
+      slope_ = (above_->r - below_->r) / (above_->g - below_->g);
+      return below_->g - below_->r / slope_;
+    }
+    return s.g - s.r / slope_;
+  }
+  /// The slope of the real excess over g last used.
+  double slope() const { return slope_; }
+
+ private:
+  std::optional<Sample> above_, below_, last_;
+  double slope_ = 1;
+};
+
+/// The linearised bisection with its corrections on the real volume (oc_update in update.h):
+/// each round bisects the multiplier for a target of g(λ) = Σ dv_i x_i(λ) (dot products only),
+/// first the tangent at x (the volume linearised at x), then one from the real values found
+/// (ZeroOnG). Returns the multiplier, or 0 when the rounds do not meet the real volume as
+/// tightly as the exact bisection would (the caller then bisects exactly from `hint`, which
+/// receives the last multiplier).
+double corrected_linear_multiplier(Candidates& candidates, const VecXd& x, const VecXd& dv,
+                                   const std::function<double(const VecXd&)>& volume_excess,
+                                   const OcLinearisation& linear, double& hint) {
+  // Near a settled design one or two rounds; from a design far off the target at β = 32 up to 8.
+  constexpr int kRounds = 10;
+  const auto sum = [&](double local) { return linear.global_sum ? linear.global_sum(local) : local; };
+  const auto g_at = [&](double lambda) { return sum(dv.dot(candidates.at(lambda))); };
+  double target = sum(dv.dot(x)) - linear.excess_at_x;
+  ZeroOnG zero;
+  for (int round = 0; round < kRounds; ++round) {
+    const Bracket b = bisect([&](double lambda) { return g_at(lambda) - target; }, hint);
+    hint = b.hi;
+    const Sample s{g_at(b.hi), volume_excess(candidates.at(b.hi))};
+    // as the exact bisection's result: not too much material, and short of the target by less
+    // than the volume change across its last bracket
+    if (s.r <= 0 && -s.r <= zero.slope() * (g_at(b.lo) - s.g)) return b.hi;
+    target = zero.next(s);
+  }
+  return 0;
+}
+
 }  // namespace
 
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
-                const std::function<double(const VecXd&)>& volume_excess, double* multiplier) {
-  double l1 = 0, l2 = 1e9;
-  VecXd xnew(x.size());
-  auto candidate = [&](double lambda) {
-    for (long i = 0; i < x.size(); ++i) {
-      double b = std::sqrt(std::max(-dc[i], 0.0) / (lambda * dv[i]));
-      xnew[i] = std::clamp(x[i] * b, std::max(0.0, x[i] - move[i]), std::min(1.0, x[i] + move[i]));
-    }
-  };
-  auto excess_at = [&](double lambda) {
-    candidate(lambda);
-    return volume_excess(xnew);
-  };
-  if (multiplier && *multiplier > 0 && std::isfinite(*multiplier)) {
-    bracket_near(*multiplier, excess_at, l1, l2);
-  } else {
-    // Bracket the multiplier first: compliance sensitivities can be far from 1 in scale.
-    while (excess_at(l2) > 0 && l2 <= 1e300) l1 = l2, l2 *= 1e3;
-  }
-  while ((l2 - l1) / (l1 + l2) > 1e-6) {
-    double mid = 0.5 * (l1 + l2);
-    if (excess_at(mid) > 0)
-      l1 = mid;
-    else
-      l2 = mid;
-  }
-  candidate(l2);
-  if (multiplier) *multiplier = l2;
-  return xnew;
+                const std::function<double(const VecXd&)>& volume_excess, double* multiplier,
+                const OcLinearisation* linearised) {
+  Candidates candidates(x, dc, dv, move);
+  double hint = multiplier ? *multiplier : 0;
+  double lambda =
+      linearised ? corrected_linear_multiplier(candidates, x, dv, volume_excess, *linearised, hint) : 0;
+  if (lambda <= 0) lambda = bisect([&](double l) { return volume_excess(candidates.at(l)); }, hint).hi;
+  if (multiplier) *multiplier = lambda;
+  return candidates.at(lambda);
 }
 
 MoveLimits::MoveLimits(int n, double largest, double smallest, double shrink, double grow)

@@ -8,17 +8,35 @@
 
 namespace topopt::simp {
 
+/// What OC's linearised bisection needs beyond oc_update's arguments.
+struct OcLinearisation {
+  /// volume_excess(x) at the current design, which the caller has computed already.
+  double excess_at_x = 0;
+  /// A rank's partial dot product → the global one (an MPI all-reduce); the identity when empty.
+  std::function<double(double)> global_sum;
+};
+
 /// Optimality criteria with move limits. x: #D current design variables in [0, 1]; dc: #D
 /// objective sensitivities (<= 0 for compliance); dv: #D constraint sensitivities (> 0);
 /// move: #D largest change of each variable (MoveLimits, or one value for all);
 /// volume_excess(x_new): the volume constraint's value for a candidate (> 0 means too much
 /// material). The Lagrange multiplier is found by bisection (to 1e-6 relative) so the
 /// constraint is met. multiplier (optional, in/out): the last iteration's multiplier, > 0, to
-/// bracket around (about 24 volume evaluations instead of ~40 from a blind bracket: each is a
-/// filter application with the projection on); receives this one's. Null or <= 0: a blind
-/// bracket from 1e9.
+/// bracket around (about 24 volume evaluations instead of ~40 from a blind bracket); receives
+/// this one's. Null or <= 0: a blind bracket from 1e9.
+///
+/// linearised (optional): the bisection then runs on the volume linearised at x,
+/// excess(x) + Σ dv_i (x_new,i − x_i) — a dot product per step instead of volume_excess, which
+/// under the projection is a filter application and a projection of every element — and the
+/// multiplier is corrected on the real volume (one volume_excess per round: the model's
+/// constant and slope along the candidates' path refitted through the real values, a secant)
+/// until the real volume is met as the exact bisection meets it (not over the target, and short
+/// of it by less than the volume change across the last bracket). dv must then be the gradient of volume_excess at x. Rounds
+/// that do not get there (a volume far from linear: draw direction, overhang) end in the exact
+/// bisection from the last multiplier, so the result meets the volume either way.
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
-                const std::function<double(const VecXd&)>& volume_excess, double* multiplier = nullptr);
+                const std::function<double(const VecXd&)>& volume_excess, double* multiplier = nullptr,
+                const OcLinearisation* linearised = nullptr);
 
 /// Move limits per variable for OC that let an oscillating design settle: a variable whose
 /// last two steps went opposite ways gets its limit multiplied by `shrink`, one that kept
