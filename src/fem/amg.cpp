@@ -24,7 +24,6 @@ struct Level {
   double lambda = 1;           // estimate of λmax(D⁻¹A)
   std::vector<double> eigvec;  // its eigenvector estimate (restarts the power iteration)
   CsrMatrix P, R;              // to/from the next coarser level
-  CsrMatrix AP;                // A P, kept so that a Galerkin refresh rewrites values only
   // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
@@ -204,6 +203,26 @@ CsrMatrix smoothed_prolongator(const CsrMatrix& A, const CsrMatrix& Pt, const st
         }
   }
   return AP;
+}
+
+/// The values of C = R (A P) recomputed for new values of A on C's pattern (the product the setup
+/// made: multiply(R, multiply(A, P))): A P formed a slice of A's row blocks at a time and its
+/// terms added to C as they come (add_product_rows), so that about 1/kSlices of A P is held —
+/// A P is the hierarchy's largest matrix (1.5 times A's entries on the rocker), and keeping it
+/// whole between refreshes was 0.5 GB per million tets. The same additions in the same order as
+/// the product of the whole A P: the same values to the bit.
+void galerkin_values(const CsrMatrix& A, const CsrMatrix& P, const CsrMatrix& R, CsrMatrix& C, int threads) {
+  constexpr long kSlices = 8;
+  std::fill(C.val.begin(), C.val.end(), 0.0);
+  std::vector<int> cursor(row_blocks(R));
+  for (size_t b = 0; b < cursor.size(); ++b) cursor[b] = R.ptr[R.blocks.empty() ? b : R.blocks[b]];
+  const long blocks = row_blocks(A);
+  for (long s = 0; s < kSlices; ++s) {
+    const long b0 = blocks * s / kSlices, b1 = blocks * (s + 1) / kSlices;
+    if (b0 == b1) continue;
+    const CsrMatrix slice = multiply_rows(A, P, b0, b1, threads);
+    add_product_rows(R, slice, A.blocks.empty() ? static_cast<int>(b0) : A.blocks[b0], cursor, C, threads);
+  }
 }
 
 }  // namespace
@@ -406,8 +425,8 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     L.P = smoothed_prolongator(Al, Pt, L.inv_diag, L.lambda, m.threads);
     L.R = transpose(L.P);
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
-    L.AP = multiply(Al, L.P, m.threads);
-    CsrMatrix coarse = multiply(L.R, L.AP, m.threads);
+    // A P only for as long as the product needs it (a refresh forms it again slice by slice)
+    CsrMatrix coarse = multiply(L.R, multiply(Al, L.P, m.threads), m.threads);
     Impl::to_float(L.P, L.Pf);
     Impl::to_float(L.R, L.Rf);
     Impl::to_float(Al, L.Af);
@@ -439,10 +458,8 @@ void SmoothedAggregationAmg::refresh_galerkin() {
     m.inverse_diagonal(L);
     m.estimate_lambda(L, 5);
     Impl::to_float(*L.A, L.Af);
-    // same patterns as the setup's products: rewrite their values in place (the next level's
-    // A points at its `own`)
-    multiply_values(*L.A, L.P, L.AP, m.threads);
-    multiply_values(L.R, L.AP, m.levels[l + 1].own, m.threads);
+    // the setup's pattern: the next level's values rewritten in place (its A points at its `own`)
+    galerkin_values(*L.A, L.P, L.R, m.levels[l + 1].own, m.threads);
   }
   m.inverse_diagonal(m.levels.back());
   m.factor_coarsest(true);

@@ -27,20 +27,27 @@ bool CsrMatrix::blocks_consistent() const {
   return true;
 }
 
+long row_blocks(const CsrMatrix& A) { return A.blocks.empty() ? A.rows : static_cast<long>(A.blocks.size()) - 1; }
+
+CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
+  return multiply_rows(A, B, 0, row_blocks(A), threads);
+}
+
 // Gustavson's row-by-row product with a dense accumulator per thread; a block's rows share one
 // walk over their column indices.
-CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
-  assert(A.cols == B.rows);
+CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads) {
+  assert(A.cols == B.rows && 0 <= first && first <= last && last <= row_blocks(A));
   constexpr int kB = CsrMatrix::kMaxBlock;
-  CsrMatrix C;
-  C.rows = A.rows;
-  C.cols = B.cols;
   std::vector<int> blocks = A.blocks;
   if (blocks.empty()) {  // one row a block
     blocks.resize(A.rows + 1);
     std::iota(blocks.begin(), blocks.end(), 0);
   }
-  const long nblocks = static_cast<long>(blocks.size()) - 1;
+  const int row0 = blocks[first];
+  CsrMatrix C;
+  C.rows = blocks[last] - row0;
+  C.cols = B.cols;
+  const long nblocks = last - first;
   const int chunks = static_cast<int>(std::max(1L, std::min<long>(threads, nblocks / 512 + 1)));
   struct Part {
     std::vector<int> count, col;
@@ -54,7 +61,7 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
         std::vector<double> acc;
         for (long c = cb; c < ce; ++c) {
           Part& part = parts[c];
-          const long b0 = nblocks * c / chunks, b1 = nblocks * (c + 1) / chunks;
+          const long b0 = first + nblocks * c / chunks, b1 = first + nblocks * (c + 1) / chunks;
           part.count.reserve(blocks[b1] - blocks[b0]);
           part.col.reserve(static_cast<size_t>(A.ptr[blocks[b1]] - A.ptr[blocks[b0]]) * 4);
           part.val.reserve(part.col.capacity());
@@ -92,7 +99,7 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
         }
       },
       1);
-  C.ptr.assign(A.rows + 1, 0);
+  C.ptr.assign(C.rows + 1, 0);
   long nnz = 0, row = 0;
   for (const Part& p : parts) nnz += static_cast<long>(p.col.size());
   C.col = std::move(parts[0].col);  // the first part in place, the others appended
@@ -106,36 +113,42 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
     C.col.insert(C.col.end(), p.col.begin(), p.col.end());
     C.val.insert(C.val.end(), p.val.begin(), p.val.end());
   }
-  assert(row == A.rows);
-  C.blocks = A.blocks;
+  assert(row == C.rows);
+  if (!A.blocks.empty())
+    for (long b = first; b <= last; ++b) C.blocks.push_back(A.blocks[b] - row0);
   return C;
 }
 
-void multiply_values(const CsrMatrix& A, const CsrMatrix& B, CsrMatrix& C, int threads) {
-  assert(A.cols == B.rows && C.rows == A.rows && C.cols == B.cols);
+void add_product_rows(const CsrMatrix& A, const CsrMatrix& X, int first, std::vector<int>& cursor, CsrMatrix& C,
+                      int threads) {
+  assert(C.rows == A.rows && C.cols == X.cols);
   constexpr int kB = CsrMatrix::kMaxBlock;
   const bool one_row = A.blocks.empty();
-  const long nblocks = one_row ? A.rows : static_cast<long>(A.blocks.size()) - 1;
+  const long nblocks = row_blocks(A);
+  const int last = first + X.rows;
+  assert(static_cast<long>(cursor.size()) == nblocks);
   parallel_for(
       nblocks, threads,
       [&](long bb, long be) {
-        std::vector<int> slot(B.cols);  // a column's position in the block's rows of C
+        std::vector<int> slot(C.cols);  // a column's position in the block's rows of C
         for (long blk = bb; blk < be; ++blk) {
           const int r0 = one_row ? static_cast<int>(blk) : A.blocks[blk];
-          const int nr = one_row ? 1 : A.blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
+          const int nr = one_row ? 1 : A.blocks[blk + 1] - r0, end = A.ptr[r0 + 1];
+          int k = cursor[blk];
+          if (k == end || A.col[k] >= last) continue;
           const int c0 = C.ptr[r0], clen = C.ptr[r0 + 1] - c0;
           for (int t = 0; t < clen; ++t) slot[C.col[c0 + t]] = t;
-          for (int r = 0; r < nr; ++r) std::fill_n(&C.val[C.ptr[r0 + r]], clen, 0.0);
-          for (int k = 0; k < len; ++k) {
-            const int cc = A.col[A.ptr[r0] + k];
+          for (; k < end && A.col[k] < last; ++k) {
+            const int i = A.col[k] - first, offset = k - A.ptr[r0];
             double a[kB];
-            for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
-            for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
-              const int t = slot[B.col[kb]];
-              const double v = B.val[kb];
+            for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + offset];
+            for (int kx = X.ptr[i]; kx < X.ptr[i + 1]; ++kx) {
+              const int t = slot[X.col[kx]];
+              const double v = X.val[kx];
               for (int r = 0; r < nr; ++r) C.val[C.ptr[r0 + r] + t] += a[r] * v;
             }
           }
+          cursor[blk] = k;
         }
       },
       512);

@@ -72,12 +72,24 @@ void sparse_product(const CsrMatrix& M, const Value* val, const double* x, doubl
 /// are formed together and C inherits A's blocks.
 CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads);
 
-/// C = A B again for new values of A and B on the patterns C was computed from: C must be the
-/// result of multiply(A', B') with A' and B' of A's and B's patterns (and row blocks); only
-/// C.val is rewritten, in place, with the additions in multiply's order (the same values to
-/// the bit). No allocation but one column-slot array per thread: the multigrid's Galerkin
-/// refresh of kept coarse levels (fem/amg.h) without fresh pages to fault in.
-void multiply_values(const CsrMatrix& A, const CsrMatrix& B, CsrMatrix& C, int threads);
+/// The number of row blocks of A: its blocks, or its rows when it has none.
+long row_blocks(const CsrMatrix& A);
+
+/// The rows of A B from A's row blocks first .. last − 1 (rows, without blocks), as multiply
+/// forms them (the same values to the bit), in a matrix of their own: its row 0 is the first
+/// row of block `first`, its blocks are those blocks shifted. A product taken a slice at a time.
+CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads);
+
+/// C += the terms of A X that come from X's rows first .. first + Xs.rows − 1, given as Xs (its
+/// row 0 is X's row `first`); C has the pattern (and row blocks) of multiply(A, X), A's columns
+/// increase within each row. cursor (one per row block of A) holds the first entry of each
+/// block's rows whose column is not yet added; it moves past the entries added. Called for
+/// consecutive slices of X from the first row to the last, with C zero and the cursors at A's
+/// row starts before the first, it leaves in C the values of multiply(A, X) — each entry's terms
+/// added in the same order, the same values to the bit — while only a slice of X is held: the
+/// multigrid's Galerkin refresh R (A P) on the kept pattern without the whole of A P (fem/amg.h).
+void add_product_rows(const CsrMatrix& A, const CsrMatrix& Xs, int first, std::vector<int>& cursor, CsrMatrix& C,
+                      int threads);
 
 /// Aᵀ in compressed rows (no blocks).
 CsrMatrix transpose(const CsrMatrix& A);

@@ -4,6 +4,7 @@
 // SolverParams::recycle_iterations iterations (the rules: FactorReuse in solver_policy.h).
 #include <Eigen/CholmodSupport>
 #include <algorithm>
+#include <vector>
 
 #include "common/error.h"
 #include "common/float_mode.h"
@@ -34,6 +35,34 @@ class LowerOperator final : public LinearOperator {
   const SparseLower& K_;
 };
 
+/// The lower triangle of a symmetric matrix K held in full compressed rows (columns increasing
+/// in each row) as the compressed columns CHOLMOD factorises, and where each of its entries
+/// sits in K, so that K's new values are copied over without a search. Row c of K from the
+/// diagonal on is column c of its lower triangle (K is symmetric).
+struct LowerTriangle {
+  SparseLower L;
+  std::vector<int> from;  // nnz(L): the position in K.val of each entry of L
+
+  explicit LowerTriangle(const CsrMatrix& K) {
+    std::vector<int> outer(K.rows + 1, 0), inner;
+    for (int c = 0; c < K.rows; ++c) {
+      for (int k = K.ptr[c]; k < K.ptr[c + 1]; ++k)
+        if (K.col[k] >= c) inner.push_back(K.col[k]), from.push_back(k);
+      outer[c + 1] = static_cast<int>(inner.size());
+    }
+    const std::vector<double> zeros(inner.size(), 0.0);
+    L = Eigen::Map<const SparseLower>(K.rows, K.cols, static_cast<long>(inner.size()), outer.data(), inner.data(),
+                                      zeros.data());
+    refill(K);
+  }
+
+  /// K has new values (same pattern): copies them into L.
+  void refill(const CsrMatrix& K) {
+    double* v = L.valuePtr();
+    for (size_t k = 0; k < from.size(); ++k) v[k] = K.val[from[k]];
+  }
+};
+
 /// A Cholesky factor (of this or an earlier matrix) as a preconditioner.
 class FactorPreconditioner final : public Preconditioner {
  public:
@@ -47,9 +76,10 @@ class FactorPreconditioner final : public Preconditioner {
 class DirectSolver final : public LinearSolver {
  public:
   DirectSolver(const FreeSystem& system, const SolverParams& params)
-      : K_(*system.K), params_(params), reuse_(params.recycle_factor) {}
+      : full_(*system.K), lower_(full_), K_(lower_.L), params_(params), reuse_(params.recycle_factor) {}
 
   void update(const Progress& progress) override {
+    lower_.refill(full_);
     if (factor_ == Factor::Current) factor_ = Factor::Earlier;
     if (reuse_.factorise_on_update(factor_ != Factor::None)) factorise(progress);
   }
@@ -73,7 +103,9 @@ class DirectSolver final : public LinearSolver {
   void factorise(const Progress& progress);
   bool solve_with_earlier_factor(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const Progress& progress);
 
-  const SparseLower& K_;
+  const CsrMatrix& full_;  // the system's K, full storage
+  LowerTriangle lower_;    // its lower triangle, refilled at each update
+  const SparseLower& K_;   // lower_.L
   SolverParams params_;
   FactorReuse reuse_;
   Cholesky cholesky_;

@@ -4,9 +4,13 @@
 //  - per element only the shape-function gradients (4 by 3) and the volume are stored
 //    (13 doubles); K0_e is rebuilt on the fly from them, which costs less than reading 78
 //    stored doubles back from memory on large meshes;
-//  - the reduced matrix (free dofs only, lower triangle, CSC) has its pattern built once from
-//    the node graph, and every element entry knows its slot (`slot_`, 78 ints a tet), so a new
-//    set of element factors refills the values without any search or sort;
+//  - the reduced matrix (free dofs only) is held once, in full compressed rows with node
+//    blocks, the form the multigrid reads (the direct solver keeps the lower triangle it
+//    factorises); its pattern is built once from the node graph, and each tet knows where the
+//    block of each of its 16 node pairs starts (16 ints a tet), so a new set of element factors
+//    refills the values without any search or sort. Before, K was a lower triangle in
+//    compressed columns with a slot per element entry (78 ints a tet) and the multigrid a full
+//    copy of it with a position map: 0.5 GB more per million tets (BENCHMARKS.md, memory);
 //  - assembly runs on threads over element colours (no two elements of a colour share a
 //    node), so there are no write races and no atomics; on one thread in mesh order instead
 //    (neighbouring elements write neighbouring values: 4-6 times faster than by colours).
@@ -16,7 +20,6 @@
 #include "fem/elasticity.h"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/Sparse>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -78,8 +81,11 @@ struct Elasticity::Impl {
   std::vector<double> prescribed;  // 3#V: prescribed value (0 where free)
   bool nonzero_prescribed = false;
 
-  SparseLower K;                          // free-free, lower triangle
-  std::vector<int> slot;                  // #T * 78: index into K's values, or -1
+  CsrMatrix K;  // free-free, full compressed rows, columns increasing, node blocks
+  /// #T * 16: for the tet's nodes a, b (entry 4a + b) the position in K.val of the entry (first
+  /// free row of a, first free column of b), or -1 when a or b has no free dof. Row i of a's
+  /// block sits one row length of a further (a's rows share their columns, blocks).
+  std::vector<int> block_at;
   std::vector<std::vector<int>> colours;  // element ids per colour
 
   std::string singular_reason;  // non-empty: the supports do not hold the structure
@@ -89,10 +95,19 @@ struct Elasticity::Impl {
 
   void compute_geometry();
   void build_dof_maps();
+  /// The free index of node n's first free dof (its others follow it), or -1 if it has none.
+  int first_free(int n) const {
+    for (int i = 0; i < 3; ++i)
+      if (free_index[3 * n + i] >= 0) return free_index[3 * n + i];
+    return -1;
+  }
   void build_pattern();
   void build_colours();
   void check_rigid_body_modes();
   void assemble();
+  /// Adds tet t's upper-triangle entries Ke (78, kLocalPairs' order) and their mirror images
+  /// into K's values.
+  void add_element(long t, const double* Ke);
   /// loads (3#V by #cases) on the free dofs, minus the reactions of prescribed displacements.
   Eigen::MatrixXd free_loads(const Eigen::MatrixXd& loads) const;
   /// The free solution x (nf by #cases) with the prescribed values added: 3#V by #cases.
@@ -151,41 +166,47 @@ void Elasticity::Impl::build_pattern() {
   const int nv = static_cast<int>(mesh.V.rows());
   const long nt = mesh.T.rows();
   const Adjacency graph = node_graph(mesh.T, nv);
-  // Column c = free dof (node nb, comp j); rows: free dofs (na, i), na a neighbour, row >= c.
+  // The rows of node a: its free dofs; the columns of each: the free dofs of a's neighbours
+  // (a included), increasing because neighbours are sorted and the free numbering follows the
+  // dof numbering. Counted first so that the column array is allocated once at its size.
+  auto free_of = [&](int n) {
+    return (free_index[3 * n] >= 0) + (free_index[3 * n + 1] >= 0) + (free_index[3 * n + 2] >= 0);
+  };
   const int nf = static_cast<int>(free_dofs.size());
-  std::vector<int> outer(nf + 1, 0);
-  std::vector<int> inner;
-  for (int c = 0; c < nf; ++c) {
-    int nb = free_dofs[c] / 3;
-    for (int na : graph.row(nb))
-      for (int i = 0; i < 3; ++i) {
-        int r = free_index[3 * na + i];
-        if (r >= c) inner.push_back(r);
-      }
-    // rows of a column come out sorted because neighbours are sorted and the free numbering
-    // follows the dof numbering
-    outer[c + 1] = static_cast<int>(inner.size());
+  K = CsrMatrix();
+  K.rows = K.cols = nf;
+  K.blocks = node_blocks(free_dofs);
+  K.ptr.assign(nf + 1, 0);
+  for (int r = 0; r < nf; ++r) {
+    int len = 0;
+    for (int nb : graph.row(free_dofs[r] / 3)) len += free_of(nb);
+    K.ptr[r + 1] = K.ptr[r] + len;
   }
-  const long nnz = static_cast<long>(inner.size());
-  std::vector<double> zeros(nnz, 0.0);
-  K = Eigen::Map<const SparseLower>(nf, nf, nnz, outer.data(), inner.data(), zeros.data());
-  K.makeCompressed();
-  // Slots of the element entries.
-  slot.assign(kPairs * nt, -1);
-  const int* op = K.outerIndexPtr();
-  const int* ip = K.innerIndexPtr();
+  K.col.resize(K.ptr[nf]);
+  parallel_for(nf, threads, [&](long b, long e) {
+    for (long r = b; r < e; ++r) {
+      int k = K.ptr[r];
+      for (int nb : graph.row(free_dofs[r] / 3))
+        for (int j = 0; j < 3; ++j)
+          if (free_index[3 * nb + j] >= 0) K.col[k++] = free_index[3 * nb + j];
+    }
+  });
+  K.val.assign(K.col.size(), 0.0);
+  // where each node pair's block starts
+  block_at.assign(16 * nt, -1);
   parallel_for(nt, threads, [&](long b, long e) {
-    for (long t = b; t < e; ++t)
-      for (int p = 0; p < kPairs; ++p) {
-        int di = 3 * mesh.T(t, kLocalPairs[p].i / 3) + kLocalPairs[p].i % 3;
-        int dj = 3 * mesh.T(t, kLocalPairs[p].j / 3) + kLocalPairs[p].j % 3;
-        int r = free_index[di], c = free_index[dj];
-        if (r < 0 || c < 0) continue;
-        if (r < c) std::swap(r, c);
-        const int* hit = std::lower_bound(ip + op[c], ip + op[c + 1], r);
-        assert(hit != ip + op[c + 1] && *hit == r);
-        slot[kPairs * t + p] = static_cast<int>(hit - ip);
-      }
+    for (long t = b; t < e; ++t) {
+      int first[4];
+      for (int a = 0; a < 4; ++a) first[a] = first_free(mesh.T(t, a));
+      for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) {
+          if (first[a] < 0 || first[c] < 0) continue;
+          const int* cols = K.col.data();
+          const int* hit = std::lower_bound(cols + K.ptr[first[a]], cols + K.ptr[first[a] + 1], first[c]);
+          assert(*hit == first[c]);
+          block_at[16 * t + 4 * a + c] = static_cast<int>(hit - cols);
+        }
+    }
   });
 }
 
@@ -331,26 +352,39 @@ void Elasticity::Impl::check_rigid_body_modes() {
   }
 }
 
+void Elasticity::Impl::add_element(long t, const double* Ke) {
+  int dof[12], first[4], len[4];  // free index of each local dof; per node its first and its row length
+  for (int a = 0; a < 4; ++a) {
+    const int n = mesh.T(t, a);
+    for (int i = 0; i < 3; ++i) dof[3 * a + i] = free_index[3 * n + i];
+    first[a] = first_free(n);
+    len[a] = first[a] < 0 ? 0 : K.ptr[first[a] + 1] - K.ptr[first[a]];
+  }
+  const int* at = &block_at[16 * t];
+  double* val = K.val.data();
+  for (int p = 0; p < kPairs; ++p) {
+    const int I = kLocalPairs[p].i, J = kLocalPairs[p].j;
+    if (dof[I] < 0 || dof[J] < 0) continue;
+    const int a = I / 3, b = J / 3, i = dof[I] - first[a], j = dof[J] - first[b];
+    // entry (I, J) and its mirror (J, I): the element matrix is symmetric, and both take the
+    // upper triangle's value, so K is symmetric to the bit
+    val[at[4 * a + b] + i * len[a] + j] += Ke[p];
+    if (I != J) val[at[4 * b + a] + j * len[b] + i] += Ke[p];
+  }
+}
+
 void Elasticity::Impl::assemble() {
-  double* val = K.valuePtr();
-  std::fill(val, val + K.nonZeros(), 0.0);
-  // adds element t's 78 upper-triangle entries into K's values
-  auto add_element = [&](int t, double* Ke) {
+  std::fill(K.val.begin(), K.val.end(), 0.0);
+  auto add = [&](long t, double* Ke) {
     element_stiffness_upper(&grad[12 * t], vol[t] * scale[t], lambda, mu, Ke);
-    const int* s = &slot[kPairs * static_cast<long>(t)];
-    for (int p = 0; p < kPairs; ++p)
-      if (s[p] >= 0) {
-        // a diagonal block pair (i,j) and (j,i) of different dofs map to one lower slot only
-        // once, because the 78 pairs are the element's upper triangle
-        val[s[p]] += Ke[p];
-      }
+    add_element(t, Ke);
   };
   if (threads == 1) {
     // one thread: the elements in mesh order, whose neighbours share nodes and so K's rows and
     // cache lines; colour by colour each pass sweeps the whole of K. Cantilever, 63 k tets,
     // 1 thread: 46-69 ms an assembly in colour order, 12 ms in mesh order (BENCHMARKS.md, speed3)
     double Ke[kPairs];
-    for (long t = 0; t < mesh.T.rows(); ++t) add_element(static_cast<int>(t), Ke);
+    for (long t = 0; t < mesh.T.rows(); ++t) add(t, Ke);
     return;
   }
   for (const auto& list : colours) {
@@ -358,7 +392,7 @@ void Elasticity::Impl::assemble() {
         static_cast<long>(list.size()), threads,
         [&](long b, long e) {
           double Ke[kPairs];  // the upper triangle, in kLocalPairs' order
-          for (long k = b; k < e; ++k) add_element(list[k], Ke);
+          for (long k = b; k < e; ++k) add(list[k], Ke);
         },
         512);
   }

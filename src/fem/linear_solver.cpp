@@ -11,8 +11,7 @@ SolverKind choose_solver(SolverKind kind, int free_dofs) {
 }
 
 std::unique_ptr<LinearSolver> make_linear_solver(const FreeSystem& system, const SolverParams& params) {
-  if (choose_solver(params.kind, static_cast<int>(system.K->rows())) == SolverKind::Direct)
-    return make_direct_solver(system, params);
+  if (choose_solver(params.kind, system.K->rows) == SolverKind::Direct) return make_direct_solver(system, params);
   return make_multigrid_solver(system, params);
 }
 

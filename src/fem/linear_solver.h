@@ -57,15 +57,18 @@ constexpr int kDirectDofLimit = AmgParams{}.coarse_dofs;
 /// returned as they are).
 SolverKind choose_solver(SolverKind kind, int free_dofs);
 
-/// Lower triangle of a symmetric sparse matrix, compressed columns.
+/// Lower triangle of a symmetric sparse matrix, compressed columns (what CHOLMOD factorises).
 using SparseLower = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// What a solver sees of the elasticity problem: the stiffness restricted to the free dofs and
 /// where those dofs sit. The pointees are owned by the caller and must outlive the solver.
 struct FreeSystem {
-  /// nf by nf, lower triangle. Its pattern is fixed for the solver's life; its values change
-  /// before each LinearSolver::update.
-  const SparseLower* K = nullptr;
+  /// nf by nf, symmetric, in full compressed rows with columns increasing in each row and the
+  /// node blocks (CsrMatrix::blocks = node_blocks(free_dofs): a node's rows share their
+  /// columns). The one copy of the stiffness: Elasticity assembles into it and the multigrid
+  /// reads it as it is (the direct solver keeps the lower triangle CHOLMOD needs). Its pattern
+  /// is fixed for the solver's life; its values change before each LinearSolver::update.
+  const CsrMatrix* K = nullptr;
   /// nf: the mesh dof (3 * node + component) of each unknown, increasing (so a node's free
   /// components are consecutive unknowns).
   const std::vector<int>* free_dofs = nullptr;

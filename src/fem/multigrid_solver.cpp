@@ -1,5 +1,6 @@
 // The iterative solver: CG preconditioned by our smoothed-aggregation multigrid (fem/amg.h) on
-// a full CSR copy of K, warm-started from the previous solution. Between SIMP iterations the
+// the system's K itself (full compressed rows with node blocks, as Elasticity assembles it: no
+// copy), warm-started from the previous solution. Between SIMP iterations the
 // hierarchy is kept (only its finest smoother refreshed) until the iteration count grows by
 // half (HierarchyReuse in solver_policy.h); a solve on a kept hierarchy that reaches that growth
 // is cut there, the coarse matrices are recomputed from the new matrix on the kept aggregates
@@ -11,7 +12,6 @@
 
 #include "common/blas_threads.h"
 #include "common/error.h"
-#include "common/parallel.h"
 #include "common/stopwatch.h"
 #include "fem/amg.h"
 #include "fem/linear_solver.h"
@@ -21,45 +21,6 @@
 namespace topopt::fem {
 
 namespace {
-
-/// K (lower triangle, compressed columns) in full compressed rows, and for each of K's
-/// entries its one or two positions there (the second -1 on the diagonal), so that new values
-/// of K are copied over without a search.
-struct FullCopy {
-  CsrMatrix full;
-  std::vector<int> pos;  // 2 * nnz(K)
-};
-
-FullCopy full_copy(const SparseLower& K) {
-  FullCopy f;
-  CsrMatrix& full = f.full;
-  const int nf = static_cast<int>(K.rows());
-  const int* op = K.outerIndexPtr();
-  const int* ip = K.innerIndexPtr();
-  full.rows = full.cols = nf;
-  full.ptr.assign(nf + 1, 0);
-  for (int c = 0; c < nf; ++c)
-    for (int k = op[c]; k < op[c + 1]; ++k) {
-      ++full.ptr[ip[k] + 1];
-      if (ip[k] != c) ++full.ptr[c + 1];
-    }
-  for (int i = 0; i < nf; ++i) full.ptr[i + 1] += full.ptr[i];
-  full.col.assign(full.ptr[nf], 0);
-  full.val.assign(full.ptr[nf], 0.0);
-  f.pos.assign(2 * static_cast<size_t>(K.nonZeros()), -1);
-  std::vector<int> fill(full.ptr.begin(), full.ptr.end() - 1);
-  for (int c = 0; c < nf; ++c)
-    for (int k = op[c]; k < op[c + 1]; ++k) {
-      const int r = ip[k];
-      f.pos[2 * k] = fill[r];
-      full.col[fill[r]++] = c;
-      if (r != c) {
-        f.pos[2 * k + 1] = fill[c];
-        full.col[fill[c]++] = r;
-      }
-    }
-  return f;
-}
 
 class MultigridSolver final : public LinearSolver {
  public:
@@ -71,16 +32,13 @@ class MultigridSolver final : public LinearSolver {
   SolverStats stats() const override { return stats_; }
 
  private:
-  void refill();
   void set_up(const Progress& progress);
   PcgResult solve_one(const Eigen::VectorXd& b, Eigen::VectorXd& x, const Progress& progress);
 
   FreeSystem system_;
   SolverParams params_;
   HierarchyReuse reuse_;
-  FullCopy copy_;              // K in full rows (built at the first update)
-  std::vector<int> blocks_;    // node_blocks of the free dofs
-  std::vector<double> modes_;  // near_null_space, nf by 6
+  std::vector<double> modes_;  // near_null_space, nf by 6 (made at the first update)
   SmoothedAggregationAmg amg_;
   bool built_ = false;  // a hierarchy exists (perhaps of an earlier matrix)
   bool kept_ = false;   // the hierarchy in use was built for an earlier matrix
@@ -89,13 +47,7 @@ class MultigridSolver final : public LinearSolver {
 
 void MultigridSolver::update(const Progress& progress) {
   Stopwatch watch;
-  if (copy_.full.rows != system_.K->rows()) {
-    copy_ = full_copy(*system_.K);
-    blocks_ = node_blocks(*system_.free_dofs);
-    copy_.full.blocks = blocks_;  // a node's rows share their columns (the pattern is per node pair)
-    modes_ = near_null_space(*system_.nodes, *system_.free_dofs);
-  }
-  refill();
+  if (modes_.empty()) modes_ = near_null_space(*system_.nodes, *system_.free_dofs);
   kept_ = reuse_.keep(built_);
   if (kept_ && reuse_.refresh_coarse_on_update()) {
     // a recent solve found the kept coarse levels stale: recompute them now (R A P on the kept
@@ -113,26 +65,11 @@ void MultigridSolver::update(const Progress& progress) {
   }
 }
 
-void MultigridSolver::refill() {
-  const double* v = system_.K->valuePtr();
-  const std::vector<int>& pos = copy_.pos;
-  std::vector<double>& val = copy_.full.val;
-  parallel_for(
-      system_.K->nonZeros(), system_.threads,
-      [&](long b, long e) {
-        for (long k = b; k < e; ++k) {
-          val[pos[2 * k]] = v[k];
-          if (pos[2 * k + 1] >= 0) val[pos[2 * k + 1]] = v[k];
-        }
-      },
-      1 << 16);
-}
-
 void MultigridSolver::set_up(const Progress& progress) {
   Stopwatch watch;
   AmgParams ap = params_.multigrid;
   ap.threads = system_.threads;
-  amg_.setup(copy_.full, blocks_, modes_, ap);
+  amg_.setup(*system_.K, system_.K->blocks, modes_, ap);
   built_ = true;
   kept_ = false;
   reuse_.set_up();
@@ -149,12 +86,12 @@ PcgResult MultigridSolver::solve_one(const Eigen::VectorXd& b, Eigen::VectorXd& 
   PcgParams pp;
   pp.tolerance = params_.tolerance;
   pp.max_iterations = kept_ ? reuse_.patience(params_.max_iterations) : params_.max_iterations;
-  return pcg(CsrOperator(copy_.full, system_.threads), amg_, b, x, pp, progress);
+  return pcg(CsrOperator(*system_.K, system_.threads), amg_, b, x, pp, progress);
 }
 
 void MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const Progress& progress) {
   Stopwatch watch;
-  const long nf = system_.K->rows();
+  const long nf = system_.K->rows;
   if (kept_) ++stats_.reuses;
   // The V-cycle's BLAS work (coarse triangular solves) is small: one BLAS thread, so that
   // OpenBLAS's spinning workers leave the cores to our sparse products.

@@ -15,9 +15,10 @@
 namespace topopt::pipeline {
 namespace {
 
-/// Bytes per filter pair of the explicit filter: its one sparse matrix's column index and
-/// value (12), rounded up for the per-thread scratch while it is built.
-constexpr double kBytesPerPair = 16;
+/// Bytes per filter pair of the explicit filter: its one sparse matrix holds the upper triangle,
+/// a column index and a value (12) for every two pairs (i, j) and (j, i), rounded up for the
+/// per-thread scratch while it is built.
+constexpr double kBytesPerPair = 8;
 
 /// A figure as a user reads it: 3 significant digits, no exponent below a million.
 std::string number(double v) {

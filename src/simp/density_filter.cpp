@@ -160,7 +160,9 @@ MatX3d tet_centroids(const TetMesh& mesh) {
 
 DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
                              const FilterParams& params, const std::vector<char>& held)
-    : kind_(params.kind == FilterKind::Cone ? "cone" : "Gaussian"), radius_(params.radius) {
+    : threads_(thread_count(params.threads)),
+      kind_(params.kind == FilterKind::Cone ? "cone" : "Gaussian"),
+      radius_(params.radius) {
   const long nd = static_cast<long>(design.size());
   volume_.resize(nd);
   MatX3d centre(nd, 3);
@@ -171,49 +173,94 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
   if (!(r > 0) || nd == 0) {
     W_.setIdentity();
   } else {
-    // two passes over the neighbours (count, then write) so that the pairs are held once
+    // two passes over the neighbours (count, then write) so that the pairs are held once, and
+    // only those with j >= i (W is symmetric: w depends on the distance alone)
     const CentroidGrid grid(centre, r);
-    const int threads = thread_count(params.threads);
     std::vector<int> count(static_cast<size_t>(nd) + 1, 0);
-    parallel_for(nd, threads, [&](long b, long e) {
+    parallel_for(nd, threads_, [&](long b, long e) {
       std::vector<std::pair<int, double>> scratch;
-      for (long i = b; i < e; ++i) grid.for_each_neighbour(i, scratch, [&](int, double) { ++count[i + 1]; });
+      for (long i = b; i < e; ++i) grid.for_each_neighbour(i, scratch, [&](int j, double) { count[i + 1] += j >= i; });
     });
     for (long i = 0; i < nd; ++i) count[i + 1] += count[i];
     W_.resizeNonZeros(count[nd]);
     std::copy(count.begin(), count.end(), W_.outerIndexPtr());
-    parallel_for(nd, threads, [&](long b, long e) {
+    parallel_for(nd, threads_, [&](long b, long e) {
       std::vector<std::pair<int, double>> scratch;
       for (long i = b; i < e; ++i) {
         int k = count[i];
         grid.for_each_neighbour(i, scratch, [&](int j, double d) {
+          if (j < i) return;
           W_.innerIndexPtr()[k] = j;
           W_.valuePtr()[k++] = weight(params.kind, r, d);
         });
       }
     });
   }
-  weighted_sum_ = W_ * volume_;
-  plain_sum_ = W_ * VecXd::Ones(nd);
+  weighted_sum_ = product(volume_);
+  plain_sum_ = product(VecXd::Ones(nd));
   padded_ = params.pad_free_faces && r > 0 && nd > 0;
   if (padded_) {
     const auto [G, vg] = void_ghosts(mesh, design, r, held);
-    weighted_sum_ += ghost_mass(centre, G, vg, params.kind, r, thread_count(params.threads));
+    weighted_sum_ += ghost_mass(centre, G, vg, params.kind, r, threads_);
   }
 }
 
-VecXd DensityFilter::apply(const VecXd& x) const { return (W_ * volume_.cwiseProduct(x)).cwiseQuotient(weighted_sum_); }
+VecXd DensityFilter::product(const VecXd& z) const {
+  const long n = W_.rows();
+  const int* ptr = W_.outerIndexPtr();
+  const int* col = W_.innerIndexPtr();
+  const double* w = W_.valuePtr();
+  // Row i of W is its lower part (the entries (j, i) of the rows j < i, stored there) then its
+  // stored part, both in increasing j. Rows taken in increasing i, each scattering its w_ij z_i
+  // into the rows j > i, leave in y_i the lower part summed in increasing j just when row i
+  // comes: the full matrix's left-to-right sum, to the bit. `rows` b .. e into y, which holds
+  // the partial sums of the rows before b (zero for the first range).
+  auto rows = [&](long b, long e, double* y) {
+    for (long i = b; i < e; ++i) {
+      double s = y[i];
+      const double zi = z[i];
+      for (int k = ptr[i]; k < ptr[i + 1]; ++k) {
+        const int j = col[k];
+        s += w[k] * z[j];
+        if (j != i) y[j] += w[k] * zi;
+      }
+      y[i] = s;
+    }
+  };
+  VecXd y = VecXd::Zero(n);
+  // the product reads 12 bytes an entry and is memory-bound: threads pay only on large filters,
+  // each with its own partial sums (n doubles), added at the end
+  const int parts = static_cast<int>(std::min<long>(std::min(threads_, 8), W_.nonZeros() / (1 << 20) + 1));
+  if (parts == 1) {
+    rows(0, n, y.data());
+    return y;
+  }
+  std::vector<VecXd> partial(parts, VecXd::Zero(n));
+  parallel_for(
+      parts, parts,
+      [&](long pb, long pe) {
+        for (long p = pb; p < pe; ++p) rows(n * p / parts, n * (p + 1) / parts, partial[p].data());
+      },
+      1);
+  for (const VecXd& part : partial) y += part;
+  return y;
+}
+
+VecXd DensityFilter::apply(const VecXd& x) const {
+  return product(volume_.cwiseProduct(x)).cwiseQuotient(weighted_sum_);
+}
 
 VecXd DensityFilter::apply_transpose(const VecXd& g) const {
-  return (W_ * g.cwiseQuotient(weighted_sum_)).cwiseProduct(volume_);
+  return product(g.cwiseQuotient(weighted_sum_)).cwiseProduct(volume_);
 }
 
 VecXd DensityFilter::filter_sensitivity(const VecXd& x, const VecXd& g) const {
-  return (W_ * x.cwiseProduct(g)).cwiseQuotient(plain_sum_.cwiseProduct(x.cwiseMax(1e-3)));
+  return product(x.cwiseProduct(g)).cwiseQuotient(plain_sum_.cwiseProduct(x.cwiseMax(1e-3)));
 }
 
 double DensityFilter::mean_neighbours() const {
-  return W_.rows() ? static_cast<double>(W_.nonZeros()) / W_.rows() : 0.0;
+  // every stored off-diagonal entry is two pairs (i, j) and (j, i)
+  return W_.rows() ? static_cast<double>(2 * W_.nonZeros() - W_.rows()) / W_.rows() : 0.0;
 }
 
 std::string DensityFilter::describe() const {

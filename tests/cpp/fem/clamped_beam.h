@@ -19,9 +19,10 @@ inline TetMesh beam(std::array<int, 3> cells) {
   return mesh::structured_box_mesh(p);
 }
 
-/// Assembled free-dof stiffness of a clamped beam (x = 0 fixed) in full CSR, with the node
-/// ranges and rigid modes the multigrid needs, and as the lower triangle with the free dofs a
-/// LinearSolver sees; built directly so the tests do not depend on Elasticity's internals.
+/// Assembled free-dof stiffness of a clamped beam (x = 0 fixed) in full CSR with its node
+/// blocks (what a LinearSolver sees, with the free dofs), the node ranges and rigid modes the
+/// multigrid needs, and as the lower triangle (for Eigen's own Cholesky); built directly so the
+/// tests do not depend on Elasticity's internals.
 struct System {
   CsrMatrix A;
   std::vector<int> node_ptr;
@@ -75,6 +76,7 @@ inline System clamped_beam_system(const TetMesh& m, const VecXd& scale) {
   for (int d = 0; d < 3 * nv; ++d)
     if (index[d] >= 0) sys.free_dofs.push_back(d);
   sys.node_ptr = node_ptr;
+  sys.A.blocks = node_ptr;  // every free node has its three dofs, coupled to the same nodes
   sys.modes.assign(6 * nf, 0.0);
   int k = 0;
   for (int n = 0; n < nv; ++n) {

@@ -1,12 +1,14 @@
 // Sparse matrix kernels against dense arithmetic: products with and without row blocks, the
-// single-precision product, the matrix product (fresh, and values only on a kept pattern) and
-// the transpose.
+// single-precision product, the matrix product (whole, a slice of rows at a time, and values
+// only on a kept pattern by slices of its right factor) and the transpose.
 #include "fem/csr_matrix.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <random>
+#include <utility>
 
 namespace topopt::fem {
 namespace {
@@ -72,22 +74,58 @@ TEST(CsrMatrix, MatrixProductAndTransposeEqualDenseArithmetic) {
   EXPECT_EQ(dense(T), dense(A).transpose());
 }
 
-TEST(CsrMatrix, ValuesOnlyProductMatchesAFreshProductToTheBit) {
+/// Rows first .. last − 1 of M as a matrix of their own.
+CsrMatrix rows_of(const CsrMatrix& M, int first, int last) {
+  CsrMatrix S;
+  S.rows = last - first;
+  S.cols = M.cols;
+  S.ptr.assign(1, 0);
+  for (int i = first; i < last; ++i) {
+    S.col.insert(S.col.end(), M.col.begin() + M.ptr[i], M.col.begin() + M.ptr[i + 1]);
+    S.val.insert(S.val.end(), M.val.begin() + M.ptr[i], M.val.begin() + M.ptr[i + 1]);
+    S.ptr.push_back(static_cast<int>(S.col.size()));
+  }
+  return S;
+}
+
+TEST(CsrMatrix, ProductBySlicesMatchesAFreshProductToTheBit) {
   for (const bool blocked : {true, false}) {
     CsrMatrix A = random_blocked(24, 18, 4, 5), B = random_blocked(18, 11, 1, 6);
     if (!blocked) A.blocks.clear();
-    CsrMatrix C = multiply(A, B, 2);
-    const std::vector<double> old_values = C.val;
-    std::mt19937 rng(7);  // new values, same patterns: SIMP's next stiffness on kept aggregates
+    for (int i = 0; i < A.rows; ++i) {  // add_product_rows wants increasing columns (as a transpose has)
+      std::vector<std::pair<int, double>> row;
+      for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k) row.push_back({A.col[k], A.val[k]});
+      std::sort(row.begin(), row.end());
+      for (size_t k = 0; k < row.size(); ++k) A.col[A.ptr[i] + k] = row[k].first, A.val[A.ptr[i] + k] = row[k].second;
+    }
+    // the rows of a product a slice of row blocks at a time are the whole product's
+    const CsrMatrix whole = multiply(A, B, 2);
+    const long blocks = row_blocks(A);
+    const CsrMatrix top = multiply_rows(A, B, 0, blocks / 2, 2), bottom = multiply_rows(A, B, blocks / 2, blocks, 1);
+    const int split = blocked ? A.blocks[blocks / 2] : static_cast<int>(blocks / 2);
+    for (const auto& [part, first] : {std::pair{&top, 0}, std::pair{&bottom, split}}) {
+      const CsrMatrix expected = rows_of(whole, first, first + part->rows);
+      EXPECT_EQ(part->col, expected.col);
+      EXPECT_EQ(part->val, expected.val);
+      EXPECT_TRUE(part->blocks_consistent());
+    }
+    // new values, same patterns (SIMP's next stiffness on kept aggregates): C = A B again by
+    // slices of B's rows, the values of a fresh product to the bit
+    CsrMatrix C = whole;
+    std::mt19937 rng(7);
     std::uniform_real_distribution<double> value(-2, 2);
     for (double& v : A.val) v = value(rng);
     for (double& v : B.val) v = value(rng);
     const CsrMatrix fresh = multiply(A, B, 2);
-    multiply_values(A, B, C, 2);
+    std::fill(C.val.begin(), C.val.end(), 0.0);
+    std::vector<int> cursor(blocks);
+    for (long b = 0; b < blocks; ++b) cursor[b] = A.ptr[blocked ? A.blocks[b] : b];
+    for (const auto& [first, last] : {std::pair{0, 5}, std::pair{5, 6}, std::pair{6, 13}, std::pair{13, 18}})
+      add_product_rows(A, rows_of(B, first, last), first, cursor, C, 2);
     EXPECT_EQ(C.ptr, fresh.ptr);
     EXPECT_EQ(C.col, fresh.col);
     EXPECT_EQ(C.val, fresh.val) << (blocked ? "blocked" : "one row a block");
-    EXPECT_NE(C.val, old_values);  // the values were rewritten
+    EXPECT_NE(C.val, whole.val);  // the values were rewritten
     EXPECT_LT((dense(C) - dense(A) * dense(B)).norm(), 1e-12 * (dense(A) * dense(B)).norm());
   }
 }

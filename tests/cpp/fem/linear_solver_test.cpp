@@ -22,16 +22,18 @@ struct Beam {
   System system;
   explicit Beam(std::array<int, 3> cells) : mesh(beam(cells)), system(clamped_beam_system(mesh, ones())) {}
   VecXd ones() const { return VecXd::Ones(mesh.T.rows()); }
-  FreeSystem view() const { return {&system.lower, &system.free_dofs, &mesh.V, 2}; }
-  /// New values for element factors `scale` (#T), same pattern.
+  FreeSystem view() const { return {&system.A, &system.free_dofs, &mesh.V, 2}; }
+  /// New values for element factors `scale` (#T), same pattern (A's values rewritten in place,
+  /// as Elasticity's assembly does).
   void rescale(const VecXd& scale) {
-    const SparseLower K = clamped_beam_system(mesh, scale).lower;
-    ASSERT_EQ(K.nonZeros(), system.lower.nonZeros());
-    std::copy(K.valuePtr(), K.valuePtr() + K.nonZeros(), system.lower.valuePtr());
+    System s = clamped_beam_system(mesh, scale);
+    ASSERT_EQ(s.A.col, system.A.col);
+    system.A.val = s.A.val;
+    system.lower = std::move(s.lower);
   }
   /// A load along -z on every free dof (nf by 1).
   Eigen::MatrixXd load() const {
-    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(system.lower.rows(), 1);
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(system.A.rows, 1);
     for (size_t k = 0; k < system.free_dofs.size(); ++k)
       if (system.free_dofs[k] % 3 == 2) B(k, 0) = -1;
     return B;
