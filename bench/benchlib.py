@@ -10,13 +10,14 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DATA = os.environ.get("TOPOPT_SHARED_DATA", os.path.join(ROOT, "..", "shared", "data"))
 
 
-def run(cmd, env=None, check=True):
-    """Runs cmd; returns (stdout + stderr, CPU seconds (user + sys of the child), wall seconds,
+def run(cmd, env=None, check=True, cwd=None):
+    """Runs cmd (in cwd when given: ccx writes spooles.out and other files into its working
+    folder); returns (stdout + stderr, CPU seconds (user + sys of the child), wall seconds,
     largest child's peak RSS in MB so far). Exits with the command's output when it fails and
     check is true."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=cwd)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode and check:

@@ -122,7 +122,7 @@ def main():
                 if name == "solve":
                     record(dict(base, **solve(binary, a.work, job, a.cpu)))
                     cmd, env = pinned(["ccx", "-i", os.path.splitext(inp)[0]], a.cpu)
-                    _, t, wall, peak = benchlib.run(cmd, env)
+                    _, t, wall, peak = benchlib.run(cmd, env, cwd=a.work)
                     record({"study": "ccx", "round": rnd, "side": side, "cpu": t, "wall": wall, "peak": peak})
                     continue
                 ex, size = ("rocker", 1.15) if name.startswith("rocker") else ("cantilever", 1.0)

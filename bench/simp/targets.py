@@ -103,7 +103,7 @@ def solve_against_ccx(topopt, work, msh):
         if cpu < best.get("ours", (1e9,))[0]:
             best["ours"] = (cpu, wall, peak, float(re.search(r"compliance ([0-9.eE+-]+)", out).group(1)))
         c, env = benchlib.single_core(["ccx", "-i", os.path.splitext(inp)[0]])
-        out, cpu, wall, peak = benchlib.run(c, env)
+        out, cpu, wall, peak = benchlib.run(c, env, cwd=work)
         if cpu < best.get("ccx", (1e9,))[0]:
             best["ccx"] = (cpu, wall, peak)
     return best
