@@ -313,6 +313,19 @@ bool onto_cylinder(int tag, Eigen::Vector3d& p) {
   return true;
 }
 
+/// s is one oriented patch (no directed edge twice), every triangle facing away from the
+/// cylinder's axis (the x axis).
+void expect_outward_patch_on_cylinder(const TriSurface& s) {
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
+    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
+    const Eigen::Vector3d centre = (a + b + c) / 3;
+    EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
+  }
+  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+}
+
 TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
   const TriSurface s0 = needle_on_cylinder();
   ASSERT_LT(smallest_angle(s0), 7.0);
@@ -340,15 +353,7 @@ TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
   }
   EXPECT_EQ(added, r.splits - r.collapses);
   EXPECT_TRUE((s.tag.array() == 1).all());
-  // one oriented patch still, every triangle facing away from the axis
-  std::map<std::pair<int, int>, int> directed;
-  for (long t = 0; t < s.F.rows(); ++t) {
-    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
-    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
-    const Eigen::Vector3d centre = (a + b + c) / 3;
-    EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
-  }
-  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+  expect_outward_patch_on_cylinder(s);
 }
 
 /// needle_on_cylinder on the curved face of non-design solid 1 instead (tag -1, every point a fixed
@@ -410,14 +415,7 @@ TEST(ResultCheck, RemeshMendsANeedleOnACurvedNonDesignFaceNextToTheCrease) {
   // the crease stays: one free-form triangle on bc, the rest non-design
   EXPECT_EQ((s.tag.array() == 0).count(), 1);
   EXPECT_EQ((s.tag.array() == -1).count(), s.F.rows() - 1);
-  std::map<std::pair<int, int>, int> directed;
-  for (long t = 0; t < s.F.rows(); ++t) {
-    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
-    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
-    const Eigen::Vector3d centre = (a + b + c) / 3;
-    EXPECT_GT((b - a).cross(c - a).dot(Eigen::Vector3d(0, centre.y(), centre.z())), 0) << "triangle " << t;
-  }
-  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+  expect_outward_patch_on_cylinder(s);
 }
 
 TEST(ResultCheck, RemeshRemovesACreasePointOfANonDesignPlaneIntoItsNeighbour) {
