@@ -173,6 +173,7 @@ TEST(OcUpdate, ARippledVolumeIsMetByTheLinearisedBisection) {
   const OcLinearisation linear{excess(x), {}};
   evaluations = 0;
   const VecXd xnew = oc_update(x, p.dc(), v, VecXd::Constant(p.n, 0.2), excess, nullptr, &linear);
+  EXPECT_LE(evaluations, 10) << "real volumes evaluated: past 10 rounds the exact bisection (~37 more) took over";
   EXPECT_LE(std::abs(excess(xnew)), 1e-5 * target);
 }
 
