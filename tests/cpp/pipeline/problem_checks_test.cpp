@@ -66,7 +66,7 @@ TEST(ProblemChecks, FilterRadiusLargerThanThePartOrThanMemory) {
   expect_error([&] { check_filter_radius(m, 500, true, 1e12); }, ErrorCode::InvalidParameter,
                {"'optimization.filter_radius' (500 mm) is larger than the part"});
   EXPECT_NO_THROW(check_filter_radius(m, 3, true, 1e12));
-  // 1 MB of memory holds about 5 800 pairs: radius 3 needs far more
+  // the filter may take half of 1 MB, at 8 bytes a pair 62 500 pairs: radius 3 needs more
   const std::string msg = expect_error([&] { check_filter_radius(m, 3, true, 1e6); }, ErrorCode::TooLarge,
                                        {"give 'optimization.filter_radius' at most"});
   // the radius it names fits
