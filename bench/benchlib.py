@@ -4,7 +4,7 @@ Import it from a bench script with
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     import benchlib
 """
-import os, resource, subprocess, sys, time
+import os, subprocess, sys, tempfile, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DATA = os.environ.get("TOPOPT_SHARED_DATA", os.path.join(ROOT, "..", "shared", "data"))
@@ -12,18 +12,21 @@ DATA = os.environ.get("TOPOPT_SHARED_DATA", os.path.join(ROOT, "..", "shared", "
 
 def run(cmd, env=None, check=True, cwd=None):
     """Runs cmd (in cwd when given: ccx writes spooles.out and other files into its working
-    folder); returns (stdout + stderr, CPU seconds (user + sys of the child), wall seconds,
-    largest child's peak RSS in MB so far). Exits with the command's output when it fails and
+    folder); returns (stdout + stderr, CPU seconds (user + sys), wall seconds, peak RSS in MB),
+    all of this child alone (wait4's usage of it and of what it waited for), so that a tool run
+    after a larger one reports its own peak. Exits with the command's output when it fails and
     check is true."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=cwd)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with tempfile.TemporaryFile("w+") as log:
+        t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, text=True, env=env, cwd=cwd)
+        _, status, usage = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t0
+        p.returncode = os.waitstatus_to_exitcode(status)
+        log.seek(0)
+        output = log.read()
     if p.returncode and check:
-        sys.exit(" ".join(cmd) + "\n" + p.stdout + p.stderr)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return p.stdout + p.stderr, cpu, wall, after.ru_maxrss / 1024.0
+        sys.exit(" ".join(cmd) + "\n" + output)
+    return output, usage.ru_utime + usage.ru_stime, wall, usage.ru_maxrss / 1024.0
 
 
 def single_core(cmd):
