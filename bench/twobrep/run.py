@@ -150,8 +150,12 @@ def gmsh_row(part, nd, size, tmp, limit):
 
 
 def part_size(topopt, part):
-    info = json.loads(subprocess.run([topopt, "info", "--part", part, "--json"], capture_output=True, text=True,
-                                     check=True).stdout)
+    """The default mesh size of part (diagonal / 50), or None when topopt refuses the part (the
+    refusal is then the row's error on both sides, e.g. CrankArm's two solids)."""
+    p = subprocess.run([topopt, "info", "--part", part, "--json"], capture_output=True, text=True)
+    if p.returncode:
+        return None
+    info = json.loads(p.stdout)
     lo, hi = info["part"]["bbox"]["min"], info["part"]["bbox"]["max"]
     return sum((b - a) ** 2 for a, b in zip(lo, hi)) ** 0.5 / 50
 
@@ -167,7 +171,9 @@ def shared(args):
             rows[name] = {m: shared_row(topopt, part, nd, m, tmp, args.limit) for m in ("native", "gmsh")}
             if "error" in rows[name]["gmsh"]:  # the product's budget: Gmsh through python3-gmsh instead
                 rows[name]["gmsh_cli_error"] = rows[name]["gmsh"]["error"]
-                rows[name]["gmsh"] = gmsh_row(part, nd, part_size(topopt, part), tmp, args.gmsh_limit)
+                size = part_size(topopt, part)
+                if size is not None:
+                    rows[name]["gmsh"] = gmsh_row(part, nd, size, tmp, args.gmsh_limit)
             print(name, json.dumps(rows[name]), file=sys.stderr, flush=True)
             json.dump(rows, open(args.shared, "w"), indent=1)
 
