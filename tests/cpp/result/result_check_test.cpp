@@ -245,6 +245,22 @@ TEST(ResultCheck, RemeshDoesNotSplitOnACurvedFace) {
   EXPECT_EQ(s.F, F0);
 }
 
+/// After remesh_surface(s) from s0: every point it kept stands where it stood in s0, every point
+/// a split added carries lock `added_lock`, and their number is the splits' less the collapses'.
+void expect_kept_unmoved_and_added_locked(const TriSurface& s, const TriSurface& s0, const RemeshReport& r,
+                                          int added_lock) {
+  long added = 0;
+  for (long i = 0; i < s.V.rows(); ++i) {
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0) << "point " << i;
+    } else {
+      ++added;
+      EXPECT_EQ(s.lock[i], added_lock) << "point " << i;
+    }
+  }
+  EXPECT_EQ(added, r.splits - r.collapses);
+}
+
 TEST(ResultCheck, RemeshSplitsANeedleOnANonDesignPlaneWithAFixedPoint) {
   // stuck_needle in one plane (d at (5, 9, 0): the flip of ab would make (c, b, d) a 3° needle) on
   // a non-design face whose footprint border is bc: (b, c, g) lies on Ω's planar face 6 in the same
@@ -261,17 +277,8 @@ TEST(ResultCheck, RemeshSplitsANeedleOnANonDesignPlaneWithAFixedPoint) {
   const RemeshReport r = remesh_surface(s);
   EXPECT_GE(r.splits, 1);
   EXPECT_GT(smallest_angle(s), 10.0);
-  long added = 0;
-  for (long i = 0; i < s.V.rows(); ++i) {
-    EXPECT_EQ(s.V(i, 2), 0.0) << "point " << i;  // in the face's plane
-    if (r.kept_points[i] >= 0) {
-      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
-    } else {
-      ++added;
-      EXPECT_EQ(s.lock[i], 2);
-    }
-  }
-  EXPECT_EQ(added, r.splits - r.collapses);
+  expect_kept_unmoved_and_added_locked(s, s0, r, 2);
+  for (long i = 0; i < s.V.rows(); ++i) EXPECT_EQ(s.V(i, 2), 0.0) << "point " << i;  // in the face's plane
   EXPECT_EQ((s.tag.array() == 6).count(), 1);
   EXPECT_EQ((s.tag.array() == -1).count(), s.F.rows() - 1);
   // a non-design face bent at ab (stuck_needle's own d, 56° up) is not split: the midpoint of a
@@ -341,17 +348,9 @@ TEST(ResultCheck, RemeshSplitsANeedleOnACurvedFaceOntoTheFacesSurface) {
   // every point on the cylinder (the given ones unmoved, the added ones projected onto it, not
   // left at the chord's midpoint, which lies 40 - 40 cos(0.0075 / 2) ≈ 3e-4 inside), on face 1
   ASSERT_EQ(static_cast<long>(r.kept_points.size()), s.V.rows());
-  long added = 0;
-  for (long i = 0; i < s.V.rows(); ++i) {
+  expect_kept_unmoved_and_added_locked(s, s0, r, 1);
+  for (long i = 0; i < s.V.rows(); ++i)
     EXPECT_NEAR(std::hypot(s.V(i, 1), s.V(i, 2)), kCylinderRadius, 1e-9 * kCylinderRadius) << "point " << i;
-    if (r.kept_points[i] >= 0) {
-      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
-    } else {
-      ++added;
-      EXPECT_EQ(s.lock[i], 1);
-    }
-  }
-  EXPECT_EQ(added, r.splits - r.collapses);
   EXPECT_TRUE((s.tag.array() == 1).all());
   expect_outward_patch_on_cylinder(s);
 }
@@ -398,20 +397,13 @@ TEST(ResultCheck, RemeshMendsANeedleOnACurvedNonDesignFaceNextToTheCrease) {
   // every non-design point on the cylinder to 1e-9 relative (the given ones unmoved, the added ones
   // projected onto it: the chord's midpoint lies 3e-4 inside), fixed; the free-form point unmoved
   ASSERT_EQ(static_cast<long>(r.kept_points.size()), s.V.rows());
-  long added = 0;
+  expect_kept_unmoved_and_added_locked(s, s0, r, 2);
   for (long i = 0; i < s.V.rows(); ++i) {
-    if (r.kept_points[i] >= 0) {
-      EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0);
-      EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
-    } else {
-      ++added;
-      EXPECT_EQ(s.lock[i], 2);
-    }
+    if (r.kept_points[i] >= 0) EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
     if (s.lock[i] == 2) {
       EXPECT_NEAR(std::hypot(s.V(i, 1), s.V(i, 2)), kCylinderRadius, 1e-9 * kCylinderRadius) << "point " << i;
     }
   }
-  EXPECT_EQ(added, r.splits - r.collapses);
   // the crease stays: one free-form triangle on bc, the rest non-design
   EXPECT_EQ((s.tag.array() == 0).count(), 1);
   EXPECT_EQ((s.tag.array() == -1).count(), s.F.rows() - 1);
