@@ -394,19 +394,15 @@ class Remesher {
     return f != 0 && (s_.lock[v] == 2 || f > 0);
   }
 
-  /// Whether v, a point of the crease where the free-form surface meets a non-design solid's face
-  /// (lock 2, every triangle around it free-form or of that solid, at least one free-form), may go
-  /// into its non-design neighbour u across non-design triangles (both triangles on uv the solid's):
-  /// v's non-design triangles lie in one plane (to kCoplanar) or are chords of one curved face of
-  /// the solid (nondesign_faces), so with u in v's place they still lie on that face. No point moves:
-  /// the crease then runs through u; the free-form triangles around v follow it (collapse checks
-  /// their turn and angles). A needle whose other long edge is the crease is mended this way.
-  bool crease_removable(int v, int u) const {
-    if (!p_.planar_faces || s_.lock[v] != 2 || s_.lock[u] != 2) return false;
-    const std::vector<int> e = m_.edge_triangles(u, v);
-    if (e.size() != 2 || m_.tag(e[0]) >= 0 || m_.tag(e[1]) != m_.tag(e[0])) return false;
-    const int solid = m_.tag(e[0]), id = nd_face(e[0]);
-    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(e[0]));
+  /// Whether the non-design triangles around crease point v (lock 2, every triangle around it
+  /// free-form or of solid `solid`, at least one free-form) lie on the face of reference triangle
+  /// `ref` (of that solid): in its plane (to kCoplanar), or chords of its curved face
+  /// (nondesign_faces). A neighbour of v on that face may then take v's place and the triangles
+  /// stay on the face.
+  bool crease_on_one_face(int v, int ref) const {
+    if (!p_.planar_faces || s_.lock[v] != 2 || m_.tag(ref) >= 0) return false;
+    const int solid = m_.tag(ref), id = nd_face(ref);
+    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(ref));
     if (n0.norm() == 0) return false;
     bool crease = false;
     for (int t : m_.star(v)) {
@@ -418,6 +414,38 @@ class Remesher {
       if (!flat && (id < 0 || nd_face(t) != id)) return false;
     }
     return crease;
+  }
+
+  /// Whether v, a point of the crease where the free-form surface meets a non-design solid's face
+  /// (lock 2, every triangle around it free-form or of that solid, at least one free-form), may go
+  /// into its non-design neighbour u (lock 2) without any point moving, v's non-design triangles
+  /// lying in one plane or on one curved face (crease_on_one_face), so that with u in v's place
+  /// they still lie on that face: across non-design triangles (both triangles on uv the solid's;
+  /// the crease then runs through u), or along the crease (uv is a crease edge: one triangle on it
+  /// free-form, one the solid's; the crease then runs straight from v's other crease neighbour to
+  /// u, the solid's face keeping its place, its border shifting within it; only where the crease
+  /// passes v once: two crease edges). The free-form
+  /// triangles around v follow (collapse checks their turn and angles). A needle whose other long
+  /// edge is the crease is mended this way: its crease point goes into the border point across its
+  /// short edge, or along the crease when that would turn the free-form side too far.
+  bool crease_removable(int v, int u) const {
+    if (s_.lock[u] != 2) return false;
+    const std::vector<int> e = m_.edge_triangles(u, v);
+    if (e.size() != 2) return false;
+    const int nd = m_.tag(e[0]) < 0 ? e[0] : e[1], other = nd == e[0] ? e[1] : e[0];
+    if (m_.tag(nd) >= 0 || (m_.tag(other) != m_.tag(nd) && m_.tag(other) != 0)) return false;
+    if (m_.tag(other) == 0 && crease_edges(v) != 2) return false;  // along: the crease passes v once
+    return crease_on_one_face(v, nd);
+  }
+
+  /// How many edges of v are crease edges (one triangle on it free-form, the other non-design).
+  int crease_edges(int v) const {
+    int n = 0;
+    for (int w : m_.neighbours(v)) {
+      const std::vector<int> e = m_.edge_triangles(v, w);
+      n += e.size() == 2 && ((m_.tag(e[0]) == 0 && m_.tag(e[1]) < 0) || (m_.tag(e[0]) < 0 && m_.tag(e[1]) == 0));
+    }
+    return n;
   }
 
   /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, removable from
