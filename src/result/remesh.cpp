@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "result/crossing_guard.h"
 #include "result/editable_surface.h"
 #include "result/result_check.h"
 
@@ -26,7 +27,8 @@ Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
 class Remesher {
  public:
   Remesher(TriSurface& s, const RemeshParams& p, const FaceProjector& onto)
-      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
+      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), guard_(s_.V, m_),
+        given_points_(static_cast<int>(s.V.rows())) {
     if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
     if (onto_.nondesign_faces && onto_.onto_nondesign) nd_face_ = onto_.nondesign_faces(s_);
     nd_face_.resize(s_.F.rows(), -1);
@@ -204,12 +206,21 @@ class Remesher {
     flip_link(p, flipped_to);
     double worst_after = 180;
     for (int u : m_.star(p)) worst_after = std::min(worst_after, angle(u));
-    if (worst_after > worst_before + 1e-9) {
+    if (worst_after > worst_before + 1e-9 && !guard_.crosses(star_triangles(p), m_.star(p))) {
+      for (int u : m_.star(p)) guard_.add(u);
       ++report_.splits;
       return 1;
     }
     undo_split(p, b, flipped_to);
+    for (int u : m_.star(b)) guard_.add(u);  // every triangle the split changed had p, now b
     return 0;
+  }
+
+  /// The triangles around point v, as point triples.
+  std::vector<Tri> star_triangles(int v) const {
+    std::vector<Tri> out;
+    for (int t : m_.star(v)) out.push_back(m_.tri(t));
+    return out;
   }
 
   /// Flips the edges opposite p in its triangles where that raises the smallest angle of the two
@@ -333,7 +344,8 @@ class Remesher {
         turned |= n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn;
         worst_after = std::min(worst_after, angle(t));
       }
-      if (!turned && worst_after > worst_before + 1e-9) {
+      if (!turned && worst_after > worst_before + 1e-9 && !guard_.crosses(star_triangles(v), m_.star(v))) {
+        for (int t : m_.star(v)) guard_.add(t);
         ++report_.moves;
         return true;
       }
@@ -367,7 +379,9 @@ class Remesher {
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
     if (normal_of(s_.V, f.u).dot(m) <= 0 || normal_of(s_.V, f.w).dot(m) <= 0) return false;
     if (std::min(angle_of(f.u), angle_of(f.w)) <= std::min(angle(f.t1), angle(f.t2)) + 1e-9) return false;
+    if (guard_.crosses({f.u, f.w}, {f.t1, f.t2})) return false;
     m_.flip(a, b, f);
+    guard_.add(f.t1), guard_.add(f.t2);
     ++report_.flips;
     return true;
   }
@@ -472,6 +486,7 @@ class Remesher {
     const std::vector<int> shared = m_.edge_triangles(u, v);
     double worst_before = 180, worst_after = 180;
     const double cos_turn = std::cos(p_.max_normal_turn * M_PI / 180);
+    std::vector<Tri> made;
     for (int t : m_.star(v)) {
       worst_before = std::min(worst_before, angle(t));
       if (std::count(shared.begin(), shared.end(), t)) continue;
@@ -480,9 +495,11 @@ class Remesher {
       const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(t)), n1 = normal_of(s_.V, moved);
       if (n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn) return false;
       worst_after = std::min(worst_after, angle_of(moved));
+      made.push_back(moved);
     }
-    if (worst_after <= worst_before) return false;
+    if (worst_after <= worst_before || guard_.crosses(made, m_.star(v))) return false;
     m_.collapse(v, u);
+    for (int t : m_.star(u)) guard_.add(t);
     ++report_.collapses;
     return true;
   }
@@ -491,6 +508,7 @@ class Remesher {
   const RemeshParams& p_;
   const FaceProjector& onto_;
   EditableSurface m_;
+  CrossingGuard guard_;  ///< every edit is refused when its triangles would cross the surface
   int given_points_;  ///< the points s had; split_needle adds points after them
   std::vector<int> nd_face_;  ///< per triangle (index of m_): its curved non-design face (nondesign_faces) or -1
   RemeshReport report_;

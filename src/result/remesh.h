@@ -87,7 +87,9 @@ struct RemeshReport {
 /// non-design face: across edges bent less than curved_dihedral when both triangles are chords of
 /// that one face (the four points stay where they are). Non-design points
 /// and points on Ω's edges keep their positions; tags keep their meaning. Returns the counts and
-/// which points stayed (a point added by a split has index -1 in kept_points).
+/// which points stayed (a point added by a split has index -1 in kept_points). Every edit (flip,
+/// collapse, move, split) is refused when its triangles would cross the surface (crossing_guard.h,
+/// exact), so one crossing costs that edit only.
 RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {}, const FaceProjector& onto = {});
 
 }  // namespace topopt::result

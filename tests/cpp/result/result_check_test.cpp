@@ -499,7 +499,9 @@ TEST(ResultCheck, RemeshRemovesACreasePointAlongTheCreaseWhenGoingAcrossTurnsToo
         EXPECT_EQ(s.V(s.F(t, k), 0), 0.0);
         ++nondesign;
       }
-      if (s.tag[t] == 4) EXPECT_EQ(s.V(s.F(t, k), 1), 0.0);
+      if (s.tag[t] == 4) {
+        EXPECT_EQ(s.V(s.F(t, k), 1), 0.0);
+      }
     }
   EXPECT_GT(nondesign, 0);
   EXPECT_GT((s.tag.array() == 0).count(), 0);  // the crease is still there
@@ -514,6 +516,52 @@ TEST(ResultCheck, RemeshRemovesACreasePointAlongTheCreaseWhenGoingAcrossTurnsToo
   bent.V(1, 0) = 0.2;
   remesh_surface(bent);
   EXPECT_LT(smallest_angle(bent), 10.0);
+}
+
+/// Two free-form needles apart, every point fixed (lock 2: no collapse or move): near the origin
+/// (a, b, c) and (b, a, d) of 5.8° bent 22.6° along ab, whose flip into cd (two triangles of 11.4°
+/// and more) would lift the surface at x = 5 from z = 0 to z = 0.1, through a small upright
+/// triangle of another sheet that stands between z = 0.03 and 0.15 (it touches no triangle as they
+/// are); and stuck_needle moved 100 mm along x, which a split mends. The first 4 points and 2
+/// triangles are the bent pair, the next 3 and 1 the upright triangle.
+TriSurface needle_under_a_sheet() {
+  const TriSurface far = stuck_needle(0);
+  TriSurface s;
+  s.V.resize(7 + far.V.rows(), 3);
+  s.V.topRows(7) << 0, 0, 0, 10, 0, 0, 5, 0.5, 0.1, 5, -0.5, 0.1, 4.95, 0, 0.03, 5.05, 0, 0.03, 5, 0, 0.15;
+  s.V.bottomRows(far.V.rows()) = far.V.rowwise() + Eigen::RowVector3d(100, 0, 0);
+  s.F.resize(3 + far.F.rows(), 3);
+  s.F.topRows(3) << 0, 1, 2, 1, 0, 3, 4, 5, 6;
+  s.F.bottomRows(far.F.rows()) = far.F.array() + 7;
+  s = with_tags(s.V, s.F);
+  s.lock.setConstant(2);
+  return s;
+}
+
+TEST(ResultCheck, RemeshRefusesTheOneEditThatWouldCrossAndKeepsTheOthers) {
+  const TriSurface s0 = needle_under_a_sheet();
+  ASSERT_TRUE(mesh::self_intersections(s0.V, s0.F).empty());
+  ASSERT_LT(min_triangle_angle(s0.V, 0, 1, 2), 6.0);
+  // without the upright triangle the bent pair is flipped: the guard is what keeps it
+  TriSurface open = s0;
+  open.F.row(2) = open.F.row(open.F.rows() - 1);
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  open.tag.conservativeResize(open.F.rows());
+  remesh_surface(open);
+  EXPECT_GT(smallest_angle(open), 10.0);
+  // with it, the flip is refused and the far needle is still split: no crossing, one needle left
+  SmoothParams remesh_only;
+  remesh_only.iterations = 0;
+  TriSurface s = s0;
+  const DesignSurfaceReport r = finish_design_surface(s, remesh_only);
+  EXPECT_EQ(r.remesh_undone, 0);  // before, the whole pass was dropped for the flip's crossing
+  EXPECT_GE(r.splits, 1);
+  EXPECT_TRUE(r.check.crossings.empty());
+  long needles = 0;
+  for (long t = 0; t < s.F.rows(); ++t) needles += min_triangle_angle(s.V, s.F(t, 0), s.F(t, 1), s.F(t, 2)) < 10.0;
+  EXPECT_EQ(needles, 2);  // the bent pair as it was
+  EXPECT_EQ(s.F.row(0), s0.F.row(0));
+  EXPECT_EQ(s.F.row(1), s0.F.row(1));
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
