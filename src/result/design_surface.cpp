@@ -10,8 +10,8 @@ namespace {
 /// The smallest free-form angle the design surface aims at (issue 19: no triangle below 10°).
 constexpr double kMinDesignAngle = 10.0;
 
-/// Remeshes s, and keeps the remeshed surface only when it crosses nothing (a flip across a
-/// bent edge, a collapse or a move can fold the surface onto a neighbour); counts into report.
+/// Remeshes s, and keeps the remeshed surface only when it crosses nothing (the remesher refuses
+/// each edit that would cross, so this is the net behind it); counts into report.
 void remesh_unless_crossing(TriSurface& s, const RemeshParams& params, const FaceProjector& onto,
                             DesignSurfaceReport& report) {
   TriSurface kept = s;

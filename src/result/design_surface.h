@@ -19,7 +19,8 @@ struct DesignSurfaceReport {
 
 /// Turns the marching-tetrahedra surface s (extract_iso_surface) into the design surface:
 /// remesh, smooth (when smooth.iterations > 0), undo the smoothing where triangles cross,
-/// remesh (a remeshing pass whose surface crosses itself is dropped whole) (smooth.remesh and smooth.repair switch the
+/// remesh (each edit that would make a crossing is refused by the remesher; a remeshing pass whose
+/// surface still crosses itself is dropped whole) (smooth.remesh and smooth.repair switch the
 /// remeshing and the repair off). Non-design points never move; Ω's face points stay in their planes. `onto` (may
 /// be empty) puts the points the remeshing adds inside Ω's curved faces onto their surfaces (remesh_surface).
 /// Returns the counts and the final check; the caller decides what an invalid check means (see

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "result/crossing_guard.h"
 #include "result/editable_surface.h"
 #include "result/result_check.h"
 
@@ -26,7 +27,8 @@ Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
 class Remesher {
  public:
   Remesher(TriSurface& s, const RemeshParams& p, const FaceProjector& onto)
-      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), given_points_(static_cast<int>(s.V.rows())) {
+      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), guard_(s_.V, m_),
+        given_points_(static_cast<int>(s.V.rows())) {
     if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
     if (onto_.nondesign_faces && onto_.onto_nondesign) nd_face_ = onto_.nondesign_faces(s_);
     nd_face_.resize(s_.F.rows(), -1);
@@ -204,12 +206,21 @@ class Remesher {
     flip_link(p, flipped_to);
     double worst_after = 180;
     for (int u : m_.star(p)) worst_after = std::min(worst_after, angle(u));
-    if (worst_after > worst_before + 1e-9) {
+    if (worst_after > worst_before + 1e-9 && !guard_.crosses(star_triangles(p), m_.star(p))) {
+      for (int u : m_.star(p)) guard_.add(u);
       ++report_.splits;
       return 1;
     }
     undo_split(p, b, flipped_to);
+    for (int u : m_.star(b)) guard_.add(u);  // every triangle the split changed had p, now b
     return 0;
+  }
+
+  /// The triangles around point v, as point triples.
+  std::vector<Tri> star_triangles(int v) const {
+    std::vector<Tri> out;
+    for (int t : m_.star(v)) out.push_back(m_.tri(t));
+    return out;
   }
 
   /// Flips the edges opposite p in its triangles where that raises the smallest angle of the two
@@ -333,7 +344,8 @@ class Remesher {
         turned |= n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn;
         worst_after = std::min(worst_after, angle(t));
       }
-      if (!turned && worst_after > worst_before + 1e-9) {
+      if (!turned && worst_after > worst_before + 1e-9 && !guard_.crosses(star_triangles(v), m_.star(v))) {
+        for (int t : m_.star(v)) guard_.add(t);
         ++report_.moves;
         return true;
       }
@@ -367,7 +379,9 @@ class Remesher {
     const Eigen::Vector3d m = n1.normalized() + n2.normalized();
     if (normal_of(s_.V, f.u).dot(m) <= 0 || normal_of(s_.V, f.w).dot(m) <= 0) return false;
     if (std::min(angle_of(f.u), angle_of(f.w)) <= std::min(angle(f.t1), angle(f.t2)) + 1e-9) return false;
+    if (guard_.crosses({f.u, f.w}, {f.t1, f.t2})) return false;
     m_.flip(a, b, f);
+    guard_.add(f.t1), guard_.add(f.t2);
     ++report_.flips;
     return true;
   }
@@ -394,19 +408,15 @@ class Remesher {
     return f != 0 && (s_.lock[v] == 2 || f > 0);
   }
 
-  /// Whether v, a point of the crease where the free-form surface meets a non-design solid's face
-  /// (lock 2, every triangle around it free-form or of that solid, at least one free-form), may go
-  /// into its non-design neighbour u across non-design triangles (both triangles on uv the solid's):
-  /// v's non-design triangles lie in one plane (to kCoplanar) or are chords of one curved face of
-  /// the solid (nondesign_faces), so with u in v's place they still lie on that face. No point moves:
-  /// the crease then runs through u; the free-form triangles around v follow it (collapse checks
-  /// their turn and angles). A needle whose other long edge is the crease is mended this way.
-  bool crease_removable(int v, int u) const {
-    if (!p_.planar_faces || s_.lock[v] != 2 || s_.lock[u] != 2) return false;
-    const std::vector<int> e = m_.edge_triangles(u, v);
-    if (e.size() != 2 || m_.tag(e[0]) >= 0 || m_.tag(e[1]) != m_.tag(e[0])) return false;
-    const int solid = m_.tag(e[0]), id = nd_face(e[0]);
-    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(e[0]));
+  /// Whether the non-design triangles around crease point v (lock 2, every triangle around it
+  /// free-form or of solid `solid`, at least one free-form) lie on the face of reference triangle
+  /// `ref` (of that solid): in its plane (to kCoplanar), or chords of its curved face
+  /// (nondesign_faces). A neighbour of v on that face may then take v's place and the triangles
+  /// stay on the face.
+  bool crease_on_one_face(int v, int ref) const {
+    if (!p_.planar_faces || s_.lock[v] != 2 || m_.tag(ref) >= 0) return false;
+    const int solid = m_.tag(ref), id = nd_face(ref);
+    const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(ref));
     if (n0.norm() == 0) return false;
     bool crease = false;
     for (int t : m_.star(v)) {
@@ -418,6 +428,38 @@ class Remesher {
       if (!flat && (id < 0 || nd_face(t) != id)) return false;
     }
     return crease;
+  }
+
+  /// Whether v, a point of the crease where the free-form surface meets a non-design solid's face
+  /// (lock 2, every triangle around it free-form or of that solid, at least one free-form), may go
+  /// into its non-design neighbour u (lock 2) without any point moving, v's non-design triangles
+  /// lying in one plane or on one curved face (crease_on_one_face), so that with u in v's place
+  /// they still lie on that face: across non-design triangles (both triangles on uv the solid's;
+  /// the crease then runs through u), or along the crease (uv is a crease edge: one triangle on it
+  /// free-form, one the solid's; the crease then runs straight from v's other crease neighbour to
+  /// u, the solid's face keeping its place, its border shifting within it; only where the crease
+  /// passes v once: two crease edges). The free-form
+  /// triangles around v follow (collapse checks their turn and angles). A needle whose other long
+  /// edge is the crease is mended this way: its crease point goes into the border point across its
+  /// short edge, or along the crease when that would turn the free-form side too far.
+  bool crease_removable(int v, int u) const {
+    if (s_.lock[u] != 2) return false;
+    const std::vector<int> e = m_.edge_triangles(u, v);
+    if (e.size() != 2) return false;
+    const int nd = m_.tag(e[0]) < 0 ? e[0] : e[1], other = nd == e[0] ? e[1] : e[0];
+    if (m_.tag(nd) >= 0 || (m_.tag(other) != m_.tag(nd) && m_.tag(other) != 0)) return false;
+    if (m_.tag(other) == 0 && crease_edges(v) != 2) return false;  // along: the crease passes v once
+    return crease_on_one_face(v, nd);
+  }
+
+  /// How many edges of v are crease edges (one triangle on it free-form, the other non-design).
+  int crease_edges(int v) const {
+    int n = 0;
+    for (int w : m_.neighbours(v)) {
+      const std::vector<int> e = m_.edge_triangles(v, w);
+      n += e.size() == 2 && ((m_.tag(e[0]) == 0 && m_.tag(e[1]) < 0) || (m_.tag(e[0]) < 0 && m_.tag(e[1]) == 0));
+    }
+    return n;
   }
 
   /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, removable from
@@ -444,6 +486,7 @@ class Remesher {
     const std::vector<int> shared = m_.edge_triangles(u, v);
     double worst_before = 180, worst_after = 180;
     const double cos_turn = std::cos(p_.max_normal_turn * M_PI / 180);
+    std::vector<Tri> made;
     for (int t : m_.star(v)) {
       worst_before = std::min(worst_before, angle(t));
       if (std::count(shared.begin(), shared.end(), t)) continue;
@@ -452,9 +495,11 @@ class Remesher {
       const Eigen::Vector3d n0 = normal_of(s_.V, m_.tri(t)), n1 = normal_of(s_.V, moved);
       if (n1.norm() == 0 || n0.norm() == 0 || n0.normalized().dot(n1.normalized()) < cos_turn) return false;
       worst_after = std::min(worst_after, angle_of(moved));
+      made.push_back(moved);
     }
-    if (worst_after <= worst_before) return false;
+    if (worst_after <= worst_before || guard_.crosses(made, m_.star(v))) return false;
     m_.collapse(v, u);
+    for (int t : m_.star(u)) guard_.add(t);
     ++report_.collapses;
     return true;
   }
@@ -463,6 +508,7 @@ class Remesher {
   const RemeshParams& p_;
   const FaceProjector& onto_;
   EditableSurface m_;
+  CrossingGuard guard_;  ///< every edit is refused when its triangles would cross the surface
   int given_points_;  ///< the points s had; split_needle adds points after them
   std::vector<int> nd_face_;  ///< per triangle (index of m_): its curved non-design face (nondesign_faces) or -1
   RemeshReport report_;

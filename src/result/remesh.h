@@ -62,7 +62,9 @@ struct RemeshReport {
 /// triangles re-triangulated in their plane), lies on the crease where the free-form surface meets
 /// a non-design face and goes into a non-design neighbour across that face (its non-design
 /// triangles in one plane, or chords of one curved face that `onto` knows: they stay on the face,
-/// the crease then runs through the neighbour, no point moves), or slides on the cut line of an Ω face, the surface
+/// the crease then runs through the neighbour, no point moves) or along the crease into its crease
+/// neighbour (where the crease passes it once: the crease then runs straight past it, the solid's
+/// face keeping its place and its border shifting within it), or slides on the cut line of an Ω face, the surface
 /// stays manifold (link condition), and no remaining triangle turns by more than max_normal_turn
 /// or ends with a smaller smallest angle than the worst one it replaces; else moves a point of the
 /// triangle towards the mean of its neighbours when that raises their smallest angle: a free point
@@ -85,7 +87,9 @@ struct RemeshReport {
 /// non-design face: across edges bent less than curved_dihedral when both triangles are chords of
 /// that one face (the four points stay where they are). Non-design points
 /// and points on Ω's edges keep their positions; tags keep their meaning. Returns the counts and
-/// which points stayed (a point added by a split has index -1 in kept_points).
+/// which points stayed (a point added by a split has index -1 in kept_points). Every edit (flip,
+/// collapse, move, split) is refused when its triangles would cross the surface (crossing_guard.h,
+/// exact), so one crossing costs that edit only.
 RemeshReport remesh_surface(TriSurface& s, const RemeshParams& params = {}, const FaceProjector& onto = {});
 
 }  // namespace topopt::result

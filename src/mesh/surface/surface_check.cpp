@@ -71,14 +71,13 @@ bool degenerate(const double* a, const double* b, const double* c) {
   return true;
 }
 
-/// Whether triangles s and t (non-degenerate) intersect improperly; see the header.
-bool improper(const MatX3d& V, const MatX3i& F, int s, int t) {
-  const double* x[3] = {V.row(F(s, 0)).data(), V.row(F(s, 1)).data(), V.row(F(s, 2)).data()};
-  const double* y[3] = {V.row(F(t, 0)).data(), V.row(F(t, 1)).data(), V.row(F(t, 2)).data()};
+/// Whether the non-degenerate triangles with points x and y (ids xi, yi: equal ids are one point)
+/// intersect improperly; see the header.
+bool improper(const double* const x[3], const int xi[3], const double* const y[3], const int yi[3]) {
   int shared = 0, si[3], ti[3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      if (F(s, i) == F(t, j)) si[shared] = i, ti[shared] = j, ++shared;
+      if (xi[i] == yi[j]) si[shared] = i, ti[shared] = j, ++shared;
   if (shared == 3) return true;  // the same triangle twice
   if (shared == 0) {
     for (int i = 0; i < 3; ++i)
@@ -102,7 +101,21 @@ bool improper(const MatX3d& V, const MatX3i& F, int s, int t) {
   return orient2d(P, Q, A) == orient2d(P, Q, B);
 }
 
+/// Whether triangles s and t of (V, F) (non-degenerate) intersect improperly.
+bool improper(const MatX3d& V, const MatX3i& F, int s, int t) {
+  const double* x[3] = {V.row(F(s, 0)).data(), V.row(F(s, 1)).data(), V.row(F(s, 2)).data()};
+  const double* y[3] = {V.row(F(t, 0)).data(), V.row(F(t, 1)).data(), V.row(F(t, 2)).data()};
+  const int xi[3] = {F(s, 0), F(s, 1), F(s, 2)}, yi[3] = {F(t, 0), F(t, 1), F(t, 2)};
+  return improper(x, xi, y, yi);
+}
+
 }  // namespace
+
+bool triangle_degenerate(const double* const x[3]) { return degenerate(x[0], x[1], x[2]); }
+
+bool triangles_cross(const double* const x[3], const int xi[3], const double* const y[3], const int yi[3]) {
+  return degenerate(x[0], x[1], x[2]) || degenerate(y[0], y[1], y[2]) || improper(x, xi, y, yi);
+}
 
 std::vector<std::pair<int, int>> self_intersections(const MatX3d& V, const MatX3i& F, long max_pairs) {
   std::vector<std::pair<int, int>> out;

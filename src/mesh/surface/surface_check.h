@@ -15,6 +15,15 @@ namespace topopt::mesh {
 /// pairs (t, t). Stops after `max_pairs` pairs.
 std::vector<std::pair<int, int>> self_intersections(const MatX3d& V, const MatX3i& F, long max_pairs = 100);
 
+/// Whether the triangle with points x (3 doubles each) has zero area (exact), which
+/// self_intersections reports as the pair (t, t).
+bool triangle_degenerate(const double* const x[3]);
+
+/// Whether two triangles cross as self_intersections decides for a pair: either has zero area, or
+/// they intersect other than along what they share. x, y: each triangle's three points (3
+/// doubles each); xi, yi: their ids (equal ids name one point, shared by both triangles). Exact.
+bool triangles_cross(const double* const x[3], const int xi[3], const double* const y[3], const int yi[3]);
+
 struct SurfaceQuality {
   long triangles = 0;
   double min_angle = 0;       ///< smallest angle of any triangle (degrees)

@@ -8,6 +8,7 @@
 #include <map>
 #include <vector>
 
+#include "mesh/surface/surface_check.h"
 #include "result/design_surface.h"
 #include "result/remesh.h"
 #include "simp/density_filter.h"
@@ -442,6 +443,125 @@ TEST(ResultCheck, RemeshRemovesACreasePointOfANonDesignPlaneIntoItsNeighbour) {
   bent.V.row(5) << 14, 0, 3;
   EXPECT_EQ(remesh_surface(bent).collapses, 0);
   EXPECT_LT(smallest_angle(bent), 7.0);
+}
+
+/// The neighbourhood of the 8.52° needle of the default-size (1.5 mm) cantilever's result, as the
+/// remeshing left it before a crease point could go along the crease (coordinates in mm from
+/// (2, 20, 0), rounded to 0.1 µm): non-design solid 1's face x = 0 (tag -1, points lock 2), Ω's
+/// planar face 4, y = 0 (tag 4), and free-form triangles (tag 0) meeting the solid's face along the
+/// crease 0-1-3-4 (4 also on face 4's cut line). The needle (3, 9, 1): its short edge 3-9 joins the
+/// crease point 3 to 9 on the border of the footprint on face 4 (9 may not go), its longest edge 9-1
+/// can be split only with a flip of its other long edge 3-1, the crease; 3 going into 9 turns the
+/// free-form triangle (3, 5, 4) by 46°, beyond max_normal_turn.
+TriSurface crease_needle() {
+  TriSurface s;
+  s.V.resize(17, 3);
+  s.V << 0, -1.4449, 1.7787, 0, -1.0776, 1.7115, 0.8163, -1.0841, 1.6816, 0, -0.186, 1.3288, 0, 0, 1.1429, 0.541, 0,
+      1.2833, 0.5052, -0.4842, 1.4903, 0, 0, 2.8571, -1.0029, 0, 2.1478, 0, 0, 1.4286, -0.3343, 0, 2.1445, 0.9963, 0,
+      0.9665, 0, 0, 0, -1.0005, 0, 1.0001, -0.6678, 0, 1.5255, -0.3335, 0, 0.8095, 0, -1.1472, 2.0779;
+  s.F.resize(19, 3);
+  s.F << 0, 2, 1, 3, 5, 4, 1, 2, 6, 3, 1, 6, 3, 6, 5,                           // free-form
+      10, 9, 8, 10, 7, 9, 5, 11, 4, 11, 12, 4, 14, 8, 9, 14, 9, 13, 15, 13, 9, 15, 9, 4, 15, 4, 12,  // face 4
+      1, 16, 0, 4, 9, 3, 3, 9, 1, 9, 16, 1, 16, 9, 7;                             // solid 1
+  s.tag.resize(19);
+  s.tag << 0, 0, 0, 0, 0, 4, 4, 4, 4, 4, 4, 4, 4, 4, -1, -1, -1, -1, -1;
+  s.lock.resize(17);
+  s.lock << 2, 2, 0, 2, 2, 1, 0, 2, 2, 2, 2, 1, 2, 2, 2, 2, 2;
+  s.point_face = VecXi::Zero(17);
+  s.point_face[4] = 4, s.point_face[5] = 4;
+  s.face_plane.assign(5, Eigen::Vector4d::Zero());
+  s.face_plane[4] << 0, 1, 0, 0;
+  return s;
+}
+
+TEST(ResultCheck, RemeshRemovesACreasePointAlongTheCreaseWhenGoingAcrossTurnsTooFar) {
+  // crease point 3 goes along the crease (into 1 or 4, no point moving): the solid's face keeps its
+  // plane, its border shifts within it. Before, the needle stayed at 8.52° (measured with the
+  // previous remesh.cpp on this fixture)
+  const TriSurface s0 = crease_needle();
+  ASSERT_LT(smallest_angle(s0), 9.0);
+  TriSurface s = s0;
+  const RemeshReport r = remesh_surface(s);
+  EXPECT_GE(r.collapses, 1);
+  EXPECT_GT(smallest_angle(s), 10.0);
+  for (long i = 0; i < s.V.rows(); ++i) {  // no point moved or was added; 3 went
+    ASSERT_GE(r.kept_points[i], 0);
+    EXPECT_NE(r.kept_points[i], 3) << "the crease point 3 stayed";
+    EXPECT_EQ((s.V.row(i) - s0.V.row(r.kept_points[i])).norm(), 0.0) << "point " << i;
+    EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
+  }
+  // every triangle still on its face: the solid's in x = 0, face 4's in y = 0; an oriented patch
+  // that does not cross itself
+  long nondesign = 0;
+  for (long t = 0; t < s.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      if (s.tag[t] == -1) {
+        EXPECT_EQ(s.V(s.F(t, k), 0), 0.0);
+        ++nondesign;
+      }
+      if (s.tag[t] == 4) {
+        EXPECT_EQ(s.V(s.F(t, k), 1), 0.0);
+      }
+    }
+  EXPECT_GT(nondesign, 0);
+  EXPECT_GT((s.tag.array() == 0).count(), 0);  // the crease is still there
+  std::map<std::pair<int, int>, int> directed;
+  for (long t = 0; t < s.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k) ++directed[{s.F(t, k), s.F(t, (k + 1) % 3)}];
+  for (const auto& [e, n] : directed) EXPECT_EQ(n, 1) << e.first << "-" << e.second;
+  EXPECT_TRUE(mesh::self_intersections(s.V, s.F).empty());
+  // with crease point 1 lifted off the plane (0.2 mm), the solid's triangles around 1 and 3 are not
+  // in one plane and no curved face is known: neither may go, the needle stays
+  TriSurface bent = s0;
+  bent.V(1, 0) = 0.2;
+  remesh_surface(bent);
+  EXPECT_LT(smallest_angle(bent), 10.0);
+}
+
+/// Two free-form needles apart, every point fixed (lock 2: no collapse or move): near the origin
+/// (a, b, c) and (b, a, d) of 5.8° bent 22.6° along ab, whose flip into cd (two triangles of 11.4°
+/// and more) would lift the surface at x = 5 from z = 0 to z = 0.1, through a small upright
+/// triangle of another sheet that stands between z = 0.03 and 0.15 (it touches no triangle as they
+/// are); and stuck_needle moved 100 mm along x, which a split mends. The first 4 points and 2
+/// triangles are the bent pair, the next 3 and 1 the upright triangle.
+TriSurface needle_under_a_sheet() {
+  const TriSurface far = stuck_needle(0);
+  TriSurface s;
+  s.V.resize(7 + far.V.rows(), 3);
+  s.V.topRows(7) << 0, 0, 0, 10, 0, 0, 5, 0.5, 0.1, 5, -0.5, 0.1, 4.95, 0, 0.03, 5.05, 0, 0.03, 5, 0, 0.15;
+  s.V.bottomRows(far.V.rows()) = far.V.rowwise() + Eigen::RowVector3d(100, 0, 0);
+  s.F.resize(3 + far.F.rows(), 3);
+  s.F.topRows(3) << 0, 1, 2, 1, 0, 3, 4, 5, 6;
+  s.F.bottomRows(far.F.rows()) = far.F.array() + 7;
+  s = with_tags(s.V, s.F);
+  s.lock.setConstant(2);
+  return s;
+}
+
+TEST(ResultCheck, RemeshRefusesTheOneEditThatWouldCrossAndKeepsTheOthers) {
+  const TriSurface s0 = needle_under_a_sheet();
+  ASSERT_TRUE(mesh::self_intersections(s0.V, s0.F).empty());
+  ASSERT_LT(min_triangle_angle(s0.V, 0, 1, 2), 6.0);
+  // without the upright triangle the bent pair is flipped: the guard is what keeps it
+  TriSurface open = s0;
+  open.F.row(2) = open.F.row(open.F.rows() - 1);
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  open.tag.conservativeResize(open.F.rows());
+  remesh_surface(open);
+  EXPECT_GT(smallest_angle(open), 10.0);
+  // with it, the flip is refused and the far needle is still split: no crossing, one needle left
+  SmoothParams remesh_only;
+  remesh_only.iterations = 0;
+  TriSurface s = s0;
+  const DesignSurfaceReport r = finish_design_surface(s, remesh_only);
+  EXPECT_EQ(r.remesh_undone, 0);  // before, the whole pass was dropped for the flip's crossing
+  EXPECT_GE(r.splits, 1);
+  EXPECT_TRUE(r.check.crossings.empty());
+  long needles = 0;
+  for (long t = 0; t < s.F.rows(); ++t) needles += min_triangle_angle(s.V, s.F(t, 0), s.F(t, 1), s.F(t, 2)) < 10.0;
+  EXPECT_EQ(needles, 2);  // the bent pair as it was
+  EXPECT_EQ(s.F.row(0), s0.F.row(0));
+  EXPECT_EQ(s.F.row(1), s0.F.row(1));
 }
 
 TEST(ResultCheck, TheFinishedBarIsValidWithNoAngleBelowTen) {
