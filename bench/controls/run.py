@@ -6,7 +6,10 @@ cantilever only — with a minimum size the compliance is the eroded design's, w
 iterations, final compliance (SIMP's, on the tet mesh), SIMP wall time, whole-command wall
 and CPU time (user + sys), all with OMP_NUM_THREADS=1 and one run after another in this one script; the overhang
 share of the result surface built along +x and +y (45°); and a picture of the result surface
-(result.stl, rendered with matplotlib) in the work folder.
+(result.stl, rendered with matplotlib) in the work folder. Runs with a minimum member size get a
+second table: the smallest member and the share of thin solid tets of the crisp design the user
+gets, by the product's member measure (`_native.measure_members`, reach of a mesh size), and that
+design's compliance as `topopt optimize` prints it (the SIMP compliance is the eroded design's).
 
 usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
                              [--controls free,draw]  (labels containing one of these words)
@@ -75,6 +78,28 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
     return area[flat].sum() / max(area[down].sum(), 1e-30)
 
 
+def member_columns(build, out, size, mesh_size, stdout):
+    """For a run with a minimum member size: the crisp design the user gets (the run's cleaned
+    densities, `design` in density.vtu, through the node densities at the run's threshold, as
+    bench/result/crisp.py takes it) measured by the product's member measure
+    (simp/controls/member_measure.h, reach of a mesh size): its smallest member, the share of its
+    solid design tets thinner than the size less a mesh size (the measure's resolution), and the
+    crisp design's compliance that `topopt optimize` prints with its verification."""
+    sys.path.insert(0, os.path.join(build, "workbench", "TopOpt", "topopt"))
+    sys.path.insert(0, os.path.join(ROOT, "bench", "result"))
+    import _native  # noqa: E402
+    import crisp  # noqa: E402
+    points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
+    h = json.load(open(os.path.join(out, "history.json")))
+    domain = arrays["domain"].astype(np.int64)
+    solid = crisp.crisp_tets(points, tets, domain, arrays["design"], h["threshold"]).astype(float)
+    m = _native.measure_members(points, tets, domain, solid, mesh_size)
+    design_solid = (domain == 0) & (solid > 0.5)
+    thin = (np.asarray(m["thickness"])[design_solid] < size - mesh_size).mean() if design_solid.any() else 0.0
+    c = re.search(r"crisp design ([0-9.eE+-]+) N\*mm", stdout)
+    return m["smallest_member"], thin, float(c.group(1)) if c else float("nan")
+
+
 def run(cmd):
     """cmd with OpenMP and OpenBLAS held to one thread: (wall s, CPU s (user + sys of the command), the
     completed process)."""
@@ -108,6 +133,7 @@ def main():
     print("| example | control | tets | variables | iterations | compliance (N·mm) | vs free | SIMP wall (s) | command wall / CPU (s) | "
           "overhang share, build +x / +y / +z | picture |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
+    members = []
     for name, (size, case) in EXAMPLES.items():
         if a.only and name != a.only:
             continue
@@ -141,10 +167,18 @@ def main():
             benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
             stl = os.path.join(out, "result.stl")
             shares = " / ".join("%.1f %%" % (100 * overhang_share(stl, up)) for up in BUILDS.values())
+            if controls and "min_member_size" in controls:
+                small, thin, crisp_c = member_columns(a.build, out, controls["min_member_size"], size, p.stdout)
+                members.append("| %s | %s | %.2f mm | %.1f %% | %.4g | %.4g |" % (name, label, small, 100 * thin, c, crisp_c))
             print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f / %.1f | %s | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
                 "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, cpu, shares, os.path.basename(png)))
             sys.stdout.flush()
+    if members:
+        print("\n| example | control | smallest member (reach 1 mesh size) | solid design tets thinner than size − mesh size | "
+              "SIMP compliance (eroded) | crisp design's compliance (N·mm) |")
+        print("|---|---|---|---|---|---|")
+        print("\n".join(members))
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@
 #include "pipeline/job.h"
 #include "pipeline/optimize_job.h"
 #include "pipeline/run_job.h"
+#include "simp/controls/member_measure.h"
 
 namespace topopt::py {
 namespace pyb = pybind11;
@@ -90,6 +91,41 @@ pieces (solid pieces before cleaning), voids_filled, void_volume_filled, voids_k
 void_volume_kept (mm³), min_feature (mm, thinnest member) and warnings (list of sentences: loose
 pieces removed with their volume, non-design solids apart from the largest piece, voids). For
 the workbench's threshold slider, so a re-extraction warns as the optimisation did.)doc");
+}
+
+/// measure_members: the member sizes of a crisp design (simp/controls/member_measure.h), for the
+/// benchmarks of the minimum and maximum member size.
+void bind_member_measure(pyb::module_& m) {
+  m.def(
+      "measure_members",
+      [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
+         const pyb::object& solid_arg, const pyb::object& reach_arg, const pyb::object& gaps_arg) {
+        const TetMesh mesh = tet_mesh_arg(nodes_arg, tets_arg, domain_arg);
+        const VecXd solid = values_arg(solid_arg, "solid", mesh.T.rows(), "tet", 0, 1);
+        simp::MemberMeasureParams params;
+        params.reach = number_arg(reach_arg, "reach", 0, std::numeric_limits<double>::max());
+        if (!pyb::isinstance<pyb::bool_>(gaps_arg)) throw Error(ErrorCode::InvalidParameter, "gaps must be True or False");
+        params.gaps = gaps_arg.cast<bool>();
+        simp::MemberMeasure mm;
+        {
+          pyb::gil_scoped_release release;
+          mm = simp::measure_members(mesh, solid, params);
+        }
+        pyb::dict d;
+        d["smallest_member"] = mm.smallest_member;
+        d["largest_ball"] = mm.largest_ball;
+        d["solid_design"] = mm.solid_design;
+        d["thickness"] = mm.thickness;
+        return d;
+      },
+      pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("solid"), pyb::arg("reach") = 0.0,
+      pyb::arg("gaps") = false,
+      R"doc(Member sizes of a crisp design (solid: #T, 1 for solid tets, non-design tets 1): a dict with
+smallest_member (mm, the thinnest local thickness over the design's solid tets), largest_ball (mm,
+the widest inscribed ball), solid_design (count) and thickness (#T, each tet's local thickness, 0
+outside the phase). reach (mm): how far from a ball's centre a tet's centroid may lie and still
+count in it (a mesh size reads a tet staircase's corners); gaps: measure the void design tets.
+The part's faces do not bound the balls (PartFaces::Clipped, the minimum size's measure).)doc");
 }
 
 /// One iteration as Python sees it: {"iteration", "compliance", "volume", "change", "seconds",
@@ -188,6 +224,7 @@ surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, second
 surface), warnings (list of strings).)doc");
   bind_extract_surface(m);
   bind_design_report(m);
+  bind_member_measure(m);
 }
 
 }  // namespace topopt::py

@@ -36,7 +36,7 @@ std::unique_ptr<Filter> make_filter(const TetMesh& mesh, const std::vector<int>&
                                     const FilterParams& params, const Progress& progress,
                                     const std::vector<char>& held) {
   if (params.kind == FilterKind::Helmholtz && params.radius > 0)
-    return std::make_unique<HelmholtzFilter>(mesh, design, volume, params, progress);
+    return std::make_unique<HelmholtzFilter>(mesh, design, volume, params, progress, held);
   return std::make_unique<DensityFilter>(mesh, design, volume, params, held);
 }
 

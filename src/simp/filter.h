@@ -42,6 +42,8 @@ struct FilterParams {
   /// along each face's outward normal, out to the radius). A face is free unless it belongs to a
   /// non-design tet or all its nodes are held (make_filter's `held`: supports and loads, whose
   /// faces the design must keep reaching). The minimum member size sets it (member_size.h).
+  /// Helmholtz: the same free faces get the Robin condition ℓ ∂ρ̃/∂n + ρ̃ = 0, the void half-space's
+  /// (helmholtz_filter.h).
   bool pad_free_faces = false;
 };
 

@@ -7,9 +7,12 @@
 #include <cmath>
 #include <cstdint>
 #include <sstream>
+#include <unordered_set>
 
 #include "common/error.h"
+#include "common/face_key.h"
 #include "common/parallel.h"
+#include "common/tet_boundary.h"
 #include "fem/pcg.h"
 
 namespace topopt::simp {
@@ -52,7 +55,7 @@ bool helmholtz_uses_multigrid(HelmholtzSolver solver, double length, double edge
 }
 
 HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume,
-                                 const FilterParams& params, const Progress& progress)
+                                 const FilterParams& params, const Progress& progress, const std::vector<char>& held)
     : length_(helmholtz_length(params.radius, params.like_gaussian)),
       threads_(thread_count(params.threads)),
       progress_(progress) {
@@ -61,6 +64,7 @@ HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& de
   volume_.resize(static_cast<long>(design.size()));
   for (size_t i = 0; i < design.size(); ++i) volume_[static_cast<long>(i)] = volume[design[i]];
   assemble(mesh, design);
+  if (params.pad_free_faces) pad_free_faces(mesh, design, held);
   mean_edge_ = mean_edge_length(mesh, design);
   if (helmholtz_uses_multigrid(params.helmholtz_solver, length_, mean_edge_)) set_up_multigrid();
 }
@@ -124,6 +128,41 @@ void HelmholtzFilter::assemble(const TetMesh& mesh, const std::vector<int>& desi
       if (A_.col[k] == r) inverse_diagonal_[r] = 1.0 / A_.val[k];
 }
 
+void HelmholtzFilter::pad_free_faces(const TetMesh& mesh, const std::vector<int>& design,
+                                     const std::vector<char>& held) {
+  // the design nodes' local numbers (assemble's: the mesh's order) and the faces of non-design tets
+  std::vector<int> local(static_cast<size_t>(mesh.V.rows()), -1);
+  std::vector<char> is_design(static_cast<size_t>(mesh.T.rows()), 0);
+  for (size_t i = 0; i < design.size(); ++i) {
+    is_design[design[i]] = 1;
+    for (int a = 0; a < 4; ++a) local[mesh.T(design[i], a)] = element_nodes_[4 * i + a];
+  }
+  std::unordered_set<FaceKey, FaceKeyHash> fixed;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (!is_design[t])
+      for (int a = 0; a < 4; ++a)
+        fixed.insert(face_key(mesh.T(t, (a + 1) % 4), mesh.T(t, (a + 2) % 4), mesh.T(t, (a + 3) % 4)));
+  // ℓ ∫_Γ ρ̃ v on each free face: its triangle's mass matrix area/12 (1 + δ_ab), times ℓ
+  const MatX3i faces = boundary_triangles(mesh.T);
+  for (long f = 0; f < faces.rows(); ++f) {
+    const int n[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
+    if (fixed.count(face_key(n[0], n[1], n[2])) || local[n[0]] < 0 || local[n[1]] < 0 || local[n[2]] < 0) continue;
+    if (!held.empty() && held[n[0]] && held[n[1]] && held[n[2]]) continue;
+    const double area = 0.5 * (mesh.V.row(n[1]) - mesh.V.row(n[0])).cross(mesh.V.row(n[2]) - mesh.V.row(n[0])).norm();
+    for (int a = 0; a < 3; ++a) {
+      const int row = local[n[a]];
+      const int* begin = A_.col.data() + A_.ptr[row];
+      const int* end = A_.col.data() + A_.ptr[row + 1];
+      for (int b = 0; b < 3; ++b)
+        A_.val[std::lower_bound(begin, end, local[n[b]]) - A_.col.data()] += length_ * area / 12.0 * (a == b ? 2 : 1);
+    }
+    ++padded_faces_;
+  }
+  for (int r = 0; r < A_.rows; ++r)
+    for (int k = A_.ptr[r]; k < A_.ptr[r + 1]; ++k)
+      if (A_.col[k] == r) inverse_diagonal_[r] = 1.0 / A_.val[k];
+}
+
 VecXd HelmholtzFilter::nodal_load(const VecXd& per_element) const {
   VecXd b = VecXd::Zero(A_.rows);
   for (long i = 0; i < per_element.size(); ++i)
@@ -176,6 +215,7 @@ std::string HelmholtzFilter::describe() const {
     << " mean edges), " << A_.rows << " nodes, " << static_cast<double>(A_.nonzeros()) / std::max(1, A_.rows)
     << " entries per row, CG preconditioned by "
     << (amg_ ? "multigrid (" + std::to_string(amg_->levels()) + " levels)" : std::string("Jacobi"));
+  if (padded_faces_ > 0) s << ", the part's free faces padded (" << padded_faces_ << " triangles)";
   return s.str();
 }
 

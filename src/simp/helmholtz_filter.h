@@ -1,6 +1,7 @@
 // The PDE density filter (Lazarov & Sigmund, "Filters in topology optimization based on
 // Helmholtz-type differential equations", IJNME 2011): ρ̃ solves
-//     −ℓ² ∇²ρ̃ + ρ̃ = x   on the design domain, ∂ρ̃/∂n = 0 on its boundary,
+//     −ℓ² ∇²ρ̃ + ρ̃ = x   on the design domain, ∂ρ̃/∂n = 0 on its boundary (or, padded, the
+//     Robin condition ℓ ∂ρ̃/∂n + ρ̃ = 0 on the part's free faces: see the constructor),
 // with linear tets on the nodes of the design elements and x piecewise constant. In matrices:
 //     (ℓ² K + M) u = T x,   ρ̃_e = mean of u at e's four nodes,
 // K the stiffness (Laplacian) and M the consistent mass of the design tets, T x the load of
@@ -44,9 +45,14 @@ Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, d
 
 class HelmholtzFilter final : public Filter {
  public:
-  /// mesh, design (#D), volume (#T): as make_filter; params.radius > 0 (mm).
+  /// mesh, design (#D), volume (#T), held (#V or empty): as make_filter; params.radius > 0 (mm).
+  /// With params.pad_free_faces the part's free faces get the Robin condition ℓ ∂ρ̃/∂n + ρ̃ = 0
+  /// instead of ∂ρ̃/∂n = 0: the equation's solution in a void half-space beyond the face decays as
+  /// e^(−s/ℓ), whose slope at the face is this, so the filter sees void beyond a free face as the
+  /// explicit filter's ghost layers do (a full design reads ½ there). Free: as the explicit
+  /// filter's (filter.h) — not a face of a non-design tet, not all of its nodes held.
   HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params,
-                  const Progress& progress = {});
+                  const Progress& progress = {}, const std::vector<char>& held = {});
 
   VecXd apply(const VecXd& x) const override;
   VecXd apply_transpose(const VecXd& g) const override;
@@ -64,6 +70,8 @@ class HelmholtzFilter final : public Filter {
  private:
   void assemble(const TetMesh& mesh, const std::vector<int>& design);
   void set_up_multigrid();
+  /// Adds ℓ × the free faces' triangle mass matrices to A_ (the Robin condition above).
+  void pad_free_faces(const TetMesh& mesh, const std::vector<int>& design, const std::vector<char>& held);
   VecXd nodal_load(const VecXd& per_element) const;  // Σ over each node's elements of value/4
   VecXd element_mean(const VecXd& nodal) const;      // each element's mean of its four nodes
   VecXd solve(const VecXd& b, VecXd& warm) const;
@@ -79,6 +87,7 @@ class HelmholtzFilter final : public Filter {
   double mean_edge_ = 0;                              // of the design tets (mm)
   mutable VecXd forward_, backward_;                  // the last solutions: warm starts for the next solve
   mutable int last_iterations_ = 0;
+  long padded_faces_ = 0;  // free-face triangles with the Robin condition
 };
 
 }  // namespace topopt::simp

@@ -87,6 +87,23 @@ class Arguments(unittest.TestCase):
         self.refused("fill_voids must be True or False", native.design_report, self.nodes, self.tets, self.domain,
                      self.dens, 0.5, fill_voids="yes")
 
+    def test_measure_members(self):
+        # the Kuhn tets of the unit cube with x <= 1/2 (three of them, the cube cut by the plane
+        # through its diagonal) against void: a member of the cube's size; bad arguments refused
+        solid = np.array([1.0 if self.nodes[t].mean(axis=0)[0] < 0.5 else 0.0 for t in self.tets])
+        m = native.measure_members(self.nodes, self.tets, self.domain, solid, 0.5)
+        self.assertEqual(m["solid_design"], int(solid.sum()))
+        self.assertGreater(m["smallest_member"], 0)
+        self.assertLessEqual(m["smallest_member"], np.sqrt(3))
+        self.assertEqual(len(m["thickness"]), len(self.tets))
+        self.assertTrue(all(m["thickness"][solid == 0] == 0))
+        self.refused("solid[0] = 2 is outside [0, 1]", native.measure_members, self.nodes, self.tets, self.domain,
+                     2 * np.ones(len(self.tets)))
+        self.refused("reach = -1 but it must be at least 0", native.measure_members, self.nodes, self.tets,
+                     self.domain, solid, -1.0)
+        self.refused("gaps must be True or False", native.measure_members, self.nodes, self.tets, self.domain, solid,
+                     0.5, gaps=1)
+
     def test_solve_indices(self):
         r = native.solve(self.nodes, self.tets, self.tris, self.faces, self.domain, JOB)
         self.assertGreater(r["compliance"][0], 0)
