@@ -471,6 +471,8 @@ Eigen::MatrixXd Elasticity::Impl::all_dofs(const Eigen::MatrixXd& x) const {
   return U;
 }
 
+void Elasticity::set_solver_tolerance(double tolerance) { impl_->solver->set_tolerance(tolerance); }
+
 Eigen::MatrixXd Elasticity::solve(const Eigen::MatrixXd& loads, const Progress& progress) {
   Impl& m = *impl_;
   if (loads.rows() != num_dofs()) throw Error(ErrorCode::Internal, "solve: loads must have 3*#V rows");

@@ -47,6 +47,10 @@ class Elasticity {
   /// the previous solution. Throws Error(NoSupport) for a singular system.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& loads, const Progress& progress = {});
 
+  /// The iterative solver's relative residual from the next solve on (LinearSolver::set_tolerance;
+  /// the direct solver ignores it).
+  void set_solver_tolerance(double tolerance);
+
   /// #T: u_e^T K0_e u_e for a displacement field u (3*#V), the unscaled element energy
   /// (twice the strain energy); SIMP's sensitivity is -dscale/dρ * this.
   VecXd element_energy(const VecXd& u) const;

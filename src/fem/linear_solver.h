@@ -96,6 +96,9 @@ class LinearSolver {
   /// (its message names the other solver), Error(Cancelled) when `progress` asks to stop.
   virtual void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const Progress& progress) = 0;
   virtual SolverStats stats() const = 0;
+  /// CG's relative residual (SolverParams::tolerance) from the next solve on. The direct solver
+  /// ignores it (its solves are exact, its recycled ones meet recycle_tolerance).
+  virtual void set_tolerance(double tolerance) { (void)tolerance; }
 };
 
 /// The solver for `params.kind` (Auto resolved by choose_solver on K's size), for `system`.

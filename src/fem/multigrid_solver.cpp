@@ -30,6 +30,11 @@ class MultigridSolver final : public LinearSolver {
   void update(const Progress& progress) override;
   void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const Progress& progress) override;
   SolverStats stats() const override { return stats_; }
+  void set_tolerance(double tolerance) override {
+    if (tolerance == params_.tolerance) return;
+    params_.tolerance = tolerance;
+    reuse_.rebaseline();  // iteration counts at another tolerance say nothing of a stale hierarchy
+  }
 
  private:
   void set_up(const Progress& progress);

@@ -55,6 +55,10 @@ class HierarchyReuse {
     refresh_ = 0;
   }
 
+  /// The tolerance changed: the next solve's iteration count is the new baseline (the hierarchy
+  /// stays as it is).
+  void rebaseline() { baseline_ = -1; }
+
   /// A solve on the kept hierarchy was cut short (patience reached) and finished on recomputed
   /// coarse levels: the designs are changing fast, so the next kRefreshAfterCut kept matrices
   /// get their coarse levels recomputed before their solve instead of losing `patience`

@@ -289,7 +289,7 @@ OptimizeSettings parse_optimization(const json& section) {
       section, "optimization",
       {"volume_fraction", "penalty", "emin", "filter", "filter_radius", "helmholtz_solver", "sensitivity_filter",
        "heaviside", "update", "move", "max_iterations", "tol_change", "tol_objective", "threshold", "solver",
-       "solver_tolerance", "smoothing_iterations", "surface_remesh", "surface_repair", "fill_voids",
+       "solver_tolerance", "early_solver_tolerance", "smoothing_iterations", "surface_remesh", "surface_repair", "fill_voids",
        "keep_loaded_faces",
        // objectives and constraints (parse_responses)
        "objective", "compliance_limit", "displacement_limits", "stress_limit", "stress_pnorm", "stress_relaxation",
@@ -325,6 +325,9 @@ OptimizeSettings parse_optimization(const json& section) {
                  ? simp::UpdateKind::MMA
                  : simp::UpdateKind::OC;
   parse_solver(f, p.solver);
+  p.early_solver_tolerance = f.number("early_solver_tolerance", p.early_solver_tolerance);
+  if (!(p.early_solver_tolerance >= 1e-14 && p.early_solver_tolerance <= 1e-2))
+    f.bad("early_solver_tolerance", "must lie in [1e-14, 1e-2] (the solver's relative residual before the final beta)");
   parse_stopping(f, p);
   parse_responses(f, s);
   settle_member_size(f, s);

@@ -31,4 +31,8 @@ NextStep Continuation::next(double compliance, double change) {
   return NextStep::RaiseBeta;
 }
 
+double solver_tolerance(const Continuation& schedule, double final_tolerance, double early) {
+  return schedule.sharp() ? final_tolerance : std::max(final_tolerance, early);
+}
+
 }  // namespace topopt::simp

@@ -106,6 +106,8 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
 
 ComplianceProblem::~ComplianceProblem() = default;
 
+void ComplianceProblem::set_solver_tolerance(double tolerance) { fe_->set_solver_tolerance(tolerance); }
+
 ComplianceProblem::Stages ComplianceProblem::filtered(const VecXd& x) const {
   Stages s;
   const VecXd z = controls_->apply(x);
@@ -349,6 +351,7 @@ SimpResult optimize(const TetMesh& mesh, const fem::Material& material, const fe
     const auto t0 = std::chrono::steady_clock::now();
     progress.check_cancel("the optimisation (iteration " + std::to_string(it) + ")");
     problem.set_beta(schedule.beta());
+    problem.set_solver_tolerance(solver_tolerance(schedule, params.solver.tolerance, params.early_solver_tolerance));
     // ---- FE analysis, objective and sensitivities
     VecXd dc, dv;
     const double c = problem.compliance(x, &dc);

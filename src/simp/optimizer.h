@@ -33,6 +33,10 @@ struct SimpParams {
   double tol_change = 0.01;     ///< stop when max |Δx| falls below this
   double tol_objective = 1e-4;  ///< ... or the relative objective change stays below this for 5 iterations
   fem::SolverParams solver;
+  /// The iterative solver's relative residual while the projection's β is below its final value
+  /// (solver_tolerance() in continuation.h); solver.tolerance from the final β on. At or below
+  /// solver.tolerance: the same tolerance throughout.
+  double early_solver_tolerance = 1e-3;
   ResponseParams responses;  ///< objective and limits beyond the volume fraction (responses/)
   ControlsParams controls;   ///< geometry controls (symmetry, repetition, extrusion, draw direction, member size)
 };
@@ -128,6 +132,8 @@ class ComplianceProblem {
   /// #D: wᵀ ∂F_k/∂ρ̄_i, the self-weight's share of load case k (zero without gravity); w: 3*#V.
   VecXd load_derivative(const VecXd& w, long k) const;
   void set_beta(double b) { proj_.beta = b; }
+  /// The FE solver's relative residual from the next compliance() on (iterative solvers).
+  void set_solver_tolerance(double tolerance);
 
  private:
   const TetMesh& mesh_;

@@ -78,5 +78,20 @@ TEST(Continuation, WithoutProjectionBetaStaysOneAndFiveCalmIterationsConverge) {
   EXPECT_EQ(c.beta(), 1);
 }
 
+TEST(Continuation, TheSolverToleranceIsLooseBelowTheFinalBetaOnly) {
+  Continuation c(schedule(4), 1e-6, 1e-6);
+  EXPECT_EQ(solver_tolerance(c, 1e-5, 1e-3), 1e-3);  // β 1
+  EXPECT_EQ(solver_tolerance(c, 1e-5, 1e-7), 1e-5);  // an "early" one tighter than the final: never used
+  for (double compliance = 100; !c.sharp(); compliance *= 0.5) {
+    ASSERT_EQ(solver_tolerance(c, 1e-5, 1e-3), 1e-3) << "beta " << c.beta();
+    c.next(compliance, 0.2);
+  }
+  EXPECT_EQ(c.beta(), 4);
+  EXPECT_EQ(solver_tolerance(c, 1e-5, 1e-3), 1e-5);  // the final β: every compliance compared is tight
+  ProjectionParams off = schedule();
+  off.enabled = false;
+  EXPECT_EQ(solver_tolerance(Continuation(off, 1e-3, 1e-3), 1e-5, 1e-3), 1e-5);  // no continuation: tight
+}
+
 }  // namespace
 }  // namespace topopt::simp

@@ -249,6 +249,42 @@ TEST(Simp, MmaReachesAboutTheSameDesignAsOc) {
   EXPECT_NEAR(mma.history.back().volume_fraction, 0.4, 0.01);
 }
 
+TEST(Simp, ALooseSolverToleranceBeforeTheFinalBetaEndsAtTheSameDesign) {
+  // multigrid CG (forced on this small case: two levels and more) with the Heaviside
+  // continuation; the early tolerance (1e-3 before β reaches 8) against none (1e-6 throughout)
+  Case c = cantilever({24, 8, 4});
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 3;
+  p.max_iterations = 150;
+  p.tol_objective = 1e-3;
+  p.projection.beta_max = 8;
+  p.solver.kind = fem::SolverKind::Iterative;
+  p.solver.multigrid.coarse_dofs = 300;
+  p.solver.tolerance = 1e-6;
+  p.early_solver_tolerance = 1e-6;
+  const SimpResult tight = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  p.early_solver_tolerance = 1e-3;
+  const SimpResult loose = optimize(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  ASSERT_TRUE(tight.converged);
+  ASSERT_TRUE(loose.converged);
+  const IterationRecord &a = tight.history.back(), &b = loose.history.back();
+  EXPECT_EQ(a.beta, 8);
+  EXPECT_EQ(b.beta, 8);
+  EXPECT_NEAR(b.compliance, a.compliance, 1e-3 * a.compliance);
+  EXPECT_NEAR(b.volume_fraction, a.volume_fraction, 1e-4);
+  EXPECT_LE(std::abs(static_cast<int>(tight.history.size()) - static_cast<int>(loose.history.size())), 2);
+  // the early iterations do differ (their solves stopped sooner), and stay within the loose
+  // residual's reach: the compliance of a CG iterate is off by ~ the residual's square
+  const double first = std::abs(loose.history[1].compliance - tight.history[1].compliance);
+  EXPECT_GT(first, 0);
+  EXPECT_LT(first, 1e-3 * tight.history[1].compliance);
+  std::printf("iterations %zu / %zu, compliance %.8g / %.8g, iteration 2 off by %.3g relative\n", tight.history.size(),
+              loose.history.size(), a.compliance, b.compliance, first / tight.history[1].compliance);
+  // the densities returned: the same design up to a few boundary tets
+  EXPECT_LT((loose.density - tight.density).cwiseAbs().mean(), 5e-3);
+}
+
 TEST(Simp, MmaSolvesAConvexProblemWithTwoConstraints) {
   // min Σ (x_i − 0.9)²  s.t.  Σ x_i / n <= 0.5,  x_0 − x_1 <= -0.2  (optimum: all 0.5 but
   // x_1 = x_0 + 0.2; with n = 4 the volume then forces the others down)
