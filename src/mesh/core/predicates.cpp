@@ -171,6 +171,17 @@ Expansion det3(const Expansion m[3][3]) {
 
 long exact_fallbacks() { return fallbacks; }
 
+bool segments_meet(const double* a, const double* b, const double* c, const double* d) {
+  const int o1 = orient2d(a, b, c), o2 = orient2d(a, b, d), o3 = orient2d(c, d, a), o4 = orient2d(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  auto within = [](const double* s, const double* t, const double* x) {  // x collinear with st: within its box?
+    return std::min(s[0], t[0]) <= x[0] && x[0] <= std::max(s[0], t[0]) && std::min(s[1], t[1]) <= x[1] &&
+           x[1] <= std::max(s[1], t[1]);
+  };
+  return (o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
+         (o4 == 0 && within(c, d, b));
+}
+
 int orient2d(const double* a, const double* b, const double* c) {
   double l = (a[0] - c[0]) * (b[1] - c[1]), r = (a[1] - c[1]) * (b[0] - c[0]);
   double det = l - r, bound = kOrient2dBound * (std::abs(l) + std::abs(r));

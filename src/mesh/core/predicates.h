@@ -16,6 +16,10 @@ int orient2d(const double* a, const double* b, const double* c);
 /// that makes (a, b, c, d) a positively oriented tet (TetMesh's convention). −1, 0 or 1.
 int orient3d(const double* a, const double* b, const double* c, const double* d);
 
+/// Whether the closed 2D segments ab and cd have a point in common: they cross, one touches
+/// the other, or they are collinear and overlap (collinear and apart: false). By orient2d alone.
+bool segments_meet(const double* a, const double* b, const double* c, const double* d);
+
 /// > 0 when d lies inside the circle through a, b, c (counter-clockwise), 0 on it, < 0 outside.
 int incircle(const double* a, const double* b, const double* c, const double* d);
 

@@ -14,17 +14,6 @@ namespace {
 using predicates::orient2d;
 using predicates::orient3d;
 
-/// Closed 2D segments pq and ab intersect (collinear overlap included).
-bool segments_meet_2d(const double* p, const double* q, const double* a, const double* b) {
-  const int o1 = orient2d(p, q, a), o2 = orient2d(p, q, b), o3 = orient2d(a, b, p), o4 = orient2d(a, b, q);
-  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
-  auto on = [](const double* s, const double* t, const double* x) {  // x collinear with st: within its box?
-    return std::min(s[0], t[0]) <= x[0] && x[0] <= std::max(s[0], t[0]) && std::min(s[1], t[1]) <= x[1] &&
-           x[1] <= std::max(s[1], t[1]);
-  };
-  return (o1 == 0 && on(p, q, a)) || (o2 == 0 && on(p, q, b)) || (o3 == 0 && on(a, b, p)) || (o4 == 0 && on(a, b, q));
-}
-
 /// Closed 2D point-in-triangle.
 bool inside_2d(const double* x, const double* a, const double* b, const double* c) {
   const int o1 = orient2d(a, b, x), o2 = orient2d(b, c, x), o3 = orient2d(c, a, x);
@@ -57,8 +46,8 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
   const int drop = drop_axis(a, b, c);
   double P[2], Q[2], A[2], B[2], C[2];
   project(p, drop, P), project(q, drop, Q), project(a, drop, A), project(b, drop, B), project(c, drop, C);
-  return inside_2d(P, A, B, C) || inside_2d(Q, A, B, C) || segments_meet_2d(P, Q, A, B) ||
-         segments_meet_2d(P, Q, B, C) || segments_meet_2d(P, Q, C, A);
+  return inside_2d(P, A, B, C) || inside_2d(Q, A, B, C) || predicates::segments_meet(P, Q, A, B) ||
+         predicates::segments_meet(P, Q, B, C) || predicates::segments_meet(P, Q, C, A);
 }
 
 bool degenerate(const double* a, const double* b, const double* c) {

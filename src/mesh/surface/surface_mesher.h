@@ -198,10 +198,14 @@ class ModelSurface {
     std::vector<int> face;
   };
   /// Face corners that proximity splits leave alone: per edge, whether its first / last piece
-  /// is at a needle corner; the nodes of cusps.
+  /// is at a needle corner; and every such corner (match_corner_pieces).
   struct SharpCorners {
+    struct Corner {
+      int node = -1;               ///< the corner's node (pool number)
+      std::array<int, 2> edges{};  ///< the B-Rep edges of the two pieces meeting there (0-based)
+    };
     std::vector<std::array<char, 2>> needle_end;
-    std::unordered_set<int> cusp;
+    std::vector<Corner> all;
   };
   /// Pieces to split in one proximity round: per edge, the pieces (may repeat); any marked;
   /// per edge, whether a piece was marked because another loop of a face is close.
@@ -262,8 +266,11 @@ class ModelSurface {
                         PieceSplits& splits) const;
   void mark_close_pieces(const Loops& L, const SegmentBoxes& boxes, const SharpCorners& corners,
                          PieceSplits& splits) const;
-  bool near_cusp(const Loops& L, int i, int j, const std::unordered_set<int>& cusp) const;
   void split_pieces(std::vector<std::vector<int>>& split, std::vector<char>& stale);
+  void split_rounds(const SharpCorners& corners, std::vector<char>& stale, const Progress& progress);
+  bool match_corner_pieces(const SharpCorners& corners, std::vector<char>& stale);
+  std::array<int, 2> corner_piece(int e, int node) const;
+  void edges_changed(const std::vector<char>& changed, std::vector<char>& stale);
   FaceSize face_size_reason(int f) const;
   // faces
   Loops face_loops(int f) const;
