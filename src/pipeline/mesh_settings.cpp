@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "pipeline/problem_checks.h"
 
 namespace topopt::pipeline {
 namespace {
@@ -59,7 +60,12 @@ void check_mesh_settings(const MeshSettings& s, const std::string& size_name, co
                 "the native mesher's time limit must be a positive number of seconds, or 0 for automatic");
 }
 
-MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volume, const Progress& progress) {
+double max_tets(double memory_bytes) {
+  return memory_bytes > 0 ? memory_bytes / MeshDefaults::kBytesPerTet : MeshDefaults::kMaxTetsUnknownMemory;
+}
+
+MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volume, const Progress& progress,
+                             double memory_bytes) {
   MeshSizes r;
   r.size = s.size > 0 ? s.size : diagonal / MeshDefaults::kDiagonalDivisions;
   if (diagonal > 0 && r.size > diagonal) {
@@ -82,12 +88,16 @@ MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volu
   r.growth = MeshDefaults::kGrowth;
   const double h = r.size;
   r.estimated_tets = 6.0 * std::abs(volume) / (h * h * h) * 1.2;  // ~6 tets per h³ for a good mesh
-  if (r.estimated_tets > MeshDefaults::kMaxTets)
+  const double memory = memory_bytes < 0 ? physical_memory_bytes() : memory_bytes;
+  r.max_tets = max_tets(memory);
+  if (r.estimated_tets > r.max_tets) {
+    const std::string gb = memory > 0 ? " (" + std::to_string(static_cast<int>(std::lround(memory / 1e9))) + " GB)" : "";
     throw Error(ErrorCode::TooLarge,
                 "a mesh size of " + std::to_string(h) + " mm would give about " +
-                    std::to_string(static_cast<long>(r.estimated_tets)) +
-                    " tetrahedra, more than this machine can optimise; use a mesh size of at least " +
-                    std::to_string(h * std::cbrt(r.estimated_tets / MeshDefaults::kMaxTets)) + " mm");
+                    std::to_string(static_cast<long>(r.estimated_tets)) + " tetrahedra, more than this machine's memory" +
+                    gb + " can optimise; use a mesh size of at least " +
+                    std::to_string(h * std::cbrt(r.estimated_tets / r.max_tets)) + " mm");
+  }
   return r;
 }
 
@@ -99,7 +109,7 @@ mesh::NativeMeshParams native_mesh_params(const MeshSettings& s, const MeshSizes
   p.surface.max_angle = 2 * kPi / MeshDefaults::kElementsPerTurn;
   p.surface.wall_layers = s.wall_layers;
   // the fills stop at twice the budget, should the estimate be off
-  p.volume.max_tets = static_cast<long>(2 * MeshDefaults::kMaxTets);
+  p.volume.max_tets = static_cast<long>(2 * (sizes.max_tets > 0 ? sizes.max_tets : max_tets(physical_memory_bytes())));
   return p;
 }
 

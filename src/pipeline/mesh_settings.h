@@ -32,8 +32,13 @@ struct MeshDefaults {
   /// Curved faces get 40 elements per turn: the faceting error of a bore, about (2π/N)²/6 of
   /// a ring's volume, stays under the 0.5 % the volumes are held to.
   static constexpr double kElementsPerTurn = 40;
-  /// Meshes estimated above this many tets are refused (memory: ~1 kB per tet through SIMP).
-  static constexpr double kMaxTets = 6e6;
+  /// Memory per estimated tet that a mesh may ask of the machine: optimize held 1.63–1.75 kB
+  /// per tet of the mesh at 1–2.4 M tets (serial, bench/scale/largest.py), a solve less, and the
+  /// estimate below counts about 1.4 tets for each the mesher makes (the cantilever), so a mesh
+  /// refused at physical memory / kBytesPerTet would have needed about 2.1 kB per real tet.
+  static constexpr double kBytesPerTet = 1500;
+  /// The limit where the machine's memory cannot be read.
+  static constexpr double kMaxTetsUnknownMemory = 6e6;
   /// The Gmsh fallback's time budget: this many seconds, plus one per this many estimated tets.
   static constexpr double kGmshBaseSeconds = 120, kGmshTetsPerSecond = 2000;
   /// The native mesher's budget in CPU seconds of the process, the same way. The estimate
@@ -75,14 +80,21 @@ struct MeshSizes {
   double min_size = 0;        ///< mm
   double growth = 0;          ///< per element (MeshDefaults::kGrowth)
   double estimated_tets = 0;  ///< about 6 tets per size³ over the part's volume
+  double max_tets = 0;        ///< the largest estimate this machine's memory takes (max_tets())
 };
+
+/// The largest estimated tet count a machine with `memory_bytes` of memory takes
+/// (MeshDefaults::kBytesPerTet each; MeshDefaults::kMaxTetsUnknownMemory when 0: unknown).
+double max_tets(double memory_bytes);
 
 /// Meets the settings with a part of bounding-box diagonal `diagonal` (mm) and volume
 /// `volume` (mm³): the automatic size and smallest size, a size above the diagonal clamped
 /// to the diagonal with a warning through `progress`. Throws Error(TooLarge) naming the
-/// size to use when the estimated mesh exceeds MeshDefaults::kMaxTets, and
+/// size to use when the estimated mesh exceeds what `memory_bytes` takes (max_tets; < 0: this
+/// machine's physical memory), and
 /// Error(InvalidParameter) when a given smallest size exceeds the automatic size.
-MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volume, const Progress& progress = {});
+MeshSizes resolve_mesh_sizes(const MeshSettings& s, double diagonal, double volume, const Progress& progress = {},
+                             double memory_bytes = -1);
 
 /// The native mesher's parameters for those sizes (the surface at 40 elements per turn,
 /// the fills bounded at twice the budget).

@@ -62,6 +62,26 @@ TEST(MeshSettings, ASizeAskingForTooManyElementsIsRefusedWithASizeToUse) {
   }
 }
 
+TEST(MeshSettings, TheElementBudgetFollowsTheMachinesMemory) {
+  // a 100 mm cube: about 7.2e6 / h³ tets estimated
+  MeshSettings s;
+  s.size = 1.0;  // 7.2 M tets estimated
+  const double gb = 1e9;
+  EXPECT_NO_THROW(resolve_mesh_sizes(s, 173.2, 1e6, {}, 24 * gb));  // 16 M take 24 GB
+  const std::string m =
+      expect_error([&] { resolve_mesh_sizes(s, 173.2, 1e6, {}, 8 * gb); }, ErrorCode::TooLarge,
+                   {"more than this machine's memory (8 GB) can optimise", "use a mesh size of at least"});
+  s.size = std::stod(m.substr(m.find("at least ") + 9)) * 1.001;  // the size it names fits in 8 GB
+  const MeshSizes fits = resolve_mesh_sizes(s, 173.2, 1e6, {}, 8 * gb);
+  EXPECT_LE(fits.estimated_tets, 8 * gb / MeshDefaults::kBytesPerTet);
+  EXPECT_GT(fits.estimated_tets, 0.99 * 8 * gb / MeshDefaults::kBytesPerTet);
+  // memory unknown: the fixed budget
+  s.size = std::cbrt(7.2e6 / (1.001 * MeshDefaults::kMaxTetsUnknownMemory));
+  expect_error([&] { resolve_mesh_sizes(s, 173.2, 1e6, {}, 0); }, ErrorCode::TooLarge, {"use a mesh size of at least"});
+  s.size *= 1.002;
+  EXPECT_NO_THROW(resolve_mesh_sizes(s, 173.2, 1e6, {}, 0));
+}
+
 TEST(MeshSettings, ChecksSayWhatToChange) {
   MeshSettings s;
   s.size = 1, s.min_size = 2;
