@@ -316,7 +316,7 @@ TEST(DelaunayBulk, Nist6BulkReachesItsCurvedWalls) {
   // by the bulk at that size: next to its B-spline half-cylinders the refinement points need
   // more than three rounds of cutting their cavity back; refused at three, they left 7 571
   // points out and 2 324 tets of four boundary nodes below 0.1 (0.7 % of the tets) under those
-  // faces, the seed of the product mesh's slivers at 0.6x (issue 20); 210 and 327 now
+  // faces, the seed of the product mesh's slivers at 0.6x (issue 20); at 12 rounds 210 and 327
   const brep::TopologyIndex topo =
       brep::index_topology(brep::read_shape_file(std::string(TOPOPT_SHARED_DATA) + "/nist/NIST_MBE_PMI_6.stp"));
   SurfaceMeshParams sp;
