@@ -22,7 +22,15 @@ using predicates::orient3d;
 constexpr auto& kFace = kTetFace;
 
 /// Rounds of taking unseen tets out of a point's cavity before its insertion is refused.
-constexpr int kMaxPeels = 3;
+/// Most points need one or two; next to NIST 6's B-spline half-cylinders many need more: at 3,
+/// the bulk of its surface (DelaunayBulk.Nist6BulkReachesItsCurvedWalls) refused 7 571 points
+/// at the cap and kept 2 324 tets of four boundary nodes below radius ratio 0.1 under those
+/// faces, which the improvement turns into tets standing on the boundary that it cannot lift
+/// (the product's mesh at 0.6x its size: 5 828 tets below 0.1). Measured (BENCHMARKS.md, issue
+/// 20, eighth pass): 8 and more leave one tet of 0.095 in VolumeFillQuality.NoSliverOnNist5,
+/// and at 12 the front could not close the bulk's holes on NIST 6 at 0.6x (then filled by the
+/// front alone: 23 257 tets below 0.1 before the improvement); 6 passes both.
+constexpr int kMaxPeels = 6;
 /// A repaired insertion is refused when its star has a tet below this radius ratio that is
 /// worse than every tet it removes (Tets::poor_star). Measured (BENCHMARKS.md, issue 20 sixth
 /// pass): 0.1 cleans NIST 2 but gives back most of NIST 6's gain (43 -> 256 tets below 0.1
