@@ -20,6 +20,19 @@ namespace {
 
 using Point = Eigen::Vector3d;
 
+/// Union-find over n items with path halving.
+struct Groups {
+  std::vector<int> parent;
+  explicit Groups(long n) : parent(n) {
+    for (long i = 0; i < n; ++i) parent[i] = static_cast<int>(i);
+  }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void join(int a, int b) { parent[find(a)] = find(b); }
+};
+
 Point node(const TetMesh& mesh, int v) { return mesh.V.row(v).transpose(); }
 
 Point tet_centre(const TetMesh& mesh, long t) {
@@ -82,19 +95,6 @@ std::string at(const Point& x) {
   s.precision(3);
   s << "around (" << x[0] << ", " << x[1] << ", " << x[2] << ") mm";
   return s.str();
-}
-
-/// Per tet (#T): whether it has a node on a tet labelled c (labels #T) — the piece itself and
-/// the tets around it.
-std::vector<char> touching_label(const TetMesh& mesh, const VecXi& label, int c) {
-  std::vector<char> on_piece(mesh.V.rows(), 0);
-  for (long t = 0; t < mesh.T.rows(); ++t)
-    if (label[t] == c)
-      for (int k = 0; k < 4; ++k) on_piece[mesh.T(t, k)] = 1;
-  std::vector<char> touches(mesh.T.rows(), 0);
-  for (long t = 0; t < mesh.T.rows(); ++t)
-    for (int k = 0; k < 4; ++k) touches[t] |= on_piece[mesh.T(t, k)];
-  return touches;
 }
 
 /// Sets the design tets of piece c (labels #T, level_components) to void: every tet around a
@@ -166,18 +166,25 @@ void remove_pieces(const TetMesh& mesh, const VecXd& nd, double threshold, const
   }
 }
 
-/// Sets void piece c (labels #T) solid, and the design tets around it to density 1 as well
-/// (the solid tets of its wall may hold low densities that would leave a smaller cavity in
-/// the node densities).
-void fill_void(const TetMesh& mesh, const VecXi& label, int c, std::vector<char>& solid, VecXd& out) {
-  const std::vector<char> touches = touching_label(mesh, label, c);
+/// Per tet (#T): whether it has a node on a tet labelled c (labels #T) — the void itself and
+/// the tets around it.
+std::vector<char> touching_label(const TetMesh& mesh, const VecXi& label, int c) {
+  std::vector<char> on_piece(mesh.V.rows(), 0);
   for (long t = 0; t < mesh.T.rows(); ++t)
-    if (touches[t] && mesh.domain[t] == 0) out[t] = 1, solid[t] = 1;
+    if (label[t] == c)
+      for (int k = 0; k < 4; ++k) on_piece[mesh.T(t, k)] = 1;
+  std::vector<char> touches(mesh.T.rows(), 0);
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    for (int k = 0; k < 4; ++k) touches[t] |= on_piece[mesh.T(t, k)];
+  return touches;
 }
 
-/// Fills (or counts) the void pieces that touch no boundary face of the mesh.
-void fill_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& params, std::vector<char>& solid,
-                VecXd& out, HygieneReport& report) {
+/// Fills (or counts) the void pieces of the crisp design (void tets, face-connected) that touch
+/// no boundary face of the mesh: a filled one becomes solid with the design tets around it at
+/// density 1 as well (the solid tets of its wall may hold low densities that would leave a
+/// smaller cavity in the node densities). closed (#T) gets the tets of those voids.
+void fill_crisp_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& params, std::vector<char>& solid,
+                      VecXd& out, HygieneReport& report, std::vector<char>& closed) {
   std::vector<char> empty(solid.size());
   for (size_t t = 0; t < solid.size(); ++t) empty[t] = !solid[t];
   int count = 0;
@@ -189,6 +196,8 @@ void fill_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& para
     volume[label[t]] += tet_volume(mesh, t);
     for (int k = 0; k < 4; ++k) open[label[t]] |= nb(t, k) < 0;
   }
+  closed.assign(mesh.T.rows(), 0);
+  for (long t = 0; t < mesh.T.rows(); ++t) closed[t] = label[t] >= 0 && !open[label[t]];
   for (int c = 0; c < count; ++c) {
     if (open[c]) continue;
     if (!params.fill_voids) {
@@ -196,8 +205,67 @@ void fill_voids(const TetMesh& mesh, const MatX4i& nb, const HygieneParams& para
       continue;
     }
     ++report.voids_filled, report.void_volume_filled += volume[c];
-    fill_void(mesh, label, c, solid, out);
+    const std::vector<char> touches = touching_label(mesh, label, c);
+    for (long t = 0; t < mesh.T.rows(); ++t)
+      if (touches[t] && mesh.domain[t] == 0) out[t] = 1, solid[t] = 1;
   }
+}
+
+/// Fills (or counts) the closed voids of the result shape (at `threshold` of the node
+/// densities nd) that the crisp design does not hold (fill_crisp_voids ran first; `counted`,
+/// #T: the tets of the closed voids it counted, skipped here): the nodes below the threshold joined by the design tets'
+/// edges with both ends below it (a linear field's region below the level in one tet is convex; non-design nodes are
+/// solid), a void closed when none of its nodes lies on the mesh boundary (nb: tet neighbours). Filling sets the design
+/// tets holding its nodes, and the design tets around those, to density 1, so every node of the void rises to 1. Its
+/// volume is what of the tets holding its nodes lies below the level.
+void fill_level_voids(const TetMesh& mesh, const MatX4i& nb, const VecXd& nd, double threshold,
+                      const HygieneParams& params, const std::vector<char>& counted, std::vector<char>& solid,
+                      VecXd& out, HygieneReport& report) {
+  const long nv = mesh.V.rows(), nt = mesh.T.rows();
+  std::vector<char> empty(nv, 0), open(nv, 0);
+  for (long v = 0; v < nv; ++v) empty[v] = nd[v] < threshold;
+  for (long t = 0; t < nt; ++t)
+    for (int k = 0; k < 4; ++k) {
+      if (mesh.domain[t] != 0) empty[mesh.T(t, k)] = 0;
+      if (nb(t, k) < 0)
+        for (int j : kTetFace[k]) open[mesh.T(t, j)] = 1;
+    }
+  Groups groups(nv);
+  for (long t = 0; t < nt; ++t)
+    for (int a = 0; a < 4 && mesh.domain[t] == 0; ++a)
+      for (int b = a + 1; b < 4; ++b)
+        if (empty[mesh.T(t, a)] && empty[mesh.T(t, b)]) groups.join(mesh.T(t, a), mesh.T(t, b));
+  for (long v = 0; v < nv; ++v)
+    if (empty[v] && open[v]) open[groups.find(static_cast<int>(v))] = 1;
+  std::vector<double> volume(nv, 0.0);  // per void (its root node)
+  std::vector<int> root_of(nt, -1);     // the void a design tet holds nodes of
+  for (long t = 0; t < nt; ++t)
+    for (int k = 0; k < 4 && mesh.domain[t] == 0; ++k)
+      if (empty[mesh.T(t, k)]) {
+        root_of[t] = groups.find(mesh.T(t, k));
+        volume[root_of[t]] += tet_volume(mesh, t) - kept_tet_volume(mesh, nd, threshold, t);
+        break;
+      }
+  for (long t = 0; t < nt; ++t)  // a void the crisp design holds is counted there
+    if (root_of[t] >= 0 && counted[t]) open[root_of[t]] = 1;
+  for (long v = 0; v < nv; ++v) {
+    if (!empty[v] || groups.find(static_cast<int>(v)) != v || open[v]) continue;
+    if (!params.fill_voids) {
+      ++report.voids_kept, report.void_volume_kept += volume[v];
+      continue;
+    }
+    ++report.voids_filled, report.void_volume_filled += volume[v];
+  }
+  if (!params.fill_voids) return;
+  // the tets holding the void's nodes and the design tets around them (their walls may hold
+  // low densities that would leave a smaller cavity in the node densities)
+  std::vector<char> near(nv, 0);
+  for (long t = 0; t < nt; ++t)
+    if (root_of[t] >= 0 && !open[root_of[t]])
+      for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
+  for (long t = 0; t < nt; ++t)
+    if (mesh.domain[t] == 0 && (near[mesh.T(t, 0)] || near[mesh.T(t, 1)] || near[mesh.T(t, 2)] || near[mesh.T(t, 3)]))
+      out[t] = 1, solid[t] = 1;
 }
 
 /// The warnings about filled or kept voids, once for all rounds.
@@ -297,23 +365,6 @@ VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& c
       for (int n : around.row(mesh.T(t, k))) visit(n);
   });
 }
-
-namespace {
-
-/// Union-find over n items with path halving.
-struct Groups {
-  std::vector<int> parent;
-  explicit Groups(long n) : parent(n) {
-    for (long i = 0; i < n; ++i) parent[i] = static_cast<int>(i);
-  }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void join(int a, int b) { parent[find(a)] = find(b); }
-};
-
-}  // namespace
 
 VecXi level_components(const TetMesh& mesh, const VecXd& node_density, double threshold, int& count) {
   const long nv = mesh.V.rows(), nt = mesh.T.rows();
@@ -440,7 +491,11 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
     solid = crisp_tets(mesh, nd, threshold);
     HygieneReport found;
     remove_pieces(mesh, nd, threshold, anchors, solid, out, found);
-    fill_voids(mesh, nb, params, solid, out, found);
+    // the voids of what the removals left: the crisp design's, then the cut's that it misses
+    std::vector<char> counted;
+    fill_crisp_voids(mesh, nb, params, solid, out, found, counted);
+    const bool changed = changed_design(found);
+    fill_level_voids(mesh, nb, changed ? node_densities(mesh, out) : nd, threshold, params, counted, solid, out, found);
     if (round == 0)
       report = std::move(found);
     else

@@ -1,10 +1,11 @@
 // Design hygiene: what the density field hands over, cleaned before the result surface is
-// cut from it. It removes the solid pieces of the result shape (the region where the node
-// densities reach the threshold, cut out as the iso-surface will cut it) that no support or
-// load reaches and names the non-design solids that end up apart from the rest; on the tets
-// of the crisp design (non-design tets, and design tets whose node densities reach the
-// threshold on average) it fills closed internal voids (unless allowed) and measures the
-// thinnest member. The finished surface is checked by the same rule (clean_surface_pieces).
+// cut from it. On the result shape (the region where the node densities reach the threshold,
+// cut out as the iso-surface will cut it) it removes the solid pieces that no support or load
+// reaches and names the non-design solids that end up apart from the rest; it fills closed
+// internal voids (unless allowed), those of the crisp design (non-design tets, and design tets
+// whose node densities reach the threshold on average) and those of the result shape, and
+// measures the thinnest member of the crisp design. The finished surface's pieces are checked
+// by the same rule (clean_surface_pieces).
 #pragma once
 #include <array>
 #include <string>
@@ -104,8 +105,11 @@ double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std
 /// unknown. The pieces of the result shape (level_components; a piece reaches the anchors of
 /// its nodes inside the level) go by piece_fates: a removed piece's tets are set to density 0,
 /// a named one is warned about (its non-design solids, or a loaded piece of the design).
-/// Piece volumes are the result shape's (kept_tet_volume). Closed voids (void tets
-/// face-connected to no boundary face of the mesh) are set to 1 when params.fill_voids.
+/// Piece volumes are the result shape's (kept_tet_volume). Closed voids are filled (set to 1
+/// with the design tets around them) when params.fill_voids: the crisp design's (void tets
+/// face-connected to no boundary face of the mesh), then the result shape's that it misses (the
+/// nodes below the threshold joined by design-tet edges with both ends below it, none on the
+/// mesh boundary: a node below the threshold whose tets all average above it).
 /// Cleaning is repeated on the cleaned densities' own crisp design until a round changes
 /// nothing (at most 4 rounds), so that cleaning the result again finds nothing. Fills `report`
 /// (pieces counted before cleaning; a warning for every removal, every piece apart, several

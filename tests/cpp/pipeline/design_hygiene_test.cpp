@@ -324,6 +324,40 @@ TEST(DesignHygiene, ANodeAtTheThresholdWhoseTetsAllAverageBelowItLeavesNoCrumb) 
   }
 }
 
+TEST(DesignHygiene, ANodeBelowTheThresholdWhoseTetsAllAverageAboveItLeavesNoCavity) {
+  // the crumb's twin (the mount at 5 mm had one, -0.88 mm³): every tet around one node inside
+  // the solid cube is void, so that node's density is 0 while every tet around it averages
+  // above the threshold: no void tet for the crisp design, but the iso-surface wraps the node
+  // in a closed cavity
+  const TetMesh m = cube();
+  VecXd d = VecXd::Ones(m.T.rows());
+  const int n = nearest_node(m, {5, 5, 5});
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any()) d[t] = 0;
+  const VecXd nd = node_densities(m, d);
+  ASSERT_LT(nd[n], 0.5);
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any())
+      ASSERT_GE(0.25 * (nd[m.T(t, 0)] + nd[m.T(t, 1)] + nd[m.T(t, 2)] + nd[m.T(t, 3)]), 0.5);
+  for (const bool fill : {true, false}) {
+    SCOPED_TRACE(fill ? "voids filled" : "voids allowed");
+    HygieneParams params;
+    params.fill_voids = fill;
+    HygieneReport rep;
+    const TriSurface s =
+        pipeline::result_surface(m, d, 0.5, 0.3, SmoothParams{}, nullptr, anchors_at_x0(m), params, &rep, nullptr, {});
+    EXPECT_EQ(result_bodies(s), 1);
+    // filled: one closed surface, the cube's; allowed: the cavity's shell inside it as well
+    EXPECT_EQ(surface_pieces(s), fill ? 1 : 2);
+    EXPECT_EQ(rep.voids_filled, fill ? 1 : 0);
+    EXPECT_EQ(rep.voids_kept, fill ? 0 : 1);
+    const double cavity = fill ? rep.void_volume_filled : rep.void_volume_kept;
+    EXPECT_GT(cavity, 0);
+    EXPECT_LT(cavity, 4);  // within the node's 24 tets of 1/6 mm³
+    EXPECT_NEAR(check_surface(s.V, s.F).volume, 1000 - (fill ? 0 : cavity), fill ? 1e-6 : 0.5 + cavity);
+  }
+}
+
 TEST(DesignHygiene, TheFinishedSurfaceLosesADesignPieceApartAndKeepsANonDesignOneNamed) {
   // cut with no cleaning: a slab on the supported and loaded face x = 0 (Face1), a 2 x 4 x 4
   // mm block floating in the void, and non-design solid 1 at the far end (x = 8 .. 10) apart
