@@ -105,6 +105,22 @@ void refuse_invalid(const result::ResultCheck& c, double threshold, bool repair,
   throw Error(ErrorCode::MeshingFailed, m.str());
 }
 
+/// Indexed by Ω face number (mesh.face): the anchor flags (result::kAnchorSupport |
+/// kAnchorLoad) every node of the face's boundary triangles has, i.e. the supports and loads
+/// that act on the whole face; empty when `anchors` (#V) is.
+std::vector<char> face_anchor_flags(const TetMesh& mesh, const std::vector<char>& anchors) {
+  if (anchors.empty() || mesh.face.size() != mesh.F.rows() || mesh.F.rows() == 0) return {};
+  std::vector<char> flags(std::max(0, static_cast<int>(mesh.face.maxCoeff())) + 1, 0), seen(flags.size(), 0);
+  for (long q = 0; q < mesh.F.rows(); ++q) {
+    const int f = mesh.face[q];
+    if (f <= 0) continue;
+    const char all = anchors[mesh.F(q, 0)] & anchors[mesh.F(q, 1)] & anchors[mesh.F(q, 2)];
+    flags[f] = seen[f] ? static_cast<char>(flags[f] & all) : all;
+    seen[f] = 1;
+  }
+  return flags;
+}
+
 /// `mesh` as SIMP sees it under keep_loaded_faces: the loaded_face_layer of the job's loaded
 /// and supported faces tagged non-design (one tag after the last non-design solid), with a
 /// warning naming the faces. Returns false (and leaves `held` alone) when there is no layer.
@@ -212,7 +228,11 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
     s = result::extract_iso_surface(mesh, nd, t, margin);
   }
   const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
-  const result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
+  result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
+  // the finished surface by the hygiene's rule: a piece the cut or the smoothing left apart
+  const int added = result::clean_surface_pieces(s, face_anchor_flags(mesh, anchors), found);
+  for (size_t k = found.warnings.size() - added; k < found.warnings.size(); ++k) progress.warn(found.warnings[k]);
+  if (added > 0) finished.check = result::check_result(s);
   refuse_invalid(finished.check, t, smooth.repair, progress);
   if (surface_report) *surface_report = finished;
   if (report) *report = std::move(found);

@@ -72,7 +72,10 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 /// `volume_fraction` of the design domain, found on the densities as given), cleaned by
 /// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the
 /// largest piece), then finished: remeshed, smoothed, crossings repaired
-/// (result::finish_design_surface). `threshold_used`, `report`, `design` (#T, the cleaned
+/// (result::finish_design_surface), and its pieces checked by the hygiene's rule
+/// (result::clean_surface_pieces, the anchors' faces: a piece of design material only that the
+/// cut or the smoothing left apart from the loads is taken out, named in `report` and a
+/// warning). `threshold_used`, `report`, `design` (#T, the cleaned
 /// densities) and `surface_report` are optional outputs; the report's warnings are also given
 /// to progress.warn. Throws Error(MeshingFailed) naming the threshold when the finished
 /// surface is open or still crosses itself (with smooth.repair off a crossing surface is

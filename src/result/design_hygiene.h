@@ -1,14 +1,18 @@
 // Design hygiene: what the density field hands over, cleaned before the result surface is
-// cut from it. On the tets of the crisp design (non-design tets, and design tets whose node
-// densities reach the threshold on average) it removes solid pieces (tets sharing nodes) that
-// no support or load reaches, names the non-design solids that end up apart from the rest, fills closed internal
-// voids (unless allowed) and measures the thinnest member.
+// cut from it. On the result shape (the region where the node densities reach the threshold,
+// cut out as the iso-surface will cut it) it removes the solid pieces that no support or load
+// reaches and names the non-design solids that end up apart from the rest; it fills closed
+// internal voids (unless allowed), those of the crisp design (non-design tets, and design tets
+// whose node densities reach the threshold on average) and those of the result shape, and
+// measures the thinnest member of the crisp design. The finished surface's pieces are checked
+// by the same rule (clean_surface_pieces).
 #pragma once
 #include <array>
 #include <string>
 #include <vector>
 
 #include "common/types.h"
+#include "result/iso_surface.h"
 
 namespace topopt::result {
 
@@ -19,7 +23,7 @@ struct HygieneParams {
   bool fill_voids = true;  ///< fill closed internal voids; false keeps them (printed lattices)
 };
 
-/// A solid piece of the crisp design (tets sharing nodes) apart from the ones that carry the loads.
+/// A solid piece of the result shape apart from the ones that carry the loads.
 struct DesignPiece {
   double volume = 0;           ///< mm³
   std::vector<int> nondesign;  ///< non-design solids in it (domain tags, ascending)
@@ -28,7 +32,7 @@ struct DesignPiece {
 
 /// What clean_design found and did.
 struct HygieneReport {
-  int pieces = 0;                  ///< solid pieces (tets sharing nodes) before cleaning
+  int pieces = 0;                  ///< solid pieces (level_components) before cleaning
   int anchored_pieces = 0;         ///< ... of them touching a support or load node (or the largest, without anchors)
   std::vector<DesignPiece> apart;  ///< the other pieces
   int voids_filled = 0;            ///< closed internal voids filled
@@ -53,9 +57,40 @@ std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, dou
 VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count);
 
 /// Components of the tets with mask[t] set that share a node (pieces touching at an edge or a
-/// corner are one: the result surface, cut from node densities, joins them). Returns #T
+/// corner are one; the verification's tets, which fill the result surface, are joined so;
+/// the pieces of the result shape cut from node densities are level_components'). Returns #T
 /// labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
 VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count);
+
+/// Pieces of the result shape: the region where the interpolated node densities (#V) reach
+/// `threshold` (nodes at or above it are inside, as extract_iso_surface decides) in the design
+/// tets, plus the non-design tets whole. Its pieces: the nodes inside joined by the design
+/// tets' edges with both ends inside (a linear field's region in one tet is convex, so nothing
+/// else joins them: two tets sharing only a node below the threshold, or a node above it whose
+/// tets all average below it, are apart, as on the iso-surface) and by the non-design tets.
+/// Returns #T labels: the piece of a non-design tet, or of the nodes inside a design tet (all
+/// of one piece), -1 for design tets with none inside; `count` gets the number of pieces.
+VecXi level_components(const TetMesh& mesh, const VecXd& node_density, double threshold, int& count);
+
+/// What becomes of a piece of the result (PieceFate): the one rule, applied to the density
+/// field (clean_design) and to the finished surface (clean_surface_pieces).
+enum class PieceFate : char {
+  Carries,  ///< carries the loads: kept
+  Removed,  ///< design material only, no load on it: taken out
+  Named     ///< apart but kept (non-design solids in it, or a load): named in a warning
+};
+
+/// What the rule looks at of a piece.
+struct PieceFacts {
+  char touch = 0;          ///< kAnchorSupport | kAnchorLoad of the anchors it reaches
+  bool nondesign = false;  ///< holds non-design material
+  double volume = 0;       ///< mm³
+};
+
+/// The rule: the pieces that hold both a support and a load carry the loads (failing those,
+/// the pieces holding either; failing those, the largest piece); every other piece is removed
+/// when it is design material with no load on it, named otherwise. Returns one fate per piece.
+std::vector<PieceFate> piece_fates(const std::vector<PieceFacts>& pieces);
 
 /// The thinnest member of the solid tets (mask #T): every solid tet's centre gets its nearest
 /// point on the solid's boundary faces (the faces tried are propagated through the mesh from
@@ -67,16 +102,30 @@ double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std
 
 /// Cleans element densities (#T) at the threshold of the result shape. anchors: #V flags
 /// (kAnchorSupport | kAnchorLoad) of the nodes where supports and loads act; empty when
-/// unknown. The pieces that hold both a support and a load carry the loads (failing those,
-/// the pieces holding either; failing those, the largest piece); every other piece is apart:
-/// set to density 0 when it is design material with no load on it, named otherwise (its
-/// non-design solids, or a loaded piece of the design). Closed voids (void tets
-/// face-connected to no boundary face of the mesh) are set to 1 when params.fill_voids.
+/// unknown. The pieces of the result shape (level_components; a piece reaches the anchors of
+/// its nodes inside the level) go by piece_fates: a removed piece's tets are set to density 0,
+/// a named one is warned about (its non-design solids, or a loaded piece of the design).
+/// Piece volumes are the result shape's (kept_tet_volume). Closed voids are filled (set to 1
+/// with the design tets around them) when params.fill_voids: the crisp design's (void tets
+/// face-connected to no boundary face of the mesh), then the result shape's that it misses (the
+/// nodes below the threshold joined by design-tet edges with both ends below it, none on the
+/// mesh boundary: a node below the threshold whose tets all average above it).
 /// Cleaning is repeated on the cleaned densities' own crisp design until a round changes
 /// nothing (at most 4 rounds), so that cleaning the result again finds nothing. Fills `report`
 /// (pieces counted before cleaning; a warning for every removal, every piece apart, several
 /// load-carrying pieces, filled or kept voids) and returns the cleaned densities (#T).
 VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
                    const HygieneParams& params, HygieneReport& report);
+
+/// The finished result surface s checked by the hygiene's rule (piece_fates): its pieces
+/// (triangles sharing points) enclosing a positive volume, each reaching the anchors of the
+/// Ω faces it holds triangles of (face_anchors, indexed by Ω face number: kAnchorSupport |
+/// kAnchorLoad of the face; empty when unknown) and holding non-design material when it has
+/// a non-design face or point. Removed pieces are taken out of s (points renumbered) and
+/// added to report.apart with a warning naming their volume; a named piece whose non-design
+/// solids the report does not name yet is named. Closed inner shells (negative volume: voids)
+/// are left alone. Returns the number of the warnings added (the last ones of
+/// report.warnings).
+int clean_surface_pieces(TriSurface& s, const std::vector<char>& face_anchors, HygieneReport& report);
 
 }  // namespace topopt::result

@@ -108,15 +108,20 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density) {
   return out;
 }
 
+double kept_tet_volume(const TetMesh& mesh, const VecXd& node_density, double threshold, long t) {
+  std::array<Eigen::Vector3d, 4> p;
+  std::array<double, 4> f;
+  const bool design = mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0;
+  for (int a = 0; a < 4; ++a)
+    p[a] = mesh.V.row(mesh.T(t, a)), f[a] = design ? level(node_density, mesh.T(t, a), threshold) : 1.0;
+  return kept_volume(p, f);
+}
+
 double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold) {
   double total = 0;
-  for (long t = 0; t < mesh.T.rows(); ++t) {
-    if (mesh.domain.size() == mesh.T.rows() && mesh.domain[t] != 0) continue;
-    std::array<Eigen::Vector3d, 4> p;
-    std::array<double, 4> f;
-    for (int a = 0; a < 4; ++a) p[a] = mesh.V.row(mesh.T(t, a)), f[a] = level(node_density, mesh.T(t, a), threshold);
-    total += kept_volume(p, f);
-  }
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0)
+      total += kept_tet_volume(mesh, node_density, threshold, t);
   return total;
 }
 

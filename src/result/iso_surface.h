@@ -21,6 +21,11 @@ VecXd node_densities(const TetMesh& mesh, const VecXd& density);
 /// the piecewise-linear field.
 double kept_design_volume(const TetMesh& mesh, const VecXd& node_density, double threshold);
 
+/// Volume of tet t where the interpolated node density (#V) is at or above `threshold` (mm³,
+/// exact for the piecewise-linear field; the whole tet for a non-design tet): what of it the
+/// result shape holds.
+double kept_tet_volume(const TetMesh& mesh, const VecXd& node_density, double threshold, long t);
+
 /// The threshold in (0, 1) at which the kept design volume equals `volume_fraction` of the
 /// design domain's volume, by bisection. Where that lands on a plateau of equal node densities
 /// (within 1e-9), the threshold steps just off it (by up to 1e-6) to the side whose volume is

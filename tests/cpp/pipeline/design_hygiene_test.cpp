@@ -1,17 +1,22 @@
 // Design hygiene on hand-made density fields of a structured box: a loose piece is removed
 // and its volume given, a non-design solid apart from the supports is named and kept, closed
 // voids are filled (or kept when allowed) while open ones stay, the thinnest member is
-// measured, and the result surface of a job warns the same way at any threshold.
+// measured, and the result surface of a job warns the same way at any threshold; a piece of
+// the result shape the crisp tets do not see (a node at the threshold whose tets all average
+// below it: the lever example's crumb) goes too, and the finished surface is checked by the
+// same rule (a design piece apart goes, a non-design one stays, named).
 #include "result/design_hygiene.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 
 #include "mesh/core/structured_box.h"
 #include "pipeline/optimize_job.h"
 #include "result/iso_surface.h"
+#include "result/step_export.h"
 
 namespace topopt::result {
 namespace {
@@ -254,6 +259,138 @@ TEST(DesignHygiene, TheResultSurfaceWarnsAtEveryThreshold) {
       EXPECT_NEAR(check_surface(s.V, s.F).volume, 300, 40) << threshold;
     }
   }
+}
+
+/// The pieces of a triangle surface (triangles sharing points), counted here by union-find.
+int surface_pieces(const TriSurface& s) {
+  std::vector<int> parent(s.V.rows());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (long q = 0; q < s.F.rows(); ++q)
+    for (int k = 1; k < 3; ++k) parent[find(s.F(q, 0))] = find(s.F(q, k));
+  std::vector<char> root(s.V.rows(), 0);
+  for (long q = 0; q < s.F.rows(); ++q) root[find(s.F(q, 0))] = 1;
+  return static_cast<int>(std::count(root.begin(), root.end(), 1));
+}
+
+/// The node of m nearest to x.
+int nearest_node(const TetMesh& m, const Eigen::Vector3d& x) {
+  Eigen::Index best = 0;
+  (m.V.rowwise() - x.transpose()).rowwise().squaredNorm().minCoeff(&best);
+  return static_cast<int>(best);
+}
+
+TEST(DesignHygiene, ANodeAtTheThresholdWhoseTetsAllAverageBelowItLeavesNoCrumb) {
+  // the lever example's crumb (issue 19): every tet around one node in the void has density
+  // 1, so that node's density is 1 while its neighbours', shared with void tets, stay low and
+  // every tet around it averages below the threshold: no crisp tet there, but the iso-surface,
+  // cut from the node densities, wraps the node in a closed blob apart from the slab
+  const TetMesh m = cube();
+  VecXd d = densities(m, {{0, 0, 0, 3, 10, 10}});
+  const int n = nearest_node(m, {7, 5, 5});
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any()) d[t] = 1;
+  const VecXd nd = node_densities(m, d);
+  ASSERT_GE(nd[n], 0.5);
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any())
+      ASSERT_LT(0.25 * (nd[m.T(t, 0)] + nd[m.T(t, 1)] + nd[m.T(t, 2)] + nd[m.T(t, 3)]), 0.5);
+  // the premise holds: the crisp tets make one piece, the result shape two
+  int crisp_count = 0, level_count = 0;
+  node_components(m, crisp_tets(m, nd, 0.5), crisp_count);
+  level_components(m, nd, 0.5, level_count);
+  EXPECT_EQ(crisp_count, 1);
+  EXPECT_EQ(level_count, 2);
+  for (const bool with_anchors : {true, false}) {
+    SCOPED_TRACE(with_anchors ? "anchors at x = 0" : "no anchors");
+    std::vector<std::string> warnings;
+    Progress progress;
+    progress.log = [&](LogLevel level, const std::string& w) {
+      if (level == LogLevel::Warning) warnings.push_back(w);
+    };
+    HygieneReport rep;
+    const TriSurface s =
+        pipeline::result_surface(m, d, 0.5, 0.3, SmoothParams{}, nullptr,
+                                 with_anchors ? anchors_at_x0(m) : std::vector<char>{}, {}, &rep, nullptr, progress);
+    EXPECT_EQ(surface_pieces(s), 1);
+    EXPECT_EQ(result_bodies(s), 1);
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_NE(warnings[0].find("removed a loose piece"), std::string::npos) << warnings[0];
+    EXPECT_NE(warnings[0].find("mm³"), std::string::npos) << warnings[0];
+    EXPECT_NEAR(check_surface(s.V, s.F).volume, 300, 40);
+  }
+}
+
+TEST(DesignHygiene, ANodeBelowTheThresholdWhoseTetsAllAverageAboveItLeavesNoCavity) {
+  // the crumb's twin (the mount at 5 mm had one, -0.88 mm³): every tet around one node inside
+  // the solid cube is void, so that node's density is 0 while every tet around it averages
+  // above the threshold: no void tet for the crisp design, but the iso-surface wraps the node
+  // in a closed cavity
+  const TetMesh m = cube();
+  VecXd d = VecXd::Ones(m.T.rows());
+  const int n = nearest_node(m, {5, 5, 5});
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any()) d[t] = 0;
+  const VecXd nd = node_densities(m, d);
+  ASSERT_LT(nd[n], 0.5);
+  for (long t = 0; t < m.T.rows(); ++t)
+    if ((m.T.row(t).array() == n).any())
+      ASSERT_GE(0.25 * (nd[m.T(t, 0)] + nd[m.T(t, 1)] + nd[m.T(t, 2)] + nd[m.T(t, 3)]), 0.5);
+  for (const bool fill : {true, false}) {
+    SCOPED_TRACE(fill ? "voids filled" : "voids allowed");
+    HygieneParams params;
+    params.fill_voids = fill;
+    HygieneReport rep;
+    const TriSurface s =
+        pipeline::result_surface(m, d, 0.5, 0.3, SmoothParams{}, nullptr, anchors_at_x0(m), params, &rep, nullptr, {});
+    EXPECT_EQ(result_bodies(s), 1);
+    // filled: one closed surface, the cube's; allowed: the cavity's shell inside it as well
+    EXPECT_EQ(surface_pieces(s), fill ? 1 : 2);
+    EXPECT_EQ(rep.voids_filled, fill ? 1 : 0);
+    EXPECT_EQ(rep.voids_kept, fill ? 0 : 1);
+    const double cavity = fill ? rep.void_volume_filled : rep.void_volume_kept;
+    EXPECT_GT(cavity, 0);
+    EXPECT_LT(cavity, 4);  // within the node's 24 tets of 1/6 mm³
+    EXPECT_NEAR(check_surface(s.V, s.F).volume, 1000 - (fill ? 0 : cavity), fill ? 1e-6 : 0.5 + cavity);
+  }
+}
+
+TEST(DesignHygiene, TheFinishedSurfaceLosesADesignPieceApartAndKeepsANonDesignOneNamed) {
+  // cut with no cleaning: a slab on the supported and loaded face x = 0 (Face1), a 2 x 4 x 4
+  // mm block floating in the void, and non-design solid 1 at the far end (x = 8 .. 10) apart
+  const TetMesh m = cube({{8, 0, 0, 10, 10, 10}});
+  const VecXd d = densities(m, {{0, 0, 0, 3, 10, 10}, {5, 3, 3, 7, 7, 7}});
+  TriSurface s = extract_iso_surface(m, node_densities(m, d), 0.5, 0.2);
+  ASSERT_EQ(surface_pieces(s), 3);
+  const double before = check_surface(s.V, s.F).volume;
+  std::vector<char> face_anchors(7, 0);
+  face_anchors[1] = kAnchorSupport | kAnchorLoad;
+  HygieneReport rep;
+  const int added = clean_surface_pieces(s, face_anchors, rep);
+  EXPECT_EQ(surface_pieces(s), 2);
+  EXPECT_EQ(check_surface(s.V, s.F).open_edges, 0);
+  ASSERT_EQ(added, 2);
+  ASSERT_EQ(rep.apart.size(), 2u);
+  // the block: removed, its volume the surface's (2 x 4 x 4 mm, the level between cells)
+  EXPECT_TRUE(rep.apart[0].removed);
+  EXPECT_GT(rep.apart[0].volume, 16);
+  EXPECT_LT(rep.apart[0].volume, 64);
+  EXPECT_NEAR(check_surface(s.V, s.F).volume, before - rep.apart[0].volume, 1e-6 * before);
+  // solid 1: kept and named, with its 200 mm³
+  EXPECT_FALSE(rep.apart[1].removed);
+  EXPECT_EQ(rep.apart[1].nondesign, std::vector<int>{1});
+  EXPECT_NEAR(rep.apart[1].volume, 200, 1e-6);
+  const std::vector<std::string> added_warnings(rep.warnings.end() - added, rep.warnings.end());
+  EXPECT_NE(added_warnings[0].find("removed a loose piece of the result surface"), std::string::npos)
+      << added_warnings[0];
+  EXPECT_NE(added_warnings[0].find("mm³"), std::string::npos) << added_warnings[0];
+  EXPECT_NE(added_warnings[1].find("non-design solid 1 is not connected"), std::string::npos) << added_warnings[1];
+  // checked again: nothing more to do; and a report that names solid 1 already gets no second name
+  EXPECT_EQ(clean_surface_pieces(s, face_anchors, rep), 0);
+  EXPECT_EQ(surface_pieces(s), 2);
 }
 
 }  // namespace
