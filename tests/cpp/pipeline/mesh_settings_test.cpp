@@ -108,14 +108,14 @@ TEST(MeshSettings, TheMeshersReceiveEveryDecision) {
   MeshSettings s;
   s.wall_layers = 2;
   s.gmsh_volume_by_front = true;
-  const MeshSizes sizes = resolve_mesh_sizes(s, 100, 1000);
+  const MeshSizes sizes = resolve_mesh_sizes(s, 100, 1000, {}, 3e9);  // a 3 GB machine: 2e6 estimated tets
   const mesh::NativeMeshParams n = native_mesh_params(s, sizes);
   EXPECT_EQ(n.surface.size, 2.0);
   EXPECT_EQ(n.surface.min_size, 0.2);
   EXPECT_DOUBLE_EQ(n.surface.gradation, 1.3);
   EXPECT_DOUBLE_EQ(n.surface.max_angle, 2 * 3.14159265358979323846 / 40);
   EXPECT_EQ(n.surface.wall_layers, 2);
-  EXPECT_EQ(n.volume.max_tets, 12'000'000);
+  EXPECT_EQ(n.volume.max_tets, 4'000'000);  // the fills stop at twice the budget
   const mesh::FragmentMeshParams g = gmsh_mesh_params(s, sizes);
   EXPECT_EQ(g.size, 2.0);
   EXPECT_EQ(g.min_size, 0.2);  // the same smallest size on both paths
