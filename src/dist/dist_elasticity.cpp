@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <vector>
 
 #include "common/error.h"
@@ -42,6 +43,7 @@ struct DistElasticity::Impl {
   Vec b = nullptr;
   std::vector<Vec> x;  // one ghosted solution per load case (warm starts)
   bool dirty = true;
+  bool safe_smoother = false;  // after a failed solve: the multigrid smooths with SOR (no eigenvalue estimate)
   int iterations = 0;
 
   Impl(const MpiSession& s, const DistMesh& m, const DistSolverParams& p) : session(s), mesh(m), params(p) {}
@@ -55,6 +57,8 @@ struct DistElasticity::Impl {
   void insert(Mat A, bool values) const;
   void create_matrix();
   void create_solver();
+  void use_safe_smoother();
+  KSPConvergedReason run_solver(long k, PetscInt& its);
   Vec ghosted_vector() const;
   void solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U);
   template <class F>
@@ -155,6 +159,11 @@ void DistElasticity::Impl::create_solver() {
     option_unless_given("-pc_hypre_boomeramg_vec_interp_variant", "3");
   } else {
     check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
+    // Chebyshev smoothing aims at 1.3 × the estimated largest eigenvalue, not PETSc's 1.1: under
+    // SIMP's stiffness contrast the estimate falls short often enough that the V-cycle stopped
+    // being positive definite (CG: "indefinite preconditioner") on 3 of 7 option sets tried on a
+    // 100 k-tet cantilever by iteration 5; at 1.3 all 7 ran (BENCHMARKS.md, distributed path).
+    option_unless_given("-mg_levels_ksp_chebyshev_esteig", "0,0.1,0,1.3");
   }
   check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
   check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
@@ -172,23 +181,50 @@ Vec DistElasticity::Impl::ghosted_vector() const {
   return v;
 }
 
+/// Switches the multigrid to smoothing by symmetric SOR sweeps, which need no eigenvalue
+/// estimate and keep the V-cycle positive definite for any SPD matrix (slower than Chebyshev).
+void DistElasticity::Impl::use_safe_smoother() {
+  KSPDestroy(&ksp);
+  params.amg = Amg::GAMG;
+  check_petsc(PetscOptionsSetValue(nullptr, "-mg_levels_ksp_type", "richardson"), "PetscOptionsSetValue");
+  check_petsc(PetscOptionsSetValue(nullptr, "-mg_levels_pc_type", "sor"), "PetscOptionsSetValue");
+  create_solver();
+  check_petsc(KSPSetOperators(ksp, K, K), "KSPSetOperators");
+  safe_smoother = true;
+}
+
+KSPConvergedReason DistElasticity::Impl::run_solver(long k, PetscInt& its) {
+  check_petsc(KSPSolve(ksp, b, x[k]), "KSPSolve");
+  KSPConvergedReason reason;
+  KSPGetConvergedReason(ksp, &reason);
+  KSPGetIterationNumber(ksp, &its);
+  return reason;
+}
+
+/// Solves load case k; a solve that fails is run once more from zero with the safe smoother
+/// before the failure is the user's (then most likely a part the supports do not hold).
 void DistElasticity::Impl::solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U) {
   PetscScalar* f = nullptr;
   VecGetArray(b, &f);
   for (long i = 0; i < 3L * mesh.owned_nodes; ++i) f[i] = dof[i] >= 0 ? loads(i, k) : 0.0;
   VecRestoreArray(b, &f);
   while (static_cast<long>(x.size()) <= k) x.push_back(ghosted_vector());
-  check_petsc(KSPSolve(ksp, b, x[k]), "KSPSolve");
-  KSPConvergedReason reason;
-  KSPGetConvergedReason(ksp, &reason);
   PetscInt its = 0;
-  KSPGetIterationNumber(ksp, &its);
+  KSPConvergedReason reason = run_solver(k, its);
+  if (reason < 0 && !safe_smoother) {
+    if (session.rank() == 0)
+      std::cerr << "[dist] the multigrid solve failed (PETSc reason " << static_cast<int>(reason) << " after " << its
+                << " iterations); solving again with SOR smoothing" << std::endl;
+    use_safe_smoother();
+    VecSet(x[k], 0.0);
+    reason = run_solver(k, its);
+  }
   iterations = std::max(iterations, static_cast<int>(its));
   if (reason < 0)
     throw Error(ErrorCode::NoSupport,
                 "the distributed solver (CG with algebraic multigrid) did not converge (PETSc reason " +
                     std::to_string(static_cast<int>(reason)) + ", " + std::to_string(its) +
-                    " iterations): check that the supports hold every piece of the part");
+                    " iterations, also with SOR smoothing): check that the supports hold every piece of the part");
   VecGhostUpdateBegin(x[k], INSERT_VALUES, SCATTER_FORWARD);
   VecGhostUpdateEnd(x[k], INSERT_VALUES, SCATTER_FORWARD);
   Vec local;

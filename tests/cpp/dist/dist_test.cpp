@@ -2,6 +2,7 @@
 // mpirun -np 2): the partition is balanced, the ghost layer holds the owners' data, and the
 // distributed solve, Helmholtz filter and SIMP give the serial answers.
 #include <gtest/gtest.h>
+#include <petscsys.h>
 
 #include <algorithm>
 #include <array>
@@ -146,6 +147,34 @@ TEST(DistElasticity, DisplacementsEqualTheSerialSolve) {
   ASSERT_EQ(stats.size(), 2u);
   EXPECT_GT(stats[1].tets, 0);
   EXPECT_GT(stats[1].peak_bytes, 0);
+}
+
+/// A user's smoother setting that makes Chebyshev amplify the highest modes (it aims at a fifth
+/// of the largest eigenvalue) breaks CG; the solve is run again with SOR smoothing and still
+/// gives the direct solver's displacements, and says so.
+TEST(DistElasticity, AFailedMultigridSolveIsSolvedAgainWithSorSmoothing) {
+  const Beam b = make_beam();
+  DistSolverParams params;
+  params.tolerance = 1e-10;
+  ASSERT_EQ(PetscOptionsSetValue(nullptr, "-mg_levels_ksp_chebyshev_esteig", "0,0.02,0,0.2"), 0);
+  Eigen::MatrixXd U;
+  std::vector<VecXd> von_mises;
+  if (!root()) {
+    serve_ranks(session());
+  } else {
+    ::testing::internal::CaptureStderr();
+    solve_on_ranks(session(), b.mesh, b.material, b.supports, b.loads, params, U, von_mises, nullptr);
+    const std::string said = ::testing::internal::GetCapturedStderr();
+    release_ranks(session());
+    EXPECT_NE(said.find("solving again with SOR smoothing"), std::string::npos) << said;
+    fem::SolverParams direct;
+    direct.kind = fem::SolverKind::Direct;
+    fem::Elasticity fe(b.mesh, b.material, b.supports, direct);
+    const Eigen::MatrixXd reference = fe.solve(b.loads);
+    EXPECT_LT((U - reference).norm(), 1e-6 * reference.norm());
+  }
+  for (const char* name : {"-mg_levels_ksp_chebyshev_esteig", "-mg_levels_ksp_type", "-mg_levels_pc_type"})
+    PetscOptionsClearValue(nullptr, name);
 }
 
 TEST(DistHelmholtz, FiltersAsTheSerialFilter) {
