@@ -78,6 +78,42 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
     return area[flat].sum() / max(area[down].sum(), 1e-30)
 
 
+def _nondesign_keys(points, tets, domain, h=1e-3, slack=1e-5):
+    """Hash keys of every non-design node (a node of a non-design tet), each key a cell of h mm,
+    inserted for the node's place shifted by up to `slack` along each axis, so that a point
+    within `slack` of the node (the STL's float32 rounding) finds one of them."""
+    nodes = points[np.unique(tets[domain != 0])]
+    keys = set()
+    for dx in (-slack, 0, slack):
+        for dy in (-slack, 0, slack):
+            for dz in (-slack, 0, slack):
+                q = np.floor((nodes + [dx, dy, dz]) / h).astype(np.int64)
+                keys.update(map(tuple, q))
+    return keys
+
+
+def overhang_on_given_faces(stl, up, vtu, angle=45.0, tol=1e-3):
+    """The overhang area (mm², as overhang_share counts it) of a result surface, all of it and the
+    part of it on the non-design solids' faces: triangles whose three corners are nodes of
+    non-design tets of the run's mesh (density.vtu; the result surface never moves those nodes and
+    its iso-surface crossings stay off the mesh's nodes). Says how much of the share is a load pad's
+    or a boss's own face that the design leaves bare (docs/optimization.md, "Overhang")."""
+    sys.path.insert(0, os.path.join(ROOT, "bench", "result"))
+    import crisp  # noqa: E402
+    points, tets, arrays = crisp.read_vtu(vtu)
+    keys = _nondesign_keys(points, tets, arrays["domain"].astype(np.int64))
+    tris = benchlib.read_stl(stl)
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    area = np.linalg.norm(n, axis=1) / 2
+    s = tris @ up
+    plate = s.min()
+    on_plate = (s.min(1) >= plate - tol) & (s.max(1) <= plate + tol)
+    flat = (n @ up < 0) & ~on_plate & (area > 0) & (-(n @ up) > np.cos(np.radians(angle)) * 2 * area)
+    corner_given = np.array([tuple(k) in keys for k in np.floor(tris.reshape(-1, 3) / 1e-3).astype(np.int64)])
+    given = corner_given.reshape(-1, 3).all(axis=1)
+    return area[flat].sum(), area[flat & given].sum()
+
+
 def member_columns(build, out, size, mesh_size, stdout):
     """For a run with a minimum member size: the crisp design the user gets (the run's cleaned
     densities, `design` in density.vtu, through the node densities at the run's threshold, as
@@ -167,6 +203,10 @@ def main():
             benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
             stl = os.path.join(out, "result.stl")
             shares = " / ".join("%.1f %%" % (100 * overhang_share(stl, up)) for up in BUILDS.values())
+            if controls and "overhang" in controls:
+                up = np.array(controls["overhang"]["direction"], dtype=float)
+                over, given = overhang_on_given_faces(stl, up / np.linalg.norm(up), os.path.join(out, "density.vtu"))
+                shares += " (%.1f mm², of it %.1f on non-design faces)" % (over, given)
             if controls and "min_member_size" in controls:
                 small, thin, crisp_c = member_columns(a.build, out, controls["min_member_size"], size, p.stdout)
                 members.append("| %s | %s | %.2f mm | %.1f %% | %.4g | %.4g |" % (name, label, small, 100 * thin, c, crisp_c))

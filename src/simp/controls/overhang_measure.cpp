@@ -14,7 +14,6 @@ OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vect
   const double plate = params.plate, eps = params.plate_tolerance;
   OverhangShare out;
   for (long f = 0; f < F.rows(); ++f) {
-    if (tag && (*tag)[f] != 0) continue;  // Ω's or a non-design solid's face: the given shape
     const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
     const Eigen::Vector3d n = (b - a).cross(c - a);
     const double area = n.norm() / 2;
@@ -23,7 +22,10 @@ OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vect
                  highest = std::max({a.dot(up), b.dot(up), c.dot(up)});
     if (lowest >= plate - eps && highest <= plate + eps) continue;  // on the plate
     out.downward_area += area;
-    if (-n.dot(up) > cos_limit * 2 * area) out.overhang_area += area;  // angle(n, -d) < limit
+    if (!(-n.dot(up) > cos_limit * 2 * area)) continue;  // angle(n, -d) >= limit: prints
+    out.overhang_area += area;
+    const int kind = tag ? (*tag)[f] : 0;
+    (kind == 0 ? out.design_overhang : kind < 0 ? out.nondesign_overhang : out.omega_overhang) += area;
   }
   return out;
 }

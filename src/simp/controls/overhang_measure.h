@@ -9,6 +9,10 @@ namespace topopt::simp {
 struct OverhangShare {
   double downward_area = 0;  ///< mm²: triangles facing against the build direction, off the plate
   double overhang_area = 0;  ///< mm²: those of them flatter than the critical angle
+  /// mm², with tags only: the overhang area split by whose face it lies on (the three sum to
+  /// overhang_area): the design's own surface (tag 0), the non-design solids' faces that the
+  /// design leaves bare (tag < 0), Ω's faces (tag > 0)
+  double design_overhang = 0, nondesign_overhang = 0, omega_overhang = 0;
   /// overhang_area / downward_area (0 when nothing faces down)
   double share() const { return downward_area > 0 ? overhang_area / downward_area : 0.0; }
 };
@@ -24,12 +28,16 @@ struct OverhangMeasureParams {
 };
 
 /// V: #P by 3 points, F: #Q by 3 triangles oriented outwards (a closed surface); d: the build
-/// direction (non-zero); params: the angle, plate and tolerances; tag: nullptr (every triangle
-/// counts) or #Q tags of result::TriSurface, of which only the design's own surface (tag 0)
-/// counts — Ω's faces and the non-design solids' faces are the part's given shape. A triangle
-/// faces down when its normal n has n·d < 0; it is an overhang when the angle between n and
-/// −d is below angle − tolerance (a plane rising less than that from the plate). Triangles
-/// lying on the plate (every corner within plate_tolerance of it) count neither way.
+/// direction (non-zero); params: the angle, plate and tolerances; tag: nullptr or #Q tags of
+/// result::TriSurface (0 the design's own surface, f > 0 Ω's face f, −k a face of non-design
+/// solid k), which only split the overhang area by kind. Every triangle counts, whoever made it:
+/// a face that faces down off the plate needs supports whether the design or the user's part
+/// shaped it, and a non-design face is on the result surface only where the design leaves it
+/// bare (its downward side lies inside Ω, where the design could have covered it); the split
+/// says which is which (docs/optimization.md, "Overhang", what counts). A triangle faces down
+/// when its normal n has n·d < 0; it is an overhang when the angle between n and −d is below
+/// angle − tolerance (a plane rising less than that from the plate). Triangles lying on the
+/// plate (every corner within plate_tolerance of it) count neither way: they rest on it.
 OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d,
                              const OverhangMeasureParams& params, const VecXi* tag = nullptr);
 
