@@ -7,7 +7,7 @@
 namespace topopt::simp {
 
 OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vector3d& d,
-                             const OverhangMeasureParams& params, const VecXi* tag) {
+                             const OverhangMeasureParams& params, const VecXi* tag, const VecXi* lock) {
   const Eigen::Vector3d up = d.normalized();
   const double limit = std::max(0.0, params.angle - params.tolerance);
   const double cos_limit = std::cos(limit * 3.14159265358979323846 / 180);
@@ -21,10 +21,17 @@ OverhangShare overhang_share(const MatX3d& V, const MatX3i& F, const Eigen::Vect
     const double lowest = std::min({a.dot(up), b.dot(up), c.dot(up)}),
                  highest = std::max({a.dot(up), b.dot(up), c.dot(up)});
     if (lowest >= plate - eps && highest <= plate + eps) continue;  // on the plate
-    out.downward_area += area;
-    if (!(-n.dot(up) > cos_limit * 2 * area)) continue;  // angle(n, -d) >= limit: prints
-    out.overhang_area += area;
     const int kind = tag ? (*tag)[f] : 0;
+    const bool given = kind > 0 && lock && (*lock)[F(f, 0)] == 2 && (*lock)[F(f, 1)] == 2 && (*lock)[F(f, 2)] == 2;
+    const bool flat = -n.dot(up) > cos_limit * 2 * area;  // angle(n, -d) < limit
+    if (given) {  // a non-design solid's face on Ω's boundary: the user's shape
+      out.given_downward_area += area;
+      if (flat) out.given_overhang_area += area;
+      continue;
+    }
+    out.downward_area += area;
+    if (!flat) continue;
+    out.overhang_area += area;
     (kind == 0 ? out.design_overhang : kind < 0 ? out.nondesign_overhang : out.omega_overhang) += area;
   }
   return out;

@@ -348,7 +348,7 @@ OverhangShare product_overhang(const Beam& b, const VecXd& density, double volum
   m.angle = angle;
   m.plate = -5;
   m.tolerance = tolerance;
-  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag);
+  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag, &s.lock);
 }
 
 TEST(Overhang, MeasureCountsEveryFaceAndSaysWhose) {
@@ -382,6 +382,27 @@ TEST(Overhang, MeasureCountsEveryFaceAndSaysWhose) {
               1e-12);
   p.plate = 1;  // the flat triangle at z = 1 rests on the plate now
   EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).downward_area, a_flat + a_40, 1e-12);
+}
+
+TEST(Overhang, MeasureSetsThePartsGivenFacesApart) {
+  // a solid 12 × 4 × 3 mm box, a non-design block in its corner x < 2 standing on its bottom
+  // face, measured as if the plate lay 1 mm below the box: the whole bottom faces down off the
+  // plate. The design's part of it (Ω's face where the design reaches it, 10 × 4 mm²) counts;
+  // the block's bottom (2 × 4 mm², a non-design face on Ω's boundary: no design changes it) is
+  // set apart as the part's given shape, on the result surface the product makes
+  const TetMesh m = box_mesh({12, 4, 3}, {{{0, 0, 0, 2, 4, 3}}});
+  const VecXd full = VecXd::Ones(m.T.rows());
+  const result::TriSurface s = pipeline::result_surface(m, full, 0.5, -1, result::SmoothParams{});
+  OverhangMeasureParams p;
+  p.plate = -1;
+  const OverhangShare o = overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), p, &s.tag, &s.lock);
+  EXPECT_NEAR(o.given_overhang_area, 8, 1e-9);
+  EXPECT_NEAR(o.given_downward_area, 8, 1e-9);
+  EXPECT_NEAR(o.omega_overhang, 40, 1e-9);
+  EXPECT_NEAR(o.downward_area, 40, 1e-9);
+  EXPECT_EQ(o.design_overhang + o.nondesign_overhang, 0.0);
+  const OverhangShare untagged = overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), p);
+  EXPECT_NEAR(untagged.overhang_area, 48, 1e-9) << "without tags every triangle counts";
 }
 
 TEST(Overhang, BeamHasLessOverhangWithTheControl) {
