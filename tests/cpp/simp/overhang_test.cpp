@@ -337,8 +337,10 @@ Beam test_beam() {
 
 /// The overhang share of the result surface the user gets (pipeline::result_surface with the
 /// product's defaults: the threshold that keeps the volume fraction, hygiene, smoothing,
-/// remeshing), every triangle of it (Ω's faces and the pad's too, split by kind: an exposed face
-/// of the pad that faces down needs supports as much as the design's own), built along +z from
+/// remeshing), every triangle a design could change (Ω's faces and the pad's too, split by kind:
+/// an exposed face of the pad that faces down needs supports as much as the design's own; the
+/// part's given faces, a non-design solid's on Ω's boundary, apart — none faces down on this
+/// beam), built along +z from
 /// z = −5; a facet counts when it rises less than angle − tolerance from the plate. `smooth`:
 /// the surface stage's settings (the crisp stage: no remeshing, no smoothing).
 OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, double angle,
@@ -355,7 +357,8 @@ TEST(Overhang, MeasureCountsEveryFaceAndSaysWhose) {
   // three triangles facing down: a flat one of the design (an overhang), one of the design at
   // 40° from the plate (an overhang at 45°, not with a tolerance of 6°), and a flat one of a
   // non-design solid (a load pad's face the design leaves bare: it needs supports as much as the
-  // design's own, so it counts; the tags only say whose it is)
+  // design's own, so it counts; the tags only say whose it is — without locks nothing is set
+  // apart as the part's given shape: MeasureSetsThePartsGivenFacesApart)
   MatX3d V(9, 3);
   const double t = std::tan(40 * M_PI / 180);
   V << 0, 0, 1, 0, 1, 1, 1, 0, 1,     // flat, facing down
