@@ -78,6 +78,67 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
     return area[flat].sum() / max(area[down].sum(), 1e-30)
 
 
+def _nondesign_boundary(points, tets, domain):
+    """The non-design solids' boundary triangles, each #B x 3 x 3: those inside Ω (faces of
+    non-design tets that a design tet shares) and those on Ω's boundary (no other tet shares them)."""
+    faces = np.concatenate([tets[:, [1, 2, 3]], tets[:, [0, 3, 2]], tets[:, [0, 1, 3]], tets[:, [0, 2, 1]]])
+    fixed = np.tile(domain != 0, 4)
+    _, inverse, count = np.unique(np.sort(faces, axis=1), axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    fixed_count = np.bincount(inverse, weights=fixed, minlength=len(count))
+    inside = fixed & (count[inverse] == 2) & (fixed_count[inverse] == 1)
+    outside = fixed & (count[inverse] == 1)
+    return points[faces[inside]], points[faces[outside]]
+
+
+def _on_triangles(p, tris, tol=1e-3):
+    """#P flags: point p[i] lies within tol of one of the triangles tris (#B x 3 x 3)."""
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    n = np.cross(b - a, c - a)
+    n2 = np.einsum("ij,ij->i", n, n)
+    out = np.zeros(len(p), dtype=bool)
+    for i, q in enumerate(p):
+        dist = np.einsum("ij,ij->i", q - a, n) / np.sqrt(n2)
+        near = np.abs(dist) < tol
+        if not near.any():
+            continue
+        # barycentric coordinates of q's projection on the near triangles
+        w = np.stack([np.einsum("ij,ij->i", np.cross(c - b, q - b), n), np.einsum("ij,ij->i", np.cross(a - c, q - c), n),
+                      np.einsum("ij,ij->i", np.cross(b - a, q - a), n)], axis=1) / n2[:, None]
+        out[i] = (near & (w >= -1e-6).all(axis=1)).any()
+    return out
+
+
+def overhang_on_given_faces(stl, up, vtu, angle=45.0, tol=1e-3):
+    """The overhang of a result surface split as simp/controls/overhang_measure.h splits it, a
+    triangle being on a non-design face when its centroid lies on one of the run's non-design
+    boundary triangles (density.vtu): (overhang area, of it on non-design faces inside Ω — a load
+    pad's face the design leaves bare, counted —, of it on non-design faces on Ω's boundary — a
+    bore's roof, the part's given shape —, the share without the given faces: what the measure
+    holds the control to), areas in mm² (docs/optimization.md, "Overhang", what counts)."""
+    sys.path.insert(0, os.path.join(ROOT, "bench", "result"))
+    import crisp  # noqa: E402
+    points, tets, arrays = crisp.read_vtu(vtu)
+    inside, outside = _nondesign_boundary(points, tets, arrays["domain"].astype(np.int64))
+    tris = benchlib.read_stl(stl)
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    area = np.linalg.norm(n, axis=1) / 2
+    s = tris @ up
+    plate = s.min()
+    on_plate = (s.min(1) >= plate - tol) & (s.max(1) <= plate + tol)
+    down = (n @ up < 0) & ~on_plate & (area > 0)
+    flat = down & (-(n @ up) > np.cos(np.radians(angle)) * 2 * area)
+    centroids = tris[down].mean(axis=1)
+    bared, given = np.zeros(len(tris), dtype=bool), np.zeros(len(tris), dtype=bool)
+    if len(inside):
+        bared[down] = _on_triangles(centroids, inside, tol)
+    if len(outside):
+        given[down] = _on_triangles(centroids, outside, tol) & ~bared[down]
+    counted = area[down & ~given].sum()
+    return (area[flat].sum(), area[flat & bared].sum(), area[flat & given].sum(),
+            area[flat & ~given].sum() / max(counted, 1e-30))
+
+
 def member_columns(build, out, size, mesh_size, stdout):
     """For a run with a minimum member size: the crisp design the user gets (the run's cleaned
     densities, `design` in density.vtu, through the node densities at the run's threshold, as
@@ -167,6 +228,12 @@ def main():
             benchlib.picture(os.path.join(out, "result.stl"), png, "%s, %s: compliance %.4g" % (name, label, c))
             stl = os.path.join(out, "result.stl")
             shares = " / ".join("%.1f %%" % (100 * overhang_share(stl, up)) for up in BUILDS.values())
+            if controls and "overhang" in controls:
+                up = np.array(controls["overhang"]["direction"], dtype=float)
+                over, bared, given, share = overhang_on_given_faces(stl, up / np.linalg.norm(up),
+                                                                     os.path.join(out, "density.vtu"))
+                shares += " (%.1f mm²: %.1f on bared non-design faces, %.1f on non-design faces on Ω's boundary; " \
+                          "without those: **%.1f %%**)" % (over, bared, given, 100 * share)
             if controls and "min_member_size" in controls:
                 small, thin, crisp_c = member_columns(a.build, out, controls["min_member_size"], size, p.stdout)
                 members.append("| %s | %s | %.2f mm | %.1f %% | %.4g | %.4g |" % (name, label, small, 100 * thin, c, crisp_c))

@@ -3,7 +3,8 @@
 // on a lattice turned against the mesh, non-design solids and a picked base face support, bad
 // settings are named, the chain rule against finite differences, and the property on an
 // optimised beam: less of its downward-facing surface is flatter than the critical angle
-// with the control than without (the issue's ≤ 1 % is not reached: see the test).
+// with the control than without, the issue's ≤ 1 % on the crisp iso-surface of the design (not
+// on the smoothed surface the user gets: see the test).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -63,17 +64,24 @@ OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double ang
   return c;
 }
 
-/// The property test's settings and bound. NOT the target (<= 1 % with the control):
-/// measured on the result surface the user gets, every triangle of it (the pad's faces too),
-/// facets within 3 degrees of the limit not counted, β at its end: 1.5 % with the default margin
-/// of 20° since the non-design pad's lattice nodes carry only the design resting on them (3.0 %
-/// before: a shelf beside the pad), 32.7 % free (docs/optimization.md, "Overhang": what is left
-/// are ceilings of the lattice's staircase next to the pad, x = 23 … 27). The test holds what is
-/// reached, with the default margin.
+/// The property test's settings and bounds. On the result surface the user gets the issue's
+/// target (<= 1 % with the control) is NOT reached: every triangle of it counted (the pad's faces
+/// too, none of which faces down on this beam), facets within 3 degrees of the limit not counted,
+/// β at its end: 1.79 % with the default margin of 20° (the main of 2026-12-03; 1.5 % on the
+/// surface stage of 2026-12-02), 32.7 % free (docs/optimization.md, "Overhang": what is left are
+/// facets of the lattice's staircase next to the pad, x = 24 … 27.5, and under the beam's middle,
+/// tilted below 45° by the surface stage). The test holds what is reached there, with the default
+/// margin, and the 1 % on the crisp iso-surface, where it is met.
 constexpr int kBeamIterations = 200;
 constexpr double kBeamTolerance = 3;
 constexpr double kBeamMargin = 20;
 constexpr double kBeamShareBound = 0.02;
+/// The 1 %, met by the design the filter makes: the crisp iso-surface at the volume's
+/// threshold (marching tetrahedra, hygiene, no remeshing or smoothing), every facet, no tolerance:
+/// 0.81 % (0.64 % at 3°). The surface stage after it (crossings kept 0.2 of an edge off the
+/// nodes, Taubin smoothing) tilts facets of the lattice's staircase beside the pad and under the
+/// beam's middle below 45° again: 1.79 % at 3° on what the user gets (docs/optimization.md).
+constexpr double kBeamCrispShareBound = 0.01;
 
 TEST(Overhang, SmoothMinAndMaxBoundTheExactOnes) {
   double da, db, dx[5];
@@ -329,43 +337,75 @@ Beam test_beam() {
 
 /// The overhang share of the result surface the user gets (pipeline::result_surface with the
 /// product's defaults: the threshold that keeps the volume fraction, hygiene, smoothing,
-/// remeshing), every triangle of it (Ω's faces and the pad's too: an exposed face of the pad
-/// that faces down needs supports as much as the design's own), built along +z from z = −5; a
-/// facet counts when it rises less than angle − tolerance from the plate.
+/// remeshing), every triangle a design could change (Ω's faces and the pad's too, split by kind:
+/// an exposed face of the pad that faces down needs supports as much as the design's own; the
+/// part's given faces, a non-design solid's on Ω's boundary, apart — none faces down on this
+/// beam), built along +z from
+/// z = −5; a facet counts when it rises less than angle − tolerance from the plate. `smooth`:
+/// the surface stage's settings (the crisp stage: no remeshing, no smoothing).
 OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, double angle,
-                               double tolerance) {
-  const result::TriSurface s =
-      pipeline::result_surface(b.mesh, density, -1, volume_fraction, result::SmoothParams{}, nullptr, b.anchors);
+                               double tolerance, const result::SmoothParams& smooth = {}) {
+  const result::TriSurface s = pipeline::result_surface(b.mesh, density, -1, volume_fraction, smooth, nullptr, b.anchors);
   OverhangMeasureParams m;
   m.angle = angle;
   m.plate = -5;
   m.tolerance = tolerance;
-  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m);
+  return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag, &s.lock);
 }
 
-TEST(Overhang, MeasureCountsTheDesignsOwnSurfaceOnly) {
-  // two triangles facing down: a flat one (an overhang) and one at 40° from the plate (an
-  // overhang at 45°, not with a tolerance of 6°); a flat one tagged as Ω's face is not counted
+TEST(Overhang, MeasureCountsEveryFaceAndSaysWhose) {
+  // three triangles facing down: a flat one of the design (an overhang), one of the design at
+  // 40° from the plate (an overhang at 45°, not with a tolerance of 6°), and a flat one of a
+  // non-design solid (a load pad's face the design leaves bare: it needs supports as much as the
+  // design's own, so it counts; the tags only say whose it is — without locks nothing is set
+  // apart as the part's given shape: MeasureSetsThePartsGivenFacesApart)
   MatX3d V(9, 3);
   const double t = std::tan(40 * M_PI / 180);
   V << 0, 0, 1, 0, 1, 1, 1, 0, 1,     // flat, facing down
       0, 0, 2, 0, 1, 2, 1, 0, 2 + t,  // rising 40° along x, facing down
-      0, 0, 3, 0, 1, 3, 1, 0, 3;      // flat, Ω's face
+      0, 0, 3, 0, 1, 3, 1, 0, 3;      // flat, the pad's face
   MatX3i F(3, 3);
   F << 0, 1, 2, 3, 4, 5, 6, 7, 8;
   VecXi tag(3);
-  tag << 0, 0, 4;
+  tag << 0, 0, -1;
   OverhangMeasureParams p;
   const OverhangShare all = overhang_share(V, F, Eigen::Vector3d::UnitZ(), p);
-  const OverhangShare own = overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag);
+  const OverhangShare split = overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag);
   const double a_flat = 0.5, a_40 = 0.5 / std::cos(40 * M_PI / 180);
   EXPECT_NEAR(all.downward_area, 2 * a_flat + a_40, 1e-12);
-  EXPECT_NEAR(own.downward_area, a_flat + a_40, 1e-12);
-  EXPECT_NEAR(own.share(), 1.0, 1e-12);
+  EXPECT_NEAR(all.share(), 1.0, 1e-12);
+  EXPECT_NEAR(split.share(), all.share(), 1e-15);
+  EXPECT_NEAR(split.design_overhang, a_flat + a_40, 1e-12);
+  EXPECT_NEAR(split.nondesign_overhang, a_flat, 1e-12);
+  EXPECT_EQ(split.omega_overhang, 0.0);
+  tag[2] = 4;  // Ω's Face4 instead
+  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).omega_overhang, a_flat, 1e-12);
   p.tolerance = 6;
-  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).share(), a_flat / (a_flat + a_40), 1e-12);
+  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).share(), 2 * a_flat / (2 * a_flat + a_40),
+              1e-12);
   p.plate = 1;  // the flat triangle at z = 1 rests on the plate now
-  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).downward_area, a_40, 1e-12);
+  EXPECT_NEAR(overhang_share(V, F, Eigen::Vector3d::UnitZ(), p, &tag).downward_area, a_flat + a_40, 1e-12);
+}
+
+TEST(Overhang, MeasureSetsThePartsGivenFacesApart) {
+  // a solid 12 × 4 × 3 mm box, a non-design block in its corner x < 2 standing on its bottom
+  // face, measured as if the plate lay 1 mm below the box: the whole bottom faces down off the
+  // plate. The design's part of it (Ω's face where the design reaches it, 10 × 4 mm²) counts;
+  // the block's bottom (2 × 4 mm², a non-design face on Ω's boundary: no design changes it) is
+  // set apart as the part's given shape, on the result surface the product makes
+  const TetMesh m = box_mesh({12, 4, 3}, {{{0, 0, 0, 2, 4, 3}}});
+  const VecXd full = VecXd::Ones(m.T.rows());
+  const result::TriSurface s = pipeline::result_surface(m, full, 0.5, -1, result::SmoothParams{});
+  OverhangMeasureParams p;
+  p.plate = -1;
+  const OverhangShare o = overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), p, &s.tag, &s.lock);
+  EXPECT_NEAR(o.given_overhang_area, 8, 1e-9);
+  EXPECT_NEAR(o.given_downward_area, 8, 1e-9);
+  EXPECT_NEAR(o.omega_overhang, 40, 1e-9);
+  EXPECT_NEAR(o.downward_area, 40, 1e-9);
+  EXPECT_EQ(o.design_overhang + o.nondesign_overhang, 0.0);
+  const OverhangShare untagged = overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), p);
+  EXPECT_NEAR(untagged.overhang_area, 48, 1e-9) << "without tags every triangle counts";
 }
 
 TEST(Overhang, BeamHasLessOverhangWithTheControl) {
@@ -383,11 +423,19 @@ TEST(Overhang, BeamHasLessOverhangWithTheControl) {
   const SimpResult printed = optimize(b.mesh, fem::Material{}, b.supports, b.loads, {}, p);
   const OverhangShare with = product_overhang(b, printed.density, 0.3, 45, kBeamTolerance);
   const OverhangShare without = product_overhang(b, free_run.density, 0.3, 45, kBeamTolerance);
+  result::SmoothParams crisp;  // the iso-surface the design's densities make, as marching tetrahedra cut it
+  crisp.iterations = 0;
+  crisp.remesh = false;
+  crisp.repair = false;
+  const OverhangShare crisp_with = product_overhang(b, printed.density, 0.3, 45, 0, crisp);
   std::cout << "overhang share with the control " << with.share() << " (" << with.overhang_area << " of "
-            << with.downward_area << " mm2), without " << without.share() << "; compliance "
+            << with.downward_area << " mm2: design " << with.design_overhang << ", pad " << with.nondesign_overhang
+            << ", part " << with.omega_overhang << "), its crisp iso-surface " << crisp_with.share()
+            << " (tolerance 0), without the control " << without.share() << "; compliance "
             << printed.history.back().compliance << " against " << free_run.history.back().compliance << ", beta "
             << printed.history.back().beta << ", grey " << printed.history.back().grey << ", " << printed.history.size()
             << " iterations\n";
+  EXPECT_LE(crisp_with.share(), kBeamCrispShareBound) << "the filter's own design, before the surface stage";
   EXPECT_EQ(printed.history.back().beta, 32) << "beta should reach its end";
   EXPECT_LE(with.share(), kBeamShareBound);
   EXPECT_LE(with.share(), 0.2 * without.share());
@@ -398,3 +446,4 @@ TEST(Overhang, BeamHasLessOverhangWithTheControl) {
 
 }  // namespace
 }  // namespace topopt::simp
+
