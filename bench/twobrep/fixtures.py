@@ -7,15 +7,15 @@ from OCCT primitives in memory); here FreeCAD's Part module (OCCT underneath) bu
 no code of topopt. Each fixture is <name>.step (the part Ω, one solid) and
 <name>_nondesign.step (the non-design solids Ω̄, a compound). Sizes in mm.
 
-usage: bench/twobrep/fixtures.py OUTDIR     (python3 with FreeCAD's library, or freecadcmd:
-       then the folder comes from TWOBREP_FIXTURES, default /tmp/twobrep_fixtures)
+usage: /usr/bin/python3 bench/twobrep/fixtures.py [OUTDIR]   (default /tmp/twobrep_fixtures; FreeCAD's
+       library is found in /usr/lib/freecad*/lib when python3 does not import it already)
 """
 import math
 import os
 import sys
 
 try:
-    import FreeCAD  # noqa: F401  (freecadcmd)
+    import FreeCAD  # noqa: F401
 except ImportError:
     sys.path += ["/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib"]
     import FreeCAD  # noqa: F401
@@ -114,5 +114,4 @@ def write_all(outdir):
 
 
 if __name__ == "__main__":
-    write_all(sys.argv[1] if len(sys.argv) > 1 and not sys.argv[1].endswith(".py")
-              else os.environ.get("TWOBREP_FIXTURES", "/tmp/twobrep_fixtures"))
+    write_all(sys.argv[1] if len(sys.argv) > 1 else "/tmp/twobrep_fixtures")
