@@ -18,6 +18,17 @@ pinned to one CPU (taskset -c 0; Gmsh runs with General.NumThreads 1), native th
 part in the same run, and keeps tets, mesh time, the largest volume error, the worst radius
 ratio and the native mesher's per-face size reasons (counts) in JSON (rows are kept, so a run
 can be resumed; --parts a,b re-runs only those). --shared-table JSON prints the ratio table.
+
+With --rows JSON, issue 20's done-when table: the examples with their non-design solids and the
+partial-contact fixtures (bench/twobrep/fixtures.py writes them as STEP) through the product's
+`topopt mesh` end to end, native and Gmsh alternated --repeat times per row, each run pinned to
+CPU --cpu (taskset) with one thread (OMP/OpenBLAS 1; the Gmsh route sets General.NumThreads 1),
+nice 15; the CPU time (user + sys) of the whole command, the least of the repeats, is the
+pipeline's time. --row-cases names the rows (example:size, size 0 = default, xF = F times the
+default; fx:<fixture>:size for a fixture; nist:N:size, occt:linkrods:size for the shared single
+solids, meshed without non-design solids); --rows-table JSON prints the table with a verdict per
+done-when item (no fallback, conformal, no degenerate tet, radius ratio >= 0.1, tets <= 1.5x
+Gmsh's, pipeline CPU <= Gmsh's).
 """
 import argparse, json, os, platform, subprocess, sys, tempfile
 
@@ -25,6 +36,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 DATA = os.path.join(ROOT, "..", "shared", "data", "examples")
 DEFAULT_CASES = "rocker:0,rocker:1.4,rocker:1,cantilever:0,cantilever:0.8,bracket:0,bracket:2"
+ROW_CASES = ("rocker:0,rocker:1.4,cantilever:0,cantilever:0.8,bracket:0,bracket:2,mount:0,mount:x0.5,"
+             "fx:bosses_one_side:0,fx:lug_cut_by_outer_face:0,fx:boss_on_cylinder_wall:0,"
+             "fx:pad_spanning_two_faces:0,fx:pads_touching_unequal:0,fx:boss_on_bspline_wall:0")
 
 
 def run(topopt, name, size, mesher, repeat):
@@ -200,6 +214,131 @@ def shared_table(path):
             a["rr_min"], b["rr_min"], "yes" if a.get("conformity") else "NO", why))
 
 
+def row_case(case, fixtures_dir):
+    """(row name, size label, part file, non-design file or None, size spec) of one --row-cases
+    item: example:size, fx:fixture:size, or nist:N:size / occt:linkrods:size (single solids)."""
+    bits = case.split(":")
+    if bits[0] in ("nist", "occt"):
+        name, size, nd = ("NIST " if bits[0] == "nist" else "") + bits[1], bits[2], None
+        base = "NIST_MBE_PMI_%s.stp" % bits[1] if bits[0] == "nist" else bits[1] + ".step"
+        part = os.path.normpath(os.path.join(DATA, "..", bits[0], base))
+    else:
+        folder, name, size = (fixtures_dir, bits[1], bits[2]) if bits[0] == "fx" else (DATA, bits[0], bits[1])
+        part, nd = os.path.join(folder, name + ".step"), os.path.join(folder, name + "_nondesign.step")
+    label = "default" if size in ("0", "x1") else (size.replace("x", "") + "x default" if size.startswith("x")
+                                                   else size + " mm")
+    return name, label, part, nd, size
+
+
+def pipeline_run(topopt, part, nd, size, mesher, cpu, tmp, in_process=False):
+    """`topopt mesh` end to end (read, classify, mesh, check, write) of one row by one mesher on
+    CPU `cpu`, one thread, nice 15: the stats' figures, the CPU time (user + sys) of the command,
+    its warnings; or its error (with the CPU used until then). in_process: TOPOPT_NO_ISOLATION=1,
+    the readers and Gmsh in topopt's own process, without the wall-time budget of the isolated
+    child (on a loaded machine the product's Gmsh stops at it)."""
+    stats = os.path.join(tmp, "s.json")
+    if os.path.exists(stats):
+        os.remove(stats)
+    cmd = ["nice", "-n", "15", "taskset", "-c", str(cpu), topopt, "mesh", "--mesher", mesher, "--part", part,
+           "--out", os.path.join(tmp, "m.msh"), "--stats", stats] + (["--non-design", nd] if nd else [])
+    if size > 0:
+        cmd += ["--size", repr(size)]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    if in_process:
+        env["TOPOPT_NO_ISOLATION"] = "1"
+    with tempfile.TemporaryFile("w+") as log:
+        p = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, text=True, env=env)
+        _, status, usage = os.wait4(p.pid, 0)
+        log.seek(0)
+        out = log.read()
+    cpu_s = round(usage.ru_utime + usage.ru_stime, 2)
+    warnings = [l[len("warning: "):] for l in out.splitlines() if l.startswith("warning: ")]
+    if os.waitstatus_to_exitcode(status) != 0 or not os.path.exists(stats):
+        return {"error": (out.strip().splitlines() or ["failed"])[-1][-300:], "cpu_seconds": cpu_s}
+    s = json.load(open(stats))
+    q, c = s["quality"], s["conformity"]
+    return {"tets": s["tets"], "mesh_seconds": round(s["seconds"]["mesh"], 2), "cpu_seconds": cpu_s,
+            "rr_min": q["radius_ratio"]["min"], "rr_mean": q["radius_ratio"]["mean"],
+            "share_below_01": q["radius_ratio"]["share_below_0.1"], "dihedral_min": q["dihedral_deg"]["min"],
+            "volume_error": c["max_volume_error"], "conformal": c["ok"],
+            "degenerate": c["flat_tets"] + c["inverted_tets"], "mesher": s.get("mesher", mesher),
+            "native_failed": s.get("native_failed"), "warnings": warnings}
+
+
+def rows(args):
+    """Issue 20's done-when rows (see the module's doc): native and Gmsh alternated per row."""
+    sys.path.insert(0, HERE)
+    import fixtures
+    if not all(os.path.exists(os.path.join(args.fixtures, n + ".step")) for n in fixtures.NAMES):
+        fixtures.write_all(args.fixtures)
+    table = json.load(open(args.rows)) if os.path.exists(args.rows) else {}
+    topopt = os.path.join(args.build, "topopt")
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in args.row_cases.split(","):
+            name, label, part, nd, spec = row_case(case, args.fixtures)
+            key = name + " @ " + label
+            if key in table and not args.again:
+                continue
+            size = float(spec) if not spec.startswith("x") else float(spec[1:]) * part_size(topopt, part)
+            runs = {"native": [], "gmsh": []}
+            for _ in range(args.repeat):
+                for m in ("native", "gmsh"):
+                    runs[m].append(pipeline_run(topopt, part, nd, size, m, args.cpu, tmp, args.in_process))
+            best = {}
+            for m, rs in runs.items():
+                ok = [r for r in rs if "error" not in r]
+                best[m] = min(ok, key=lambda r: r["cpu_seconds"]) if ok else rs[-1]
+                best[m]["cpu_all"] = [r.get("cpu_seconds") for r in rs]
+            table[key] = dict(best, size=round(size, 4), load=os.getloadavg()[0], in_process=args.in_process)
+            print(key, json.dumps(table[key]), file=sys.stderr, flush=True)
+            json.dump(table, open(args.rows, "w"), indent=1)
+
+
+def verdicts(a, b):
+    """The done-when items of one row, native `a` against Gmsh `b`: {item: True/False/None}."""
+    ok = "error" not in a
+    both = ok and "error" not in b
+    return {"native, no fallback": ok and a["mesher"] == "native",
+            "conformal": ok and bool(a["conformal"]),
+            "no degenerate tet": ok and a["degenerate"] == 0,
+            "radius ratio >= 0.1": ok and a["rr_min"] >= 0.1,
+            "tets <= 1.5x Gmsh": (a["tets"] <= 1.5 * b["tets"]) if both else None,
+            "CPU <= Gmsh": (a["cpu_seconds"] <= b["cpu_seconds"]) if both else
+            (True if ok and b.get("cpu_seconds", 0) >= a["cpu_seconds"] else None)}
+
+
+def rows_table(path):
+    """The done-when table of a --rows JSON: the figures, then yes / NO per done-when item."""
+    items = list(verdicts({"error": ""}, {"error": ""}))
+    print("| part | size | tets native / Gmsh | ratio | mesh stage native / Gmsh (s) | pipeline CPU native / Gmsh (s)"
+          " | ratio | radius ratio min native / Gmsh | share < 0.1 (native) | min dihedral (native) |"
+          " volume error native / Gmsh | " + " | ".join(items) + " |")
+    print("|---" * (11 + len(items)) + "|")
+    mark = {True: "yes", False: "**NO**", None: "–"}
+    for key, r in json.load(open(path)).items():
+        name, label = key.split(" @ ")
+        a, b = r["native"], r["gmsh"]
+        v = " | ".join(mark[x] for x in verdicts(a, b).values())
+        if "error" in a:
+            print("| %s | %s | native: %s / Gmsh: %s | | | | | | | | | %s |" % (
+                name, label, a["error"][-200:], b.get("error", "ok")[-200:], v))
+            continue
+        if "error" in b:  # Gmsh stopped: the native figures, and the CPU Gmsh had used by then
+            print("| %s | %s | %d / – | | %.2f / – | %.2f / > %.2f (Gmsh: %s) | < %.2f | %.3f / – | %.4f %% | %.1f° |"
+                  " %.3f %% / – | %s |" % (
+                      name, label, a["tets"], a["mesh_seconds"], a["cpu_seconds"], b.get("cpu_seconds", 0),
+                      b["error"][-120:], a["cpu_seconds"] / max(b.get("cpu_seconds", 0), 1e-9), a["rr_min"],
+                      100 * a["share_below_01"], a["dihedral_min"], 100 * a["volume_error"], v))
+            continue
+        name += " (in process)" if r.get("in_process") else ""
+        print("| %s | %s | %d / %d | %.2f | %.2f / %.2f | %.2f / %.2f | %.2f | %.3f / %.3f | %.4f %% | %.1f° |"
+              " %.3f %% / %.3f %% | %s |" % (
+                  name, label, a["tets"], b["tets"], a["tets"] / b["tets"], a["mesh_seconds"], b["mesh_seconds"],
+                  a["cpu_seconds"], b["cpu_seconds"], a["cpu_seconds"] / max(b["cpu_seconds"], 1e-9), a["rr_min"],
+                  b["rr_min"], 100 * a["share_below_01"], a["dihedral_min"], 100 * a["volume_error"],
+                  100 * b["volume_error"], v))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -210,7 +349,18 @@ def main():
     ap.add_argument("--gmsh-limit", type=int, default=900, help="with --shared: seconds for python3-gmsh")
     ap.add_argument("--limit", type=int, default=None, help="with --shared: wall seconds per topopt mesh")
     ap.add_argument("--shared-table", help="print the ratio table of a --shared JSON")
+    ap.add_argument("--rows", help="JSON: issue 20's done-when rows, both meshers end to end (see above)")
+    ap.add_argument("--row-cases", default=ROW_CASES, help="with --rows: example:size,..., fx:fixture:size, nist:N:size")
+    ap.add_argument("--fixtures", default="/tmp/twobrep_fixtures", help="with --rows: the fixtures' STEP folder")
+    ap.add_argument("--cpu", type=int, default=1, help="with --rows: the CPU each run is pinned to")
+    ap.add_argument("--again", action="store_true", help="with --rows: re-run rows already in the JSON")
+    ap.add_argument("--in-process", action="store_true", help="with --rows: TOPOPT_NO_ISOLATION=1 (no wall budget)")
+    ap.add_argument("--rows-table", help="print the done-when table of a --rows JSON")
     args = ap.parse_args()
+    if args.rows:
+        return rows(args)
+    if args.rows_table:
+        return rows_table(args.rows_table)
     if args.shared:
         return shared(args)
     if args.shared_table:

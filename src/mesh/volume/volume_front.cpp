@@ -61,6 +61,14 @@ void front_grid(const std::vector<Vec3>& P, const MatX3i& F, double& cell, Vec3&
   cell = std::max(std::min(min_edge, mean_edge), 1e-9 * (hi - lo).norm());
 }
 
+/// The front could not finish a fill that started from a Delaunay bulk (its holes did not
+/// close, or the front ran past its tet budget around them): fill_volume retries the region
+/// by the front alone. Any other failure (a fill by the front alone, nothing to fill) is final.
+class BulkFillFailed : public Error {
+ public:
+  explicit BulkFillFailed(const std::string& message) : Error(ErrorCode::MeshingFailed, message) {}
+};
+
 /// The fill of one region: its boundary F (outward) around the existing tets T0, optionally
 /// a Delaunay bulk first, then the front's rounds. run() returns the new tets; P gains the
 /// new nodes.
@@ -72,14 +80,29 @@ class FrontFill {
 
   /// Seeds the front, then rounds: advance (with widening passes), close what is left as
   /// cavities from single points, and if a stuck region remains, reopen the new tets around
-  /// it and advance again. Throws Error(MeshingFailed) when the front does not close.
+  /// it and advance again. Throws Error(MeshingFailed) when the front does not close,
+  /// BulkFillFailed when it started from a Delaunay bulk.
   std::vector<Tet> run() {
+    try {
+      return fill();
+    } catch (const BulkFillFailed&) {
+      throw;
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::MeshingFailed || bulk_tets_ == 0) throw;
+      throw BulkFillFailed(e.what());
+    }
+  }
+
+ private:
+  using Item = std::pair<double, int>;  ///< (face size, face)
+
+  std::vector<Tet> fill() {
     seed();
     requeue();
     for (int round = 0; round < 10 && front_.size() > 0; ++round) {
       if (round > 0 && bulk_tets_ > 0)  // the bulk's holes did not close: fill_volume goes without it
-        throw Error(ErrorCode::MeshingFailed, "the front could not close the holes of the Delaunay bulk (" +
-                                                  std::to_string(front_.size()) + " front faces left)");
+        throw BulkFillFailed("the front could not close the holes of the Delaunay bulk (" +
+                             std::to_string(front_.size()) + " front faces left)");
       if (round > 0) reopen_stuck_region(round);
       advance(round);
       if (front_.size() > 0 && front_.size() < kSmallFront) close_cavities(front_, P_, tets_, progress_);
@@ -88,9 +111,6 @@ class FrontFill {
     tets_.erase(std::remove_if(tets_.begin(), tets_.end(), [](const Tet& t) { return t[0] < 0; }), tets_.end());
     return std::move(tets_);
   }
-
- private:
-  using Item = std::pair<double, int>;  ///< (face size, face)
 
   /// The tets of the Delaunay bulk, where its tetrahedralisation holds the boundary, and the
   /// initial front: the boundary triangles no tet covers, reversed (normals into the region),
@@ -417,19 +437,34 @@ VolumeFillResult compact(long inputs, const std::vector<Vec3>& P, const std::vec
   return out;
 }
 
-/// The fill's steps within the budget of `timed` (within_cpu_budget): the front (retried
-/// without the bulk when that fails), the improvement, the flat-tet removal. Returns the tets.
+/// The warning of the retry by the front alone: why, and the budget it runs within (the
+/// fill's own, `seconds` of CPU of which `used` are gone, and `budget` tets; <= 0: none).
+std::string front_alone_warning(const std::string& why, double seconds, double used, long budget) {
+  std::ostringstream s;
+  s << "volume: the front could not finish the Delaunay bulk's fill (" << why
+    << "); the region is filled again by the front alone, which is slower, within what is left of the fill's budget (";
+  if (seconds > 0)
+    s << static_cast<long>(std::ceil(std::max(0.0, seconds - used))) << " of " << static_cast<long>(std::ceil(seconds))
+      << " s of computing";
+  else
+    s << "no time limit";
+  s << ", " << (budget > 0 ? "at most " + std::to_string(budget) + " tets" : std::string("no tet budget")) << ")";
+  return s.str();
+}
+
+/// The fill's steps within the budget of `timed` (within_cpu_budget, `seconds` of CPU from
+/// now): the front (retried by the front alone, with a warning, when the front could not
+/// finish the Delaunay bulk's fill), the improvement, the flat-tet removal. Returns the tets.
 std::vector<Tet> fill_and_improve(std::vector<Vec3>& P, const MatX3d& V, const MatX3i& F, const MatX4i& T0,
-                                  VolumeFillParams& params, long budget, const Progress& progress) {
+                                  VolumeFillParams& params, long budget, double seconds, const Progress& progress) {
+  const double cpu0 = thread_cpu_seconds();
   std::vector<Tet> tets;
   try {
     tets = fill_tets(P, F, T0, params, budget, progress);
-  } catch (const Error& e) {
-    if (!params.delaunay_bulk || e.code() != ErrorCode::MeshingFailed) throw;
+  } catch (const BulkFillFailed& e) {
     // the bulk's holes left the front a region it could not close: the front alone, from
-    // the boundary, is the method this engine was built on
-    progress.info(std::string("volume: the front could not close the Delaunay bulk's holes (") + e.what() +
-                  "); filling by the front alone");
+    // the boundary, is the method this engine was built on; the same budgets bound it
+    progress.warn(front_alone_warning(e.what(), seconds, thread_cpu_seconds() - cpu0, budget));
     params.delaunay_bulk = false;
     P.resize(V.rows());
     tets = fill_tets(P, F, T0, params, budget, progress);
@@ -469,7 +504,7 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
   auto expired = std::make_shared<bool>(false);
   const Progress timed = within_cpu_budget(progress, seconds, expired);
   try {
-    const std::vector<Tet> tets = fill_and_improve(P, V, F, T0, params, budget, timed);
+    const std::vector<Tet> tets = fill_and_improve(P, V, F, T0, params, budget, seconds, timed);
     return compact(V.rows(), P, tets);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::Cancelled || !*expired) throw;
@@ -479,6 +514,9 @@ VolumeFillResult fill_volume(const MatX3d& V, const MatX3i& F, const MatX4i& T0,
     s << "the volume mesh did not finish within its budget of " << static_cast<long>(std::ceil(seconds))
       << " s of computing (for about " << static_cast<long>(expected) << " tets); it was stopped while "
       << (at == std::string::npos ? what : what.substr(at + 7))
+      << (given.delaunay_bulk && !params.delaunay_bulk
+              ? " (by the front alone, after the front could not finish the Delaunay bulk's fill)"
+              : "")
       << "; a coarser or smoother surface mesh, or a larger size, may help";
     throw Error(ErrorCode::Timeout, s.str());
   }

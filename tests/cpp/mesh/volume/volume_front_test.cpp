@@ -169,6 +169,23 @@ TEST_P(VolumeFill, KeepsTetsAlreadyThereUnchanged) {
   check_fill(VV, F, T0, r, 64.0);
 }
 
+/// The retry by the front alone is for a fill that started from a Delaunay bulk and could
+/// not finish; a fill that fails otherwise (here: nothing to fill) fails once, by name,
+/// without a retry that would do the same work again or a warning about a bulk it never had.
+TEST(VolumeFill, AFailureWithoutABulkIsNotRetriedByTheFrontAlone) {
+  std::string log;
+  Progress pr;
+  pr.log = [&log](LogLevel, const std::string& m) { log += m + "\n"; };
+  try {
+    fill_volume(MatX3d(0, 3), MatX3i(0, 3), MatX4i(), VolumeFillParams(), pr);
+    FAIL() << "an empty boundary was filled";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::MeshingFailed);
+    EXPECT_NE(std::string(e.what()).find("nothing to fill"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(log.find("front alone"), std::string::npos) << log;
+}
+
 TEST(VolumeFill, RockerAtOneMillimetreMeetsIssueFoursQualityBounds) {
   // issue 4's case: the rocker's surface at 1 mm filled at 1 mm (about 140 000 tets): radius
   // ratio min >= 0.2 and mean >= 0.78, smallest dihedral >= 12 deg (bench/volume times it).
