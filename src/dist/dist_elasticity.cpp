@@ -162,8 +162,8 @@ void DistElasticity::Impl::create_solver() {
     // Chebyshev smoothing aims at 1.3 × the estimated largest eigenvalue, not PETSc's 1.1: under
     // SIMP's stiffness contrast the estimate falls short often enough that the V-cycle stopped
     // being positive definite (CG: "indefinite preconditioner") by SIMP iteration 5 on a 100 k-tet
-    // cantilever with 3 of 5 option sets tried (a looser filter tolerance, a GAMG threshold, more
-    // smoothing steps); at 1.3 all 5 ran, for 8 % more CG iterations with PETSc's other defaults
+    // cantilever with 3 of 6 option sets tried (a looser filter tolerance, a GAMG threshold, more
+    // smoothing steps); at 1.3 those 3 and the defaults ran, the defaults with 8 % more CG iterations
     // (BENCHMARKS.md, "The distributed solve's smoother").
     option_unless_given("-mg_levels_ksp_chebyshev_esteig", "0,0.1,0,1.3");
   }
