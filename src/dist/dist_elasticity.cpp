@@ -161,8 +161,10 @@ void DistElasticity::Impl::create_solver() {
     check_petsc(PCSetType(pc, PCGAMG), "PCSetType");
     // Chebyshev smoothing aims at 1.3 × the estimated largest eigenvalue, not PETSc's 1.1: under
     // SIMP's stiffness contrast the estimate falls short often enough that the V-cycle stopped
-    // being positive definite (CG: "indefinite preconditioner") on 3 of 7 option sets tried on a
-    // 100 k-tet cantilever by iteration 5; at 1.3 all 7 ran (BENCHMARKS.md, distributed path).
+    // being positive definite (CG: "indefinite preconditioner") by SIMP iteration 5 on a 100 k-tet
+    // cantilever with 3 of 6 option sets tried (a looser filter tolerance, a GAMG threshold, more
+    // smoothing steps); at 1.3 those 3 and the defaults ran, the defaults with 8 % more CG iterations
+    // (BENCHMARKS.md, "The distributed solve's smoother").
     option_unless_given("-mg_levels_ksp_chebyshev_esteig", "0,0.1,0,1.3");
   }
   check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
