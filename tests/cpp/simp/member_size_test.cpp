@@ -234,6 +234,7 @@ TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
   EXPECT_LT(run({16, 8, 8}, 4, fits, fits_connects), 10);
   EXPECT_TRUE(fits_connects);
   EXPECT_EQ(fits.find("came apart"), std::string::npos) << fits;
+  EXPECT_EQ(fits.find("does not join"), std::string::npos) << fits;
 }
 
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
