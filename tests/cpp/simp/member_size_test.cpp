@@ -124,6 +124,39 @@ Sizes measure_sizes(const Cantilever& b, const VecXd& crisp, double size, double
   return s;
 }
 
+/// Whether the eroded design of a robust run (its variables, at its last β) joins the supported
+/// face to the load pad: its tets with eroded density ≥ ½ and the non-design tets, joined when they
+/// share a node (the hygiene's rule for the crisp tets' pieces), hold one piece that touches both.
+/// Across shared faces alone it does not on the test beam: at the pad the eroded design is a string
+/// one or two tets wide whose last tets (ρ̄ 0.59–0.71) meet the pad's row along edges.
+bool eroded_design_connects(const Cantilever& b, const SimpParams& p, const SimpResult& run) {
+  ComplianceProblem prob(b.mesh, b.mat, b.supports, b.loads, {}, p);
+  prob.set_beta(run.history.back().beta);
+  prob.compliance(run.variables);
+  const long nt = b.mesh.T.rows();
+  std::vector<char> solid(static_cast<size_t>(nt), 0);
+  for (long t = 0; t < nt; ++t) solid[t] = b.mesh.domain[t] != 0;
+  for (size_t i = 0; i < prob.design().size(); ++i) solid[prob.design()[i]] = prob.physical_densities()[i] >= 0.5;
+  std::vector<long> parent(static_cast<size_t>(nt)), at_node(static_cast<size_t>(b.mesh.V.rows()), -1);
+  std::iota(parent.begin(), parent.end(), 0L);
+  std::function<long(long)> root = [&](long t) { return parent[t] == t ? t : parent[t] = root(parent[t]); };
+  for (long t = 0; t < nt; ++t)
+    for (int a = 0; a < 4 && solid[t]; ++a) {
+      long& first = at_node[b.mesh.T(t, a)];
+      if (first < 0) first = t;
+      parent[root(t)] = root(first);
+    }
+  std::vector<char> supported(static_cast<size_t>(b.mesh.V.rows()), 0);
+  for (int dof : b.supports.dofs) supported[dof / 3] = 1;
+  long pad = -1;
+  for (long t = 0; t < nt && pad < 0; ++t)
+    if (b.mesh.domain[t] != 0) pad = root(t);
+  for (long t = 0; t < nt; ++t)
+    for (int a = 0; a < 4; ++a)
+      if (solid[t] && supported[b.mesh.T(t, a)] && root(t) == pad) return true;
+  return false;
+}
+
 TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
   // 24 × 8 × 8 cells of 1.25 mm, volume 0.4; min_member_size 4 mm (filter radius 5.45 mm, the
   // part's free faces padded: the default) with β run to its end (32), against the free design
@@ -143,6 +176,10 @@ TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
   EXPECT_LE(robust.history.back().grey, 0.10);
   // the eroded design still carries the load (it came apart unpadded at this volume, and padded at 0.2)
   EXPECT_LT(robust.history.back().compliance, 1e3 * robust.history.front().compliance);
+  // ... through one piece from the supported face to the load pad: the robust formulation's
+  // weakest design is a structure, not a field carried by E_min (docs/optimization.md: on the
+  // bench's cantilever at 6 mm it is not)
+  EXPECT_TRUE(eroded_design_connects(b, p, robust));
   // with the reach of a cell, what the measure needs to read a square bar's corners on a tet
   // staircase (MeasureFindsKnownThicknessesInTheMiddleAndAlongThePartsFace): the set size to
   // within two cells everywhere, and to within one cell on all but 1 % of the solid tets
@@ -172,7 +209,7 @@ TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
   // volume 0.9, min size 8 mm padded on the 10 × 10 mm section (8 × 4 × 4 cells of 2.5 mm): the
   // radius (10.9 mm) is wider than the section, no member survives erosion and the run says what
   // to change; 4 mm on 1.25 mm cells (16 × 8 × 8) fits and is not named
-  auto run = [](std::array<int, 3> cells, double size, std::string& warnings) {
+  auto run = [](std::array<int, 3> cells, double size, std::string& warnings, bool& connects) {
     Cantilever b(cells);
     SimpParams p;
     p.volume_fraction = 0.9;
@@ -185,14 +222,19 @@ TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
     const SimpResult r = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p, progress);
     std::cout << size << " mm: compliance " << r.history.front().compliance << " -> " << r.history.back().compliance
               << "\n";
+    connects = eroded_design_connects(b, p, r);
     return r.history.back().compliance / r.history.front().compliance;
   };
   std::string apart, fits;
-  EXPECT_GT(run({8, 4, 4}, 8, apart), 1e3);
+  bool apart_connects = true, fits_connects = false;
+  EXPECT_GT(run({8, 4, 4}, 8, apart, apart_connects), 1e3);
+  EXPECT_FALSE(apart_connects) << "the eroded design that came apart should not join the support to the pad";
   EXPECT_NE(apart.find("controls.min_member_size 8 mm: the eroded design came apart"), std::string::npos) << apart;
   EXPECT_NE(apart.find("raise the volume fraction or lower the size"), std::string::npos) << apart;
-  EXPECT_LT(run({16, 8, 8}, 4, fits), 10);
+  EXPECT_LT(run({16, 8, 8}, 4, fits, fits_connects), 10);
+  EXPECT_TRUE(fits_connects);
   EXPECT_EQ(fits.find("came apart"), std::string::npos) << fits;
+  EXPECT_EQ(fits.find("does not join"), std::string::npos) << fits;
 }
 
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
