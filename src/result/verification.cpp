@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <set>
 #include <sstream>
 
 #include <unordered_map>
@@ -216,6 +217,24 @@ std::vector<double> drop_unheld_pieces(TetMesh& m, const VecXi& tag, const Verif
   return dropped;
 }
 
+/// `problem` with each support cut to the faces (Ω's and non-design) that `m` still has: the
+/// pieces drop_unheld_pieces left out take the faces only they held with them (a bolt boss
+/// that carries no load); a support left with no face is dropped.
+VerificationProblem on_kept_faces(const TetMesh& m, const VerificationProblem& problem) {
+  std::set<int> faces, nd_faces;
+  for (long q = 0; q < m.face.size(); ++q) faces.insert(m.face[q]);
+  for (long q = 0; q < m.nd_face.size(); ++q) nd_faces.insert(m.nd_face[q]);
+  VerificationProblem kept = problem;
+  kept.supports.clear();
+  for (fem::SupportSpec sp : problem.supports) {
+    const auto gone = [](const std::set<int>& have) { return [&have](int f) { return have.count(f) == 0; }; };
+    sp.faces.erase(std::remove_if(sp.faces.begin(), sp.faces.end(), gone(faces)), sp.faces.end());
+    sp.nd_faces.erase(std::remove_if(sp.nd_faces.begin(), sp.nd_faces.end(), gone(nd_faces)), sp.nd_faces.end());
+    if (!sp.faces.empty() || !sp.nd_faces.empty()) kept.supports.push_back(sp);
+  }
+  return kept;
+}
+
 }  // namespace
 
 TetMesh verification_mesh(const TriSurface& s, const TetMesh& fe, const mesh::VolumeFillParams& fill, double seconds,
@@ -320,7 +339,8 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   // as-built one on a top-loaded box)
   const TetMesh loaded = fem::kept_part(fe, kept);
   try {
-    v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
+    const VerificationProblem held = v.unheld_volumes.empty() ? problem : on_kept_faces(v.mesh, problem);
+    v.as_built = analyse(v.mesh, v.mesh, held, VecXd(), params.solver, timed, &v.U, &v.von_mises);
     v.as_built.seconds += seconds_mesh;
     v.as_built.cpu_seconds += cpu_mesh;
     v.crisp = analyse(fe, loaded, problem, scale, params.solver, timed);
