@@ -99,7 +99,7 @@ TEST(StepExamples, TheLeverIsOnePieceAndReadsBackAsOneSolid) {
   // hygiene's crisp tets did not see). The user's first result is also converged (it stopped
   // at its 60-iteration cap) and verified: the result solid's compliance within 10 % of the
   // crisp design's (it was 782 against 937 N·mm, 0.83, on a 3 mm mesh whose members were one
-  // tet thick for the 4 mm filter)
+  // tet thick for the 4 mm filter; the job's filter is now 6 mm)
   setenv("OMP_NUM_THREADS", "1", 1);
   const pipeline::Job job = pipeline::read_job(std::string(TOPOPT_EXAMPLES) + "/lever.topopt.json");
   const pipeline::RunResult run = pipeline::run_job(job);
