@@ -147,7 +147,8 @@ def ccx_compliance(deck, points, tets, keep, workdir, name):
             if usedset[n - 1]:
                 f.write("%d, %d, %.12g\n" % (n, dof, v))
         f.write("*NODE PRINT, NSET=NALL\nU\n*END STEP\n")
-    env = dict(os.environ, OMP_NUM_THREADS="2", CCX_NPROC_EQUATION_SOLVER="2")
+    threads = os.environ.get("OMP_NUM_THREADS", "2")  # run.py --threads 1 sets 1
+    env = dict(os.environ, OMP_NUM_THREADS=threads, CCX_NPROC_EQUATION_SOLVER=threads)
     p = subprocess.run(["ccx", "-i", name], cwd=workdir, capture_output=True, text=True, env=env)
     dat = os.path.join(workdir, name + ".dat")
     if p.returncode or not os.path.exists(dat):

@@ -61,9 +61,42 @@ SETTINGS = {"before": {"heaviside": False}, "after": {}}
 SURFACE_SETTINGS = {"surface before": {"surface_remesh": False, "surface_repair": False}, "surface after": {}}
 
 
+THREADS = [2]  # OpenMP/OpenBLAS threads of every command (--threads; the first tables used 2)
+PIN = []  # ["taskset", "-c", CPU] with --cpu
+
+
 def run(cmd):
-    """Runs a topopt command with 2 threads; returns (wall s, CPU s of the child, stdout)."""
-    return benchlib.run_threads(cmd, 2)
+    """Runs a topopt command with THREADS threads (pinned with --cpu); returns (wall s, CPU s of
+    the child, stdout)."""
+    return benchlib.run_threads(PIN + cmd, THREADS[0])
+
+
+def stl_shells(path):
+    """Closed shells of the STL at path (triangles joined by shared corner points): (solid
+    pieces, enclosed voids) = shells enclosing a positive / negative volume, and their volumes
+    (mm³) in the same order, largest first."""
+    import numpy as np
+    tris = benchlib.read_stl(path)
+    points, index = np.unique(tris.reshape(-1, 3), axis=0, return_inverse=True)
+    corners = index.reshape(-1, 3)
+    parent = list(range(len(points)))
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+    for a, b, c in corners:
+        ra, rb, rc = find(a), find(b), find(c)
+        parent[rb] = ra
+        parent[find(rc)] = ra
+    volume = {}
+    for k, (a, b, c) in enumerate(tris):
+        r = find(corners[k][0])
+        volume[r] = volume.get(r, 0.0) + float(np.dot(a, np.cross(b, c))) / 6
+    solids = sorted((v for v in volume.values() if v > 0), reverse=True)
+    voids = sorted((v for v in volume.values() if v < 0))
+    return solids, voids
 
 
 def optimize(build, work, name, setting, options, size=None):
@@ -85,7 +118,8 @@ def surface_row(h):
     """The result surface's figures from history.json."""
     s = h.get("surface", {})
     return {"triangles": s.get("triangles"), "min_angle_free": s.get("min_angle_free"),
-            "min_angle_faces": s.get("min_angle_faces"), "self_intersections": s.get("self_intersections"),
+            "min_angle_faces": s.get("min_angle_faces"), "min_angle_nondesign": s.get("min_angle_nondesign"),
+            "self_intersections": s.get("self_intersections"),
             "crossings_smoothed": s.get("self_intersections_after_smoothing"), "surface_s": h["seconds"]["surface"],
             "volume": s.get("volume")}
 
@@ -118,7 +152,8 @@ def one(build, work, name, setting):
     keep = crisp.crisp_tets(points, tets, domain, density, h["threshold"])
     c, per_case, solved = crisp_compliance(build, path, out, points, tets, keep, name)
     cad = cad_columns(out)
-    return {**cad, "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
+    solids, voids = stl_shells(os.path.join(out, "result.stl"))
+    return {**cad, "stl_solids": solids, "stl_voids": voids, "warnings": h.get("design", {}).get("warnings", []), "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
             "wall_s": wall, "cpu_s": cpu, "grey": crisp.grey_share(density, domain, vol),
             "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_cases": per_case, "crisp_tets": solved,
             "kept_tets": int(keep.sum()), **surface_row(h)}
@@ -195,10 +230,15 @@ def main():
     ap.add_argument("--only", default=",".join(EXAMPLES))
     ap.add_argument("--settings", default=",".join(SETTINGS),
                     help="which of %s to run (default: both; 'after' alone is today's defaults)" % ", ".join(SETTINGS))
+    ap.add_argument("--threads", type=int, default=2, help="OpenMP/OpenBLAS threads per command (default 2)")
+    ap.add_argument("--cpu", default=None, help="pin every command to this CPU (taskset -c)")
     ap.add_argument("--surface", action="store_true", help="only the surface table (before/after issue 19 B)")
     ap.add_argument("--size", type=float, default=None, help="mesh size for --surface (default: each example's)")
     ap.add_argument("--max-iterations", type=int, default=None, help="SIMP's cap for --surface (default: the job default)")
     a = ap.parse_args()
+    THREADS[0] = a.threads
+    os.environ["OMP_NUM_THREADS"] = str(a.threads)  # CalculiX too (crisp.py)
+    PIN[:] = ["taskset", "-c", a.cpu] if a.cpu else []
     os.makedirs(a.work, exist_ok=True)
     if a.surface:
         rows = surface_table(a.build, a.work, a.only.split(","), a.size, a.max_iterations)
@@ -223,6 +263,27 @@ def main():
                  r["simp_s"], r["cpu_s"], ratio, r["triangles"], r["min_angle_free"], r["self_intersections"],
                  r["surface_s"]))
     cad_table(rows)
+    summary_table(rows)
+
+
+def summary_table(rows):
+    """One row per run with issue 19's done-when figures side by side (BESO's cantilever: 322.45
+    N·mm; the STL's shells counted by this script, independently of the product's report)."""
+    print("\n## Result: the done-when figures (bench/result/run.py)\n")
+    print("| example | setting | crisp, CalculiX (N·mm) | as built (N·mm) | as built / crisp (ours) | grey | "
+          "smallest angle free / Ω faces / non-design (°) | self-intersections | STL solids (mm³) | STL voids | "
+          "STEP MB, s, solids, valid | STEP / STL volume | optimize wall / CPU (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for (name, setting), r in rows.items():
+        ratio = r["as_built"] / r["crisp_ours"] if r["as_built"] is not None and r["crisp_ours"] else float("nan")
+        vol = r["step_volume"] / r["volume"] if r.get("step_volume") and r.get("volume") else float("nan")
+        step = ("%.2f, %.1f, %s, %s" % (r["step_mb"], r["step_s"], r["step_solids"], r["step_valid"])
+                if r["step_mb"] is not None else "failed")
+        print("| %s | %s | %.2f | %s | %.3f | %.1f %% | %.2f / %.2f / %.2f | %d | %d: %s | %d | %s | %.5f | %.0f / %.1f |"
+              % (name, setting, r["crisp"], "%.2f" % r["as_built"] if r["as_built"] is not None else "failed", ratio,
+                 100 * r["grey"], r["min_angle_free"], r["min_angle_faces"], r["min_angle_nondesign"],
+                 r["self_intersections"], len(r["stl_solids"]), " + ".join("%.1f" % v for v in r["stl_solids"]),
+                 len(r["stl_voids"]), step, vol, r["wall_s"], r["cpu_s"]))
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <set>
 #include <sstream>
 
 #include <unordered_map>
@@ -165,48 +166,73 @@ void check_faces_kept(const TetMesh& m, const VerificationProblem& problem) {
                                                  std::to_string(f) + ": the result solid has none of that face" + fix);
 }
 
-/// Keeps in `m` only the pieces (tets sharing nodes) that hold a fixed dof of `problem`'s
-/// supports; returns the volumes of those left out. Throws Error(NoSupport) naming a piece
-/// left out on which a load acts.
-std::vector<double> drop_unheld_pieces(TetMesh& m, const VerificationProblem& problem) {
+/// Keeps in `m` only the pieces (tets sharing nodes) that carry the loads by the hygiene's rule
+/// (piece_fates, as for the density field and the finished surface): a piece touches a support
+/// where it holds a fixed dof of `problem`'s supports, a load where a load of it acts on a node,
+/// and holds non-design material where a triangle of it has a negative tag in `tag` (#F of m,
+/// the result surface's tags). Returns the volumes of the pieces left out. Throws
+/// Error(NoSupport) naming a piece with a load on it that is left out or that no support holds.
+std::vector<double> drop_unheld_pieces(TetMesh& m, const VecXi& tag, const VerificationProblem& problem) {
   int count = 0;
   const VecXi piece = node_components(m, std::vector<char>(m.T.rows(), 1), count);
   if (count <= 1) return {};
-  std::vector<char> held(count, 0), loaded(count, 0);
+  std::vector<PieceFacts> facts(count);
   std::vector<int> piece_of_node(m.V.rows(), -1);
   for (long t = 0; t < m.T.rows(); ++t)
     for (int k = 0; k < 4; ++k) piece_of_node[m.T(t, k)] = piece[t];
   for (int d : fem::make_supports(m, problem.supports).dofs)
-    if (piece_of_node[d / 3] >= 0) held[piece_of_node[d / 3]] = 1;
+    if (piece_of_node[d / 3] >= 0) facts[piece_of_node[d / 3]].touch |= kAnchorSupport;
   const Eigen::MatrixXd loads = fem::make_loads(m, problem.material, problem.load_cases);
   for (long i = 0; i < m.V.rows(); ++i)
-    if (piece_of_node[i] >= 0 && loads.middleRows(3 * i, 3).cwiseAbs().maxCoeff() > 0) loaded[piece_of_node[i]] = 1;
-  std::vector<double> volume(count, 0.0);
+    if (piece_of_node[i] >= 0 && loads.middleRows(3 * i, 3).cwiseAbs().maxCoeff() > 0)
+      facts[piece_of_node[i]].touch |= kAnchorLoad;
+  for (long q = 0; q < std::min<long>(tag.size(), m.F.rows()); ++q)
+    if (tag[q] < 0 && piece_of_node[m.F(q, 0)] >= 0) facts[piece_of_node[m.F(q, 0)]].nondesign = true;
   std::vector<Eigen::Vector3d> centre(count, Eigen::Vector3d::Zero());
   for (long t = 0; t < m.T.rows(); ++t) {
     const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
                           d = m.V.row(m.T(t, 3));
     const double v = (b - a).dot((c - a).cross(d - a)) / 6;
-    volume[piece[t]] += v, centre[piece[t]] += v * (a + b + c + d) / 4;
+    facts[piece[t]].volume += v, centre[piece[t]] += v * (a + b + c + d) / 4;
   }
+  const std::vector<PieceFate> fate = piece_fates(facts);
   std::vector<double> dropped;
   for (int k = 0; k < count; ++k) {
-    if (held[k]) continue;
-    const Eigen::Vector3d c = centre[k] / std::max(volume[k], 1e-300);
-    if (loaded[k])
+    const bool kept = fate[k] == PieceFate::Carries;
+    if (facts[k].touch & kAnchorLoad && (!kept || !(facts[k].touch & kAnchorSupport))) {
+      const Eigen::Vector3d c = centre[k] / std::max(facts[k].volume, 1e-300);
       throw Error(ErrorCode::NoSupport, "a load acts on a piece of the result (" +
-                                            std::to_string(static_cast<long>(volume[k])) + " mm³ around (" +
+                                            std::to_string(static_cast<long>(facts[k].volume)) + " mm³ around (" +
                                             std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " +
                                             std::to_string(c.z()) +
                                             ")) that no support holds: the design does not carry it; give more volume "
                                             "(\"optimization.volume_fraction\") or a lower threshold");
-    dropped.push_back(volume[k]);
+    }
+    if (!kept) dropped.push_back(facts[k].volume);
   }
   if (dropped.empty()) return {};
   std::vector<char> keep(m.T.rows());
-  for (long t = 0; t < m.T.rows(); ++t) keep[t] = held[piece[t]];
+  for (long t = 0; t < m.T.rows(); ++t) keep[t] = fate[piece[t]] == PieceFate::Carries;
   m = fem::kept_part(m, keep, fem::KeptNodes::Compact);
   return dropped;
+}
+
+/// `problem` with each support cut to the faces (Ω's and non-design) that `m` still has: the
+/// pieces drop_unheld_pieces left out take the faces only they held with them (a bolt boss
+/// that carries no load); a support left with no face is dropped.
+VerificationProblem on_kept_faces(const TetMesh& m, const VerificationProblem& problem) {
+  std::set<int> faces, nd_faces;
+  for (long q = 0; q < m.face.size(); ++q) faces.insert(m.face[q]);
+  for (long q = 0; q < m.nd_face.size(); ++q) nd_faces.insert(m.nd_face[q]);
+  VerificationProblem kept = problem;
+  kept.supports.clear();
+  for (fem::SupportSpec sp : problem.supports) {
+    const auto gone = [](const std::set<int>& have) { return [&have](int f) { return have.count(f) == 0; }; };
+    sp.faces.erase(std::remove_if(sp.faces.begin(), sp.faces.end(), gone(faces)), sp.faces.end());
+    sp.nd_faces.erase(std::remove_if(sp.nd_faces.begin(), sp.nd_faces.end(), gone(nd_faces)), sp.nd_faces.end());
+    if (!sp.faces.empty() || !sp.nd_faces.empty()) kept.supports.push_back(sp);
+  }
+  return kept;
 }
 
 }  // namespace
@@ -297,10 +323,10 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
     throw;
   }
   check_faces_kept(v.mesh, problem);
-  v.unheld_volumes = drop_unheld_pieces(v.mesh, problem);
+  v.unheld_volumes = drop_unheld_pieces(v.mesh, s.tag, problem);
   for (double vol : v.unheld_volumes)
     progress.warn("verification: a piece of the result of " + std::to_string(static_cast<long>(vol)) +
-                  " mm³ that no support holds and no load acts on (a detached non-design solid?) is left out");
+                  " mm³ that carries no load (a detached non-design solid?) is left out");
   const double seconds_mesh = seconds_since(t0);
   const double cpu_mesh = children_cpu_seconds() - child_cpu0 + process_cpu_seconds() - cpu0;
   // the crisp design on the FE mesh: removed tets keep void_stiffness, only kept tets weigh
@@ -313,7 +339,8 @@ Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& 
   // as-built one on a top-loaded box)
   const TetMesh loaded = fem::kept_part(fe, kept);
   try {
-    v.as_built = analyse(v.mesh, v.mesh, problem, VecXd(), params.solver, timed, &v.U, &v.von_mises);
+    const VerificationProblem held = v.unheld_volumes.empty() ? problem : on_kept_faces(v.mesh, problem);
+    v.as_built = analyse(v.mesh, v.mesh, held, VecXd(), params.solver, timed, &v.U, &v.von_mises);
     v.as_built.seconds += seconds_mesh;
     v.as_built.cpu_seconds += cpu_mesh;
     v.crisp = analyse(fe, loaded, problem, scale, params.solver, timed);

@@ -51,9 +51,10 @@ struct Verification {
   TetMesh mesh;              ///< the verification mesh: tets of the result, F the result surface with Ω's face tags
   Eigen::MatrixXd U;         ///< (3 #V) by #cases displacements on `mesh`
   std::vector<VecXd> von_mises;  ///< per case, #T of `mesh` (MPa)
-  /// Pieces of the result solid that no support holds and no load acts on (a detached
-  /// non-design solid the design does not reach): left out of `mesh` and the as-built
-  /// analysis (they carry nothing and would make it singular), their volumes here (mm³).
+  /// Pieces of the result solid that do not carry the loads by the hygiene's rule
+  /// (piece_fates: a detached non-design solid the design does not reach, held or not): left
+  /// out of `mesh` and the as-built analysis (they carry nothing, and an unheld one would make
+  /// it singular), their volumes here (mm³).
   std::vector<double> unheld_volumes;
   double ratio() const { return crisp.compliance > 0 ? as_built.compliance / crisp.compliance : 0; }
   /// False when the crisp design on the FE mesh does not carry the load while the result solid
@@ -86,9 +87,10 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
 /// The verification: `s` meshed and solved (as built) and the crisp design of `design` (#T
 /// element densities after hygiene, cut at `threshold` as the surface was) solved on `fe`.
 /// The whole runs within params.seconds: past it, Error(Timeout) naming the step. Pieces of
-/// the result that no support holds are left out (Verification::unheld_volumes, a warning through
-/// progress) when no load acts on them; Error(NoSupport) naming the piece when one does (the
-/// design does not carry that load). Throws Error(FaceNotFound) naming the face when the result
+/// the result (tets sharing nodes) go by the hygiene's rule (piece_fates): those that do not
+/// carry the loads are left out (Verification::unheld_volumes, a warning through progress)
+/// when no load acts on them; Error(NoSupport) naming the piece when one does, or when a piece
+/// kept holds a load and no support (the design does not carry that load). Throws Error(FaceNotFound) naming the face when the result
 /// has nothing left of a face a load or support acts on (the design removed the material there:
 /// the message says to keep optimization.keep_loaded_faces on), and what fill_volume and fem
 /// throw (MeshingFailed).

@@ -229,6 +229,29 @@ TEST(Verification, LeavesOutAnUnloadedPieceNoSupportHoldsAndRefusesALoadedOne) {
   }
 }
 
+TEST(Verification, LeavesOutAHeldPieceThatCarriesNoLoadByTheHygienesRule) {
+  // the pieces analysed are those piece_fates says carry the loads (the hygiene's one rule): a
+  // cube clear of the bar whose side x = 20 lies on the supported Face1 and whose top lies on
+  // Face6 (z = 10, which the bar does not reach), supported too, is held but carries no load,
+  // so it is left out with its volume (the rule before kept every held piece), and the support
+  // on Face6, which only the cube held, goes with it (the bracket's bolt bosses 3 and 4)
+  Fixture f = bar_fixture();
+  TriSurface s = testing::with_cube(f.surface, {20, 16, 1}, 3);
+  const long side = f.surface.F.rows() + 8, top = f.surface.F.rows() + 2;  // with_cube's quads 4 and 1
+  s.tag[side] = s.tag[side + 1] = 1;
+  s.tag[top] = s.tag[top + 1] = 6;
+  f.problem.supports.push_back(fem::support_on(fem::SupportSpec::Kind::Fixed, {6}));
+  const Verification v = verify_result(s, f.mesh, f.density, 0.5, f.problem);
+  ASSERT_EQ(v.unheld_volumes.size(), 1u);
+  EXPECT_NEAR(v.unheld_volumes[0], 27, 1e-9);
+  for (long i = 0; i < v.mesh.V.rows(); ++i) {
+    const bool in_cube = v.mesh.V(i, 0) > 19.9 && v.mesh.V(i, 1) > 15.9 && v.mesh.V(i, 2) > 0.9;
+    ASSERT_FALSE(in_cube) << "node " << i << " of the left-out cube";
+  }
+  const Verification bar = verify_result(f.surface, f.mesh, f.density, 0.5, bar_fixture().problem);
+  EXPECT_NEAR(v.as_built.compliance, bar.as_built.compliance, 0.02 * bar.as_built.compliance);
+}
+
 TEST(Verification, TheCrispDesignIsLoadedOnlyWhereItKeepsTheLoadFace) {
   // a force on the box's whole end face x = 40 (Ω face 2), which the design keeps only where the
   // end block and the bar reach it: the result solid carries it on that part, and so must the
