@@ -107,6 +107,62 @@ TEST(SliverPass, LiftsSliversOfBoundaryAndInterfaceNodesWithinTheirPlanes) {
   }
 }
 
+TEST(SliverPass, SlidesANodeOfACurvedFaceOnItThroughTheProjection) {
+  // the box's top (face 6) lifted onto a sphere of radius 10 whose cap rises 0.5 above z = 4
+  TetMesh m = two_domain_box();
+  const Vec3 centre(2, 2, 4.5 - 10);
+  const double radius = 10;
+  auto onto_sphere = [&](Vec3& x) { x = centre + radius * (x - centre).normalized(); };
+  for (long i = 0; i < m.V.rows(); ++i)
+    if (m.V(i, 2) == 4.0) {
+      Vec3 x = m.V.row(i);
+      x.z() = centre.z() + std::sqrt(radius * radius - std::pow(x.x() - 2, 2) - std::pow(x.y() - 2, 2));
+      m.V.row(i) = x.transpose();
+    }
+  const int top = node_at(m, {2, 1, centre.z() + std::sqrt(radius * radius - 1)});
+  ASSERT_GE(top, 0);
+  Vec3 to(3, 1, 4);  // slid towards its neighbour, back on the sphere, until its tets are slivers
+  onto_sphere(to);
+  const TetMesh lifted = m;
+  for (double fraction = 0.5; fraction < 1 && !(all_positive(m) && worst(m) < 0.1); fraction += 0.01) {
+    m = lifted;
+    slide(m, top, to, fraction);
+    Vec3 x = m.V.row(top);
+    onto_sphere(x);
+    m.V.row(top) = x.transpose();
+  }
+  ASSERT_TRUE(all_positive(m));
+  ASSERT_LT(worst(m), 0.1);
+  const TetMesh before = m;
+
+  SliverPassParams without;  // no projection: the node may not move, the sliver stays
+  TetMesh fixed = m;
+  EXPECT_GT(remove_final_slivers(fixed, without).below_after, 0);
+  EXPECT_EQ(fixed.V.row(top), before.V.row(top));
+
+  SliverPassParams params;
+  params.onto_face = [&](int face, Vec3& y) {
+    if (face != 6) return false;
+    onto_sphere(y);
+    return true;
+  };
+  const SliverPassReport r = remove_final_slivers(m, params);
+  EXPECT_EQ(r.below_after, 0);
+  EXPECT_GT(r.moved_curved, 0);
+  EXPECT_GE(worst(m), 0.1);
+  EXPECT_TRUE(all_positive(m));
+  const ConformityReport c = check_conformity(m);
+  EXPECT_TRUE(c.ok()) << c.to_json().dump();
+  for (long i = 0; i < before.V.rows(); ++i) {
+    const Vec3 was = before.V.row(i), now = m.V.row(i);
+    if (std::abs((was - centre).norm() - radius) < 1e-12) {
+      EXPECT_NEAR((now - centre).norm(), radius, 1e-9) << "node " << i << " left the sphere";
+    }
+    const int bits = planes_of(was) & ~(1 << 8);  // not the flat top any more
+    EXPECT_EQ(planes_of(now) & bits, bits) << "node " << i << " left a plane";
+  }
+}
+
 TEST(SliverPass, LeavesAMeshWithoutSliversAsItIs) {
   TetMesh m = two_domain_box();
   const TetMesh before = m;
