@@ -228,9 +228,10 @@ long move_sliver_nodes(Work& w, const std::vector<std::pair<double, int>>& order
   return moved;
 }
 
-/// Edge removal and 2-3 flips (the best, wide: tet_improve's flip_bad_tets) at the tets below
-/// floor, each domain's tets on their own so that no boundary or interface face changes.
-/// Domains keep the order of their first tets. Returns the number of flips.
+/// Edge removal and 2-3 flips (the best, wide: tet_improve's flip_bad_tets), then wider
+/// cavities re-filled from one point (remove_tets_below, 2 sweeps: its points are appended) at
+/// the tets below floor, each domain's tets on their own so that no boundary or interface face
+/// changes. Domains keep the order of their first tets. Returns the number of changes.
 long flip_within_domains(Work& w, double floor) {
   std::vector<int> order;
   std::vector<std::vector<Tet>> lists;
@@ -244,7 +245,9 @@ long flip_within_domains(Work& w, double floor) {
   for (int d : order) {
     bool bad = false;
     for (const Tet& t : lists[d]) bad = bad || rho(w.P, t) < floor;
-    if (bad) flips += flip_bad_tets(w.P, lists[d], floor, true, true);
+    if (!bad) continue;
+    flips += flip_bad_tets(w.P, lists[d], floor, true, true);
+    flips += remove_tets_below(w.P, lists[d], floor, 2);
   }
   if (!flips) return 0;
   w.tets.clear();

@@ -7,7 +7,8 @@
 // B-Rep face of Ω slides on it when the caller gives the projection onto the face (the volume
 // then changes by the faceting's change only); free nodes move anywhere. Every move keeps each tet of the node's ball positive (exact orientation) and is
 // kept only when it lifts the ball's worst radius ratio without leaving more of the ball
-// below the floor; after the moves, edge removal and 2-3 flips within each domain.
+// below the floor; after the moves, edge removal, 2-3 flips and cavity refills within each
+// domain.
 #pragma once
 #include <functional>
 #include <vector>
@@ -39,14 +40,14 @@ struct SliverPassReport {
   long below_before = 0, below_after = 0;  ///< tets below floor
   double worst_before = 0, worst_after = 0;
   long moved_free = 0, moved_plane = 0, moved_curved = 0;  ///< node moves made, by the node's freedom
-  long flips = 0;                        ///< edge removals and 2-3 flips made
+  long flips = 0;  ///< edge removals, 2-3 flips and cavities re-filled
 };
 
 /// The pass: the tets of `mesh` below params.floor, worst first, each of their movable nodes
 /// moved (pattern search in space, in the plane, or in the tangent plane and back onto the face) when that lifts the worst tet of its
 /// ball and leaves no more of it below floor; then edge removal and 2-3 flips at what is left
-/// within each domain (the boundary and the interfaces stay faces); rounds while the count
-/// falls. mesh.F, face, nd_face and domain are unchanged (flips may reorder tets of a domain
+/// and wider cavities re-filled from one point (tet_improve's remove_tets_below), within each
+/// domain (the boundary and the interfaces stay faces); rounds while the count falls. mesh.F, face, nd_face and domain are unchanged (flips may reorder tets of a domain
 /// that changed; domain follows). Returns what it did.
 SliverPassReport remove_final_slivers(TetMesh& mesh, const SliverPassParams& params = {});
 
