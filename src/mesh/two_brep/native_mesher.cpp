@@ -3,6 +3,9 @@
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepClass_FaceClassifier.hxx>
+#include <BRep_Tool.hxx>
+#include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <Standard_Failure.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
 #include <array>
@@ -19,6 +22,7 @@
 #include "mesh/core/conformity.h"
 #include "mesh/two_brep/volume_steps.h"
 #include "mesh/volume/background_size.h"
+#include "mesh/volume/sliver_pass.h"
 
 namespace topopt::mesh {
 namespace {
@@ -339,6 +343,26 @@ TetMesh output_mesh(const Steps& s) {
   return m;
 }
 
+/// The sliver pass's projection onto Ω's faces (1-based): the nearest point of the face's
+/// surface, each surface taken from the B-Rep once; false when OCCT finds none or fails.
+std::function<bool(int, Eigen::Vector3d&)> onto_part_faces(const brep::TopologyIndex& part) {
+  auto surfaces = std::make_shared<std::vector<Handle(Geom_Surface)>>(static_cast<size_t>(part.num_faces()));
+  return [&part, surfaces](int face, Eigen::Vector3d& x) {
+    if (face < 1 || face > part.num_faces()) return false;
+    try {
+      Handle(Geom_Surface)& surface = (*surfaces)[face - 1];
+      if (surface.IsNull()) surface = BRep_Tool::Surface(TopoDS::Face(part.faces(face)));
+      GeomAPI_ProjectPointOnSurf nearest(gp_Pnt(x.x(), x.y(), x.z()), surface);
+      if (nearest.NbPoints() == 0) return false;
+      const gp_Pnt q = nearest.NearestPoint();
+      x = Eigen::Vector3d(q.X(), q.Y(), q.Z());
+      return true;
+    } catch (const Standard_Failure&) {
+      return false;
+    }
+  };
+}
+
 /// The result is checked before anyone uses it: a transfer the classification could not make
 /// (e.g. a non-design face lying across two faces of the part) shows up here, not in SIMP.
 void check_output(const TetMesh& m, const brep::TwoBReps& model) {
@@ -395,6 +419,11 @@ TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params,
   }
   t0 = clock::now();
   TetMesh m = output_mesh(s);
+  progress.say("mesh", 0.95, "slivers");
+  SliverPassParams slivers;  // the fills never move boundary or interface nodes: this pass may, on their face
+  slivers.onto_face = onto_part_faces(model.part);
+  remove_final_slivers(m, slivers);
+  lap("sliver pass");
   check_output(m, model);
   lap("conformity check");
   return m;

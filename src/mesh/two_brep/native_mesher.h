@@ -39,8 +39,8 @@ struct MeshRun {
 /// The 14 steps: one conformal tet mesh of Ω, every tet tagged 0 (design, Ω − Ω̄) or i (the
 /// i-th non-design solid, input order); boundary triangles = Ω's boundary with Ω's FreeCAD
 /// face numbers, and nd_face = the face of Ω̄ a triangle also lies on (load pads).
-/// `run` (optional) gets mesher "native", the seconds of steps 1-7, 8-11, 12, 13-14 and
-/// the conformity check, and the part's face sizes with their rules (ModelSurface::face_sizes). Throws MeshingFailed
+/// `run` (optional) gets mesher "native", the seconds of steps 1-7, 8-11, 12, 13-14, the
+/// last sliver pass (sliver_pass.h) and the conformity check, and the part's face sizes with their rules (ModelSurface::face_sizes). Throws MeshingFailed
 /// naming the face, edge, solid or region that could not be meshed.
 TetMesh mesh_native(const brep::TwoBReps& model, const NativeMeshParams& params, const Progress& progress = {},
                     MeshRun* run = nullptr);

@@ -66,7 +66,7 @@ TEST(MeshModel, MesherChoiceIsCheckedAndReported) {
   const TetMesh m = mesh_model(model, with(Mesher::Auto), {}, &run);
   EXPECT_EQ(run.mesher, "native");
   EXPECT_TRUE(run.fallback_reason.empty());
-  ASSERT_EQ(run.seconds.size(), 5u);  // steps 1-7, 8-11, 12, 13-14, the conformity check
+  ASSERT_EQ(run.seconds.size(), 6u);  // steps 1-7, 8-11, 12, 13-14, the sliver pass, the conformity check
   EXPECT_EQ(run.seconds.back().first, "conformity check");
   EXPECT_TRUE(mesh::check_conformity(m, &model).ok());
   // a size that would not fit in memory is refused up front, by auto too (Gmsh would not fit either)
