@@ -48,15 +48,20 @@ Bracket bisect(const Excess& excess_at, double hint) {
 }
 
 /// OC's candidate design for a multiplier λ: x_i sqrt(−dc_i / (λ dv_i)) within the move limits
-/// and [0, 1] (top88's heuristic update).
+/// and [0, 1] (top88's heuristic update). The product is 0 where either factor is: a variable at
+/// 0, or one without stiffening (dc_i ≥ 0; under a steep projection the chain rule underflows to
+/// exactly 0). Computed as written, those made NaN (0 × ∞, 0 / 0) when λ dv_i underflows to 0 —
+/// the bracket searches λ down to 1e-300 when even the upper limits hold too little material —
+/// and the clamp let the NaN through.
 class Candidates {
  public:
   Candidates(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move)
       : x_(x), dc_(dc), dv_(dv), move_(move), xnew_(x.size()) {}
   const VecXd& at(double lambda) {
     for (long i = 0; i < x_.size(); ++i) {
-      const double b = std::sqrt(std::max(-dc_[i], 0.0) / (lambda * dv_[i]));
-      xnew_[i] = std::clamp(x_[i] * b, std::max(0.0, x_[i] - move_[i]), std::min(1.0, x_[i] + move_[i]));
+      const double gain = std::max(-dc_[i], 0.0);
+      const double scaled = gain > 0 && x_[i] > 0 ? x_[i] * std::sqrt(gain / (lambda * dv_[i])) : 0.0;
+      xnew_[i] = std::clamp(scaled, std::max(0.0, x_[i] - move_[i]), std::min(1.0, x_[i] + move_[i]));
     }
     return xnew_;
   }

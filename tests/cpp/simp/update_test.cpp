@@ -177,6 +177,29 @@ TEST(OcUpdate, ARippledVolumeIsMetByTheLinearisedBisection) {
   EXPECT_LE(std::abs(excess(xnew)), 1e-5 * target);
 }
 
+/// The robust formulation's dilated volume can stay below its bound even with every variable at
+/// its upper move limit; the bracket then searches the multiplier down to 1e-300, where λ dv
+/// underflows to 0. Variables whose sensitivity underflowed to exactly 0 (a steep projection),
+/// and variables at 0, must still get a number — their lower limit — not 0/0 or 0 × ∞ (the
+/// cantilever at volume 0.45 with a
+/// 6 mm minimum size stopped at iteration 100 on the NaN this made, reported by the density
+/// filter).
+TEST(OcUpdate, ZeroSensitivitiesStayNumbersWhenTheMultiplierUnderflows) {
+  const int n = 40;
+  VecXd x = VecXd::Constant(n, 0.5), dc = VecXd::Zero(n), dv = VecXd::Constant(n, 1e-30);
+  for (int i = 0; i < n; i += 2) dc[i] = -1.0;
+  for (int i = 0; i < n; i += 4) x[i] = 0.0;
+  const VecXd move = VecXd::Constant(n, 0.2);
+  auto excess = [](const VecXd& xn) { return xn.sum() - 1e9; };  // never enough material
+  for (const bool linearised : {false, true}) {
+    double multiplier = 0;
+    const OcLinearisation linear{x.sum() - 1e9, {}};
+    const VecXd xn = oc_update(x, dc, dv, move, excess, &multiplier, linearised ? &linear : nullptr);
+    ASSERT_TRUE(xn.allFinite()) << (linearised ? "linearised" : "exact") << " bisection";
+    for (int i = 0; i < n; ++i) EXPECT_DOUBLE_EQ(xn[i], i % 4 == 0 ? 0.0 : i % 2 ? 0.3 : 0.7) << i;
+  }
+}
+
 TEST(MoveLimits, ShrinkWhereTheDesignOscillatesAndGrowBackWhereItMovesOneWay) {
   // variable 0 zig-zags, variable 1 climbs steadily, variable 2 stands still
   MoveLimits moves(3, 0.2, 0.01, 0.5, 2.0);
