@@ -80,6 +80,7 @@ int cmd_result(const Args& args) {
   if (params.coarsen.tolerance < 0 || params.coarsen.tolerance > 0.5)
     throw Error(ErrorCode::InvalidParameter, "--coarsen takes a share of the median edge in [0, 0.5], e.g. 0.05");
   pipeline::Job job = pipeline::read_job(pos[0]);
+  params = pipeline::step_params(job, params);
   const std::string dir = out.empty() ? job.output.directory : fs::absolute(out).lexically_normal().string();
   if (step.empty()) step = default_step_path(dir, threshold);
   Progress progress;

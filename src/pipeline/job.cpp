@@ -136,7 +136,7 @@ fem::LoadCase parse_load_case(const json& item, int i) {
 }
 
 OutputSettings parse_output(const json& section, const std::string& base_dir) {
-  const Fields f(section, "output", {"directory", "vtu", "inp", "step", "verification"}, "{\"directory\": \"out\"}");
+  const Fields f(section, "output", {"directory", "vtu", "inp", "step", "step_max_triangles", "verification"}, "{\"directory\": \"out\"}");
   OutputSettings o;
   const std::string dir = f.text("directory", "out");
   if (dir.empty()) f.bad("directory", "must name a folder (relative to the job file's folder)");
@@ -144,6 +144,7 @@ OutputSettings parse_output(const json& section, const std::string& base_dir) {
   o.vtu = f.boolean("vtu", o.vtu);
   o.inp = f.boolean("inp", o.inp);
   o.step = f.boolean("step", o.step);
+  o.step_max_triangles = f.integer("step_max_triangles", -1, 0, 2000000000);
   o.verification = f.boolean("verification", o.verification);
   return o;
 }

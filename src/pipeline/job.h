@@ -43,6 +43,9 @@ struct OutputSettings {
   bool vtu = true;        ///< solve: DIR/result.vtu
   bool inp = false;       ///< solve: DIR/result.inp, the problem as a CalculiX deck
   bool step = true;       ///< optimize: DIR/result.step, the result as one CAD solid
+  /// The largest result surface (triangles) written as result.step; -1: the export's own
+  /// budget (result::StepExportParams::max_triangles), 0: any size.
+  long step_max_triangles = -1;
   /// optimize: DIR/verification.json and .vtu, the result solid meshed by the native volume mesher
   /// and analysed (result/verification.h).
   bool verification = true;

@@ -108,6 +108,11 @@ result::SourceFaces source_faces(const Job& job, const JobShapes& shapes, const 
   }
 }
 
+result::StepExportParams step_params(const Job& job, result::StepExportParams params) {
+  if (job.output.step_max_triangles >= 0) params.max_triangles = job.output.step_max_triangles;
+  return params;
+}
+
 result::VerificationProblem verification_problem(const Job& job) {
   return {job.material, job.supports, job.load_cases};
 }
@@ -141,7 +146,7 @@ ResultFiles write_result_step_first(const Job& job, const OptimizeResult& r, con
         [&]() {
           const std::string path = (d / "result.step").string();
           out.written.push_back(write_replacing(path, [&](const std::string& p) {
-            out.step = result::write_result_step(p, r.surface, params.step, progress, &source);
+            out.step = result::write_result_step(p, r.surface, step_params(job, params.step), progress, &source);
           }));
           out.step->bytes = static_cast<long>(fs::file_size(path));
           report["step"] = step_json(*out.step);

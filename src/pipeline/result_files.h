@@ -40,6 +40,9 @@ struct ResultFiles {
 /// faces as facets. run_job makes them once per run (RunResult::source).
 result::SourceFaces source_faces(const Job& job, const JobShapes& shapes = {}, const Progress& progress = {});
 
+/// `params` with what the job's "output" section sets for the STEP export (its triangle budget).
+result::StepExportParams step_params(const Job& job, result::StepExportParams params = {});
+
 /// The job's problem (material, supports, load cases) as the verification solves it.
 result::VerificationProblem verification_problem(const Job& job);
 

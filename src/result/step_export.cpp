@@ -370,6 +370,14 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
                                    const Progress& progress, const SourceFaces* source) {
+  if (params.max_triangles > 0 && s.F.rows() > params.max_triangles)
+    throw Error(ErrorCode::TooLarge,
+                "result.step is not written: the result surface has " + std::to_string(s.F.rows()) +
+                    " triangles, more than the STEP export's budget of " + std::to_string(params.max_triangles) +
+                    " (OCCT's face merging grows faster than the surface and would take many CPU minutes); "
+                    "result.stl holds the shape. To write it anyway set \"" +
+                    max_triangles_key + "\" in the job's \"output\" to " + std::to_string(s.F.rows()) +
+                    " or more (0: no budget), or optimise on a coarser mesh");
   const std::vector<std::string> parts = body_descriptions(s);
   if (parts.size() > 1) {
     std::string named;

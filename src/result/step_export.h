@@ -37,7 +37,17 @@ struct StepExportParams {
   /// written as 3D lines only (a reader computes the 2D curves of a planar face), which
   /// makes the file about half as large.
   bool pcurves = false;
+  /// The largest result surface (triangles as given, before coarsening) written as STEP
+  /// (<= 0: any size). OCCT's face merging and checking grow faster than the surface (measured
+  /// in BENCHMARKS.md, branch step6), so past this budget the export would look like a hang:
+  /// write_result_step then writes nothing and throws Error(TooLarge) naming the job key that
+  /// raises it (max_triangles_key), before any OCCT work, so the refusal costs nothing.
+  long max_triangles = 60000;
 };
+
+/// The key of the job's "output" section that sets StepExportParams::max_triangles, as the
+/// refusal names it.
+inline constexpr const char* max_triangles_key = "step_max_triangles";
 
 /// What the solid written holds, as OCCT's checks found it after building.
 struct StepExportReport {
@@ -94,7 +104,8 @@ std::string solid_faults(const TopoDS_Shape& shape, int limit = 5);
 
 /// Builds result_solid(s) and writes it to `path` as STEP (AP214, mm), in a child process
 /// with the time budget params.seconds, so that a fault or a hang inside OCCT costs the
-/// export, never the caller. Returns the report of the solid written. Throws Error(Timeout)
+/// export, never the caller. Returns the report of the solid written. Throws Error(TooLarge),
+/// writing nothing, when `s` has more triangles than params.max_triangles; Error(Timeout)
 /// past the budget, Error(Crashed) when OCCT ends the child, Error(InvalidShape) when the
 /// shape is not valid or not one solid per body (result_bodies), Error(Io) when the file cannot be written.
 /// A result of several bodies is written as one compound of solids (a STEP reader shows several

@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "common/error.h"
+#include "pipeline/result_files.h"
 
 namespace topopt::pipeline {
 namespace {
@@ -185,6 +186,17 @@ TEST(Job, ResultResolutionIsOneOrTwoAndNamedWhenWrong) {
                  {"'result.resolution' must be a whole number from 1 to 2, not 3"});
   expect_message(R"({"result": {"resolution": 1.5}})", ErrorCode::InvalidParameter, {"'result.resolution'"});
   expect_message(R"({"result": {"resolutoin": 2}})", ErrorCode::InvalidParameter, {"resolutoin"});
+}
+
+TEST(Job, TheStepTriangleBudgetReachesTheExport) {
+  // absent: the export's own budget; set: that number; 0: no budget
+  const long own = result::StepExportParams{}.max_triangles;
+  EXPECT_EQ(pipeline::step_params(parse_job(R"({"output": {}})", "/d")).max_triangles, own);
+  EXPECT_EQ(pipeline::step_params(parse_job(R"({"output": {"step_max_triangles": 250000}})", "/d")).max_triangles,
+            250000);
+  EXPECT_EQ(pipeline::step_params(parse_job(R"({"output": {"step_max_triangles": 0}})", "/d")).max_triangles, 0);
+  expect_message(R"({"output": {"step_max_triangles": -1}})", ErrorCode::InvalidParameter,
+                 {"'output.step_max_triangles' must be a whole number from 0"});
 }
 
 TEST(Job, IntegersAreWholeAndNumbersFinite) {

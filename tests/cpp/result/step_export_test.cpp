@@ -12,7 +12,9 @@
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <cmath>
+#include <array>
 #include <filesystem>
+#include <map>
 #include <gp_Pln.hxx>
 
 #include "common/error.h"
@@ -144,6 +146,82 @@ TEST(StepExport, TheStepFileReadsBackAsOneValidSolidOfTheSameVolume) {
   const double stl_volume = check_surface(s.V, s.F).volume;
   EXPECT_NEAR(back.volume, stl_volume, 0.005 * stl_volume);
   EXPECT_EQ(faces_on_plane_x(shape, 0), 1);
+  std::filesystem::remove(path);
+}
+
+/// The closed surface of the cube [0, n]³ with every face an n by n grid of squares, each
+/// split in two triangles (12 n² triangles, outward), all tagged free-form.
+TriSurface grid_cube(int n) {
+  std::map<std::array<int, 3>, int> index;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3i> triangles;
+  const auto at = [&](std::array<int, 3> p) {
+    const auto [it, added] = index.emplace(p, static_cast<int>(points.size()));
+    if (added) points.emplace_back(p[0], p[1], p[2]);
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side)
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const auto corner = [&](int di, int dj) {
+            std::array<int, 3> p{};
+            p[axis] = side * n, p[(axis + 1) % 3] = i + di, p[(axis + 2) % 3] = j + dj;
+            return at(p);
+          };
+          // (axis+1, axis+2) turn about +axis: counter-clockwise seen from outside on the far side
+          const int a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
+          if (side == 1) triangles.emplace_back(a, b, c), triangles.emplace_back(a, c, d);
+          if (side == 0) triangles.emplace_back(a, c, b), triangles.emplace_back(a, d, c);
+        }
+  TriSurface s;
+  s.V.resize(static_cast<long>(points.size()), 3);
+  for (size_t k = 0; k < points.size(); ++k) s.V.row(static_cast<long>(k)) = points[k];
+  s.F.resize(static_cast<long>(triangles.size()), 3);
+  for (size_t k = 0; k < triangles.size(); ++k) s.F.row(static_cast<long>(k)) = triangles[k];
+  s.tag = VecXi::Zero(s.F.rows());
+  s.lock = VecXi::Zero(s.V.rows());
+  s.point_face = VecXi::Zero(s.V.rows());
+  return s;
+}
+
+TEST(StepExport, ASurfaceOverTheTriangleBudgetIsRefusedByNameAndWritesNothing) {
+  // the default budget: a closed surface just past it (a cube of 12 n² triangles) is refused
+  // before OCCT does anything, with the key that writes it anyway
+  const StepExportParams defaults;
+  ASSERT_GT(defaults.max_triangles, 0);
+  const int n = static_cast<int>(std::ceil(std::sqrt(defaults.max_triangles / 12.0))) + 1;
+  const TriSurface big = grid_cube(n);
+  const SurfaceCheck check = check_surface(big.V, big.F);
+  ASSERT_TRUE(check.closed_manifold());
+  ASSERT_NEAR(check.volume, double(n) * n * n, 1e-6 * n * n * n);  // outward, so a body
+  ASSERT_GT(big.F.rows(), defaults.max_triangles);
+  const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_big.step").string();
+  std::filesystem::remove(path);
+  try {
+    write_result_step(path, big);
+    FAIL() << "a surface of " << big.F.rows() << " triangles was written past the budget";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::TooLarge);
+    const std::string message = e.what();
+    EXPECT_NE(message.find(max_triangles_key), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(big.F.rows()) + " triangles"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  // the budget counts the triangles given: one fewer than the result surface's refuses it, its
+  // own count writes one valid solid within 0.5 % of the surface's volume
+  const TriSurface s = bar_surface();
+  StepExportParams params;
+  params.max_triangles = s.F.rows() - 1;
+  EXPECT_THROW(write_result_step(path, s, params), Error);
+  EXPECT_FALSE(std::filesystem::exists(path));
+  params.max_triangles = s.F.rows();
+  const StepExportReport written = write_result_step(path, s, params);
+  EXPECT_TRUE(written.valid);
+  EXPECT_EQ(written.solids, 1);
+  const double volume = check_surface(s.V, s.F).volume;
+  EXPECT_NEAR(written.volume, volume, 0.005 * volume);
+  EXPECT_GT(written.bytes, 0);
   std::filesystem::remove(path);
 }
 
