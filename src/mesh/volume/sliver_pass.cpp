@@ -238,8 +238,8 @@ bool on_boundary_of(const TetSweep& s, int x, Vec3& outward) {
       const Tet& t = s.tets[q];
       const int a = t[o[0]], b = t[o[1]], c = t[o[2]];
       if (a != x && b != x && c != x) continue;
-      const Vec3 n = (s.P[b] - s.P[a]).cross(s.P[c] - s.P[a]);  // kTetFace turns a face into its tet
-      auto [it, fresh] = seen.emplace(face_key(a, b, c), std::make_pair(1, -n));
+      const Vec3 n = (s.P[b] - s.P[a]).cross(s.P[c] - s.P[a]);  // kTetFace turns a face out of its tet
+      auto [it, fresh] = seen.emplace(face_key(a, b, c), std::make_pair(1, n));
       if (!fresh) ++it->second.first;
     }
   outward = Vec3::Zero();
