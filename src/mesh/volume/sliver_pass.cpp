@@ -228,11 +228,72 @@ long move_sliver_nodes(Work& w, const std::vector<std::pair<double, int>>& order
   return moved;
 }
 
+/// The tets of `tets` holding node x have a face through x that no other of them holds: x is
+/// on the boundary of these tets (Ω's boundary or an interface), and `outward` gets the
+/// area-weighted normal of those faces, turned out of the tets.
+bool on_boundary_of(const TetSweep& s, int x, Vec3& outward) {
+  std::unordered_map<FaceKey, std::pair<int, Vec3>, FaceKeyHash> seen;
+  for (int q : s.stars.row(x))
+    for (const auto& o : kTetFace) {
+      const Tet& t = s.tets[q];
+      const int a = t[o[0]], b = t[o[1]], c = t[o[2]];
+      if (a != x && b != x && c != x) continue;
+      const Vec3 n = (s.P[b] - s.P[a]).cross(s.P[c] - s.P[a]);  // kTetFace turns a face out of its tet
+      auto [it, fresh] = seen.emplace(face_key(a, b, c), std::make_pair(1, n));
+      if (!fresh) ++it->second.first;
+    }
+  outward = Vec3::Zero();
+  for (const auto& [key, cn] : seen)
+    if (cn.first == 1) outward += cn.second;
+  return outward.norm() > 0;
+}
+
+/// Node splits at the tets of one domain below `floor` (worst first): for each boundary or
+/// interface node x of such a tet (the fills and the moves may not take it off its face), the
+/// tets of x's ball re-filled as a star from a new inner point (tet_improve's
+/// plan_refill_cavity, its search started a tenth of x's mean edge inside, off x's faces).
+/// The faces through x stay (each becomes a tet with the new point), so the boundary and the
+/// interfaces keep every triangle; the new point takes x's inner edges. This lifts slivers that
+/// hold each other around a boundary node that would have to leave its face to free them (on
+/// NIST 6 four tets around one node of a B-spline face, no single or joint move on the face
+/// lifts them). Each sliver takes the best of its nodes' stars; kept only when it lifts the
+/// worst tet and leaves no more of them below floor. Returns the splits made.
+long split_boundary_nodes(std::vector<Vec3>& P, std::vector<Tet>& tets, double floor) {
+  std::vector<std::pair<double, int>> order;
+  for (size_t t = 0; t < tets.size(); ++t)
+    if (rho(P, tets[t]) < floor) order.push_back({rho(P, tets[t]), static_cast<int>(t)});
+  if (order.empty()) return 0;
+  std::sort(order.begin(), order.end());
+  TetSweep s(P, tets);
+  long splits = 0;
+  for (const auto& [r, t] : order) {
+    if (s.touched[t]) continue;
+    CavityStar best;
+    for (int x : tets[t]) {
+      Vec3 outward;
+      if (s.locked[x] || !on_boundary_of(s, x, outward)) continue;
+      const Adjacency::Row ball = s.stars.row(x);
+      double len = 0;
+      for (int q : ball)
+        for (int y : tets[q]) len += (P[y] - P[x]).norm();
+      const Vec3 start = P[x] - 0.1 * len / (3.0 * static_cast<double>(ball.size())) * outward.normalized();
+      CavityStar star = plan_refill_cavity(s, std::vector<int>(ball.begin(), ball.end()), floor / kSliverShare, &start);
+      if (!star.empty() && star.gain > best.gain) best = std::move(star);
+    }
+    if (best.empty()) continue;
+    apply(s, best);
+    ++splits;
+  }
+  if (splits) s.end();
+  return splits;
+}
+
 /// Edge removal and 2-3 flips (the best, wide: tet_improve's flip_bad_tets), then wider
 /// cavities re-filled from one point (remove_tets_below, 2 sweeps: its points are appended) at
-/// the tets below floor, each domain's tets on their own so that no boundary or interface face
-/// changes. Domains keep the order of their first tets. Returns the number of changes.
-long flip_within_domains(Work& w, double floor) {
+/// the tets below floor, then with `split` node splits at the boundary nodes of what is left
+/// (split_boundary_nodes), each domain's tets on their own so that no boundary or interface
+/// face changes. Domains keep the order of their first tets. Returns the number of changes.
+long flip_within_domains(Work& w, double floor, bool split) {
   std::vector<int> order;
   std::vector<std::vector<Tet>> lists;
   for (size_t t = 0; t < w.tets.size(); ++t) {
@@ -248,6 +309,7 @@ long flip_within_domains(Work& w, double floor) {
     if (!bad) continue;
     flips += flip_bad_tets(w.P, lists[d], floor, true, true);
     flips += remove_tets_below(w.P, lists[d], floor, 2);
+    if (split) flips += split_boundary_nodes(w.P, lists[d], floor);
   }
   if (!flips) return 0;
   w.tets.clear();
@@ -304,7 +366,7 @@ SliverPassReport remove_final_slivers(TetMesh& mesh, const SliverPassParams& par
   add_boundary(w, mesh);
   for (int round = 0; round < params.rounds && !order.empty(); ++round) {
     move_sliver_nodes(w, order, params, report);
-    report.flips += flip_within_domains(w, params.floor);
+    report.flips += flip_within_domains(w, params.floor, params.split_boundary_nodes);
     const size_t was = order.size();
     order = tets_below(w, params.floor, &report.worst_after);
     if (order.size() >= was) break;  // rounds while the count falls: moves of 1e-6 are not worth another

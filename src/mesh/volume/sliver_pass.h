@@ -34,19 +34,24 @@ struct SliverPassParams {
   /// Moves x onto Ω's B-Rep face `face` (1-based, TetMesh::face's numbering): the nearest point
   /// of its surface; false when there is none. Empty: nodes of curved faces never move.
   std::function<bool(int face, Eigen::Vector3d& x)> onto_face;
+  /// After the flips and refills, the slivers still below floor that have a node on the
+  /// boundary or an interface get that node's ball (within its domain) re-filled from a new
+  /// inner point: the node keeps its place and its faces, the new point takes its inner edges.
+  bool split_boundary_nodes = true;
 };
 
 struct SliverPassReport {
   long below_before = 0, below_after = 0;  ///< tets below floor
   double worst_before = 0, worst_after = 0;
   long moved_free = 0, moved_plane = 0, moved_curved = 0;  ///< node moves made, by the node's freedom
-  long flips = 0;  ///< edge removals, 2-3 flips and cavities re-filled
+  long flips = 0;  ///< edge removals, 2-3 flips, cavities re-filled and boundary nodes split
 };
 
 /// The pass: the tets of `mesh` below params.floor, worst first, each of their movable nodes
 /// moved (pattern search in space, in the plane, or in the tangent plane and back onto the face) when that lifts the worst tet of its
 /// ball and leaves no more of it below floor; then edge removal and 2-3 flips at what is left
-/// and wider cavities re-filled from one point (tet_improve's remove_tets_below), within each
+/// and wider cavities re-filled from one point (tet_improve's remove_tets_below), then the balls
+/// of their boundary and interface nodes re-filled from a new inner point (node splits), within each
 /// domain (the boundary and the interfaces stay faces); rounds while the count falls. mesh.F, face, nd_face and domain are unchanged (flips may reorder tets of a domain
 /// that changed; domain follows). Returns what it did.
 SliverPassReport remove_final_slivers(TetMesh& mesh, const SliverPassParams& params = {});
