@@ -180,6 +180,10 @@ VecXd HelmholtzFilter::element_mean(const VecXd& nodal) const {
 
 VecXd HelmholtzFilter::solve(const VecXd& b, VecXd& warm) const {
   if (warm.size() != b.size()) warm = VecXd::Zero(b.size());
+  if (!b.allFinite())  // not the mesh's fault: say so rather than blame degenerate tets below
+    throw Error(ErrorCode::Internal,
+                "the Helmholtz density filter was given a field that is not finite (an internal fault of the "
+                "optimiser, not of the part or the mesh; please report it with the job)");
   fem::PcgParams pcg;
   pcg.tolerance = 1e-12;  // near round-off: the gradients (Fᵀ) must match the filter (F) closely
   pcg.max_iterations = 2000;

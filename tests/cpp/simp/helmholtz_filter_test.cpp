@@ -65,6 +65,25 @@ TEST(HelmholtzFilter, PassesConstantsAndItsTransposeIsItsAdjoint) {
   EXPECT_NEAR(f.length(), 3.0 / (2 * std::sqrt(3.0)), 1e-12);
 }
 
+/// A field that is not finite is the optimiser's fault, not the mesh's: the error says so (it
+/// used to blame degenerate tets, which sent a user to remesh a sound part).
+TEST(HelmholtzFilter, ANonFiniteFieldIsNamedAsAnInternalFaultNotTheMesh) {
+  const Box b = box(6, 1, true);
+  HelmholtzFilter f(b.mesh, b.design, b.volume, {FilterKind::Helmholtz, 3.0, 0});
+  VecXd x = VecXd::Constant(static_cast<long>(b.design.size()), 0.5);
+  x[3] = std::nan("");
+  try {
+    f.apply(x);
+    FAIL() << "a NaN went through the filter";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Internal);
+    EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("degenerate"), std::string::npos) << e.what();
+  }
+  x[3] = 0.5;
+  EXPECT_TRUE(f.apply(x).allFinite());  // the failed call left no NaN in its warm start
+}
+
 TEST(HelmholtzFilter, MatchesTheContinuumSolutionForACosine) {
   // cos(k z) with k = mπ/L meets the zero-flux condition at z = 0 and z = L, so the filtered
   // field of the continuum is cos(k z) / (1 + ℓ²k²) exactly; linear tets are O(h²) from it
