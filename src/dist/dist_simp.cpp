@@ -48,6 +48,8 @@ class DistProblem {
   const std::vector<int>& design() const { return design_; }
   void set_beta(double beta) { proj_.beta = beta; }
   int solver_iterations() const { return fe_.last_iterations(); }
+  int solver_setups() const { return fe_.setups(); }
+  void set_solver_tolerance(double tolerance) { fe_.set_tolerance(tolerance); }
 
   void forward(const VecXd& x, VecXd& rho_tilde, VecXd& rho_bar) const {
     rho_tilde = filter_->apply(x);
@@ -175,6 +177,8 @@ simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, 
   for (int it = 1; it <= params.max_iterations; ++it) {
     const auto t0 = std::chrono::steady_clock::now();
     problem.set_beta(schedule.beta());
+    problem.set_solver_tolerance(
+        simp::solver_tolerance(schedule, solver.tolerance, params.early_solver_tolerance));
     // ---- FE analysis, objective and sensitivities (through filter and projection)
     VecXd dc, dv;
     const double c = problem.compliance(x, dc);
@@ -197,7 +201,8 @@ simp::SimpResult optimize_mesh(const MpiSession& session, const DistMesh& mesh, 
       std::ostringstream msg;
       msg << "iteration " << it << ": compliance " << c << ", volume " << vol << ", change " << change;
       if (rec.beta != 1) msg << ", beta " << rec.beta << ", grey " << 100 * rec.grey << " %";
-      msg << " (" << session.size() << " ranks, CG " << problem.solver_iterations() << ")";
+      msg << " (" << session.size() << " ranks, CG " << problem.solver_iterations() << ", multigrid set-ups "
+          << problem.solver_setups() << ")";
       progress.say("simp", static_cast<double>(it) / params.max_iterations, msg.str());
     }
     // ---- continuation and convergence (judged at the final β only)
