@@ -175,6 +175,14 @@ void DistElasticity::Impl::create_solver() {
     // smoothing steps); at 1.3 those 3 and the defaults ran, the defaults with 8 % more CG iterations
     // (BENCHMARKS.md, "The distributed solve's smoother").
     option_unless_given("-mg_levels_ksp_chebyshev_esteig", "0,0.1,0,1.3");
+    // ... and at 1.3 × an estimate of its own level operator (a few CG steps, which approach the
+    // largest eigenvalue from below quickly), not GAMG's from its prolongator smoothing: with
+    // GAMG's, the whole cantilever study (98 k tets, default job) still broke down at SIMP
+    // iteration 8 (CG "indefinite preconditioner", and the SOR retry failed too); with its own it
+    // ran on (BENCHMARKS.md, "The distributed path's cost per tet"). A kept hierarchy's finest
+    // smoother re-estimates for the new matrix.
+    option_unless_given("-pc_gamg_use_sa_esteig", "false");
+    option_unless_given("-mg_levels_esteig_ksp_type", "cg");
   }
   check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
   check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
