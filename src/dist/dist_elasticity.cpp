@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "fem/solver_policy.h"
 #include "fem/tet_element.h"
 
 namespace topopt::dist {
@@ -45,8 +46,13 @@ struct DistElasticity::Impl {
   bool dirty = true;
   bool safe_smoother = false;  // after a failed solve: the multigrid smooths with SOR (no eigenvalue estimate)
   int iterations = 0;
+  fem::HierarchyReuse reuse;  // the serial multigrid's rule for keeping a preconditioner
+  bool built = false;         // a preconditioner is set up (perhaps for an earlier matrix)
+  bool kept = false;          // the preconditioner in use was set up for an earlier matrix
+  int setups = 0;
 
-  Impl(const MpiSession& s, const DistMesh& m, const DistSolverParams& p) : session(s), mesh(m), params(p) {}
+  Impl(const MpiSession& s, const DistMesh& m, const DistSolverParams& p)
+      : session(s), mesh(m), params(p), reuse(p.reuse) {}
   ~Impl() {
     for (Vec& v : x) VecDestroy(&v);
     VecDestroy(&b);
@@ -58,9 +64,12 @@ struct DistElasticity::Impl {
   void create_matrix();
   void create_solver();
   void use_safe_smoother();
+  void set_operators(bool keep);
+  void refresh_finest_smoother();
   KSPConvergedReason run_solver(long k, PetscInt& its);
+  KSPConvergedReason run_kept_solver(long k, PetscInt& its, bool& rebuilt);
   Vec ghosted_vector() const;
-  void solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U);
+  bool solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U);
   template <class F>
   VecXd per_element(const VecXd& u, const F& f) const;
 };
@@ -166,6 +175,14 @@ void DistElasticity::Impl::create_solver() {
     // smoothing steps); at 1.3 those 3 and the defaults ran, the defaults with 8 % more CG iterations
     // (BENCHMARKS.md, "The distributed solve's smoother").
     option_unless_given("-mg_levels_ksp_chebyshev_esteig", "0,0.1,0,1.3");
+    // ... and at 1.3 × an estimate of its own level operator (a few CG steps, which approach the
+    // largest eigenvalue from below quickly), not GAMG's from its prolongator smoothing: with
+    // GAMG's, the whole cantilever study (98 k tets, default job) still broke down at SIMP
+    // iteration 8 (CG "indefinite preconditioner", and the SOR retry failed too); with its own it
+    // ran on (BENCHMARKS.md, "The distributed path's cost per tet"). A kept hierarchy's finest
+    // smoother re-estimates for the new matrix.
+    option_unless_given("-pc_gamg_use_sa_esteig", "false");
+    option_unless_given("-mg_levels_esteig_ksp_type", "cg");
   }
   check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
   check_petsc(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
@@ -191,8 +208,41 @@ void DistElasticity::Impl::use_safe_smoother() {
   check_petsc(PetscOptionsSetValue(nullptr, "-mg_levels_ksp_type", "richardson"), "PetscOptionsSetValue");
   check_petsc(PetscOptionsSetValue(nullptr, "-mg_levels_pc_type", "sor"), "PetscOptionsSetValue");
   create_solver();
-  check_petsc(KSPSetOperators(ksp, K, K), "KSPSetOperators");
   safe_smoother = true;
+  set_operators(false);
+}
+
+/// Hands K's current values to the solver: on the preconditioner set up for an earlier matrix
+/// (keep: CG runs on the new K, the multigrid stays the old one's but for the finest smoother)
+/// or on a new set-up at the next solve. Counts the set-ups; the reuse rule's bookkeeping is the
+/// caller's.
+void DistElasticity::Impl::set_operators(bool keep) {
+  check_petsc(KSPSetReusePreconditioner(ksp, keep ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
+  check_petsc(KSPSetOperators(ksp, K, K), "KSPSetOperators");
+  if (keep) {
+    refresh_finest_smoother();
+  } else {
+    ++setups;
+    built = true;
+  }
+  kept = keep;
+}
+
+/// A kept GAMG hierarchy for a new K: the finest level's smoother is given K anew, so that its
+/// Jacobi diagonal and Chebyshev's eigenvalue estimate follow the new values (the coarse levels
+/// stay the old matrix's Galerkin products), as the serial multigrid refreshes its finest level.
+void DistElasticity::Impl::refresh_finest_smoother() {
+  PC pc;
+  KSPGetPC(ksp, &pc);
+  PetscBool mg = PETSC_FALSE;
+  check_petsc(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCGAMG, &mg), "PetscObjectTypeCompare");
+  if (!mg) return;
+  PetscInt levels = 0;
+  check_petsc(PCMGGetLevels(pc, &levels), "PCMGGetLevels");
+  if (levels < 1) return;
+  KSP smoother;
+  check_petsc(PCMGGetSmoother(pc, levels - 1, &smoother), "PCMGGetSmoother");
+  check_petsc(KSPSetOperators(smoother, K, K), "KSPSetOperators");
 }
 
 KSPConvergedReason DistElasticity::Impl::run_solver(long k, PetscInt& its) {
@@ -203,21 +253,47 @@ KSPConvergedReason DistElasticity::Impl::run_solver(long k, PetscInt& its) {
   return reason;
 }
 
+/// Solves load case k; on a kept preconditioner CG may take the reuse rule's patience only: a
+/// solve that reaches it (the old hierarchy no longer fits) is finished from where it stopped on
+/// a new set-up, and one that fails on it (a stale smoother can make the V-cycle indefinite) is
+/// run again from zero on a new set-up. `rebuilt` is set when either happened; its counts
+/// include the iterations on the kept preconditioner.
+KSPConvergedReason DistElasticity::Impl::run_kept_solver(long k, PetscInt& its, bool& rebuilt) {
+  if (!kept) return run_solver(k, its);
+  const PetscInt patience = reuse.patience(params.max_iterations);
+  check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, patience), "KSPSetTolerances");
+  KSPConvergedReason reason = run_solver(k, its);
+  check_petsc(KSPSetTolerances(ksp, params.tolerance, 1e-300, 1e300, params.max_iterations), "KSPSetTolerances");
+  if (reason >= 0) return reason;
+  const PetscInt on_kept = its;
+  reuse.cut();
+  if (reason != KSP_DIVERGED_ITS) VecSet(x[k], 0.0);  // from where CG stopped, unless it broke down
+  set_operators(false);
+  rebuilt = true;
+  reason = run_solver(k, its);
+  its += on_kept;
+  return reason;
+}
+
 /// Solves load case k; a solve that fails is run once more from zero with the safe smoother
 /// before the failure is the user's (then most likely a part the supports do not hold).
-void DistElasticity::Impl::solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U) {
+/// Returns true when the preconditioner was set up anew during the solve.
+bool DistElasticity::Impl::solve_case(const Eigen::MatrixXd& loads, long k, Eigen::MatrixXd& U) {
   PetscScalar* f = nullptr;
   VecGetArray(b, &f);
   for (long i = 0; i < 3L * mesh.owned_nodes; ++i) f[i] = dof[i] >= 0 ? loads(i, k) : 0.0;
   VecRestoreArray(b, &f);
   while (static_cast<long>(x.size()) <= k) x.push_back(ghosted_vector());
   PetscInt its = 0;
-  KSPConvergedReason reason = run_solver(k, its);
+  bool rebuilt = false;
+  KSPConvergedReason reason = run_kept_solver(k, its, rebuilt);
   if (reason < 0 && !safe_smoother) {
     if (session.rank() == 0)
       std::cerr << "[dist] the multigrid solve failed (PETSc reason " << static_cast<int>(reason) << " after " << its
                 << " iterations); solving again with SOR smoothing" << std::endl;
+    reuse.set_up();
     use_safe_smoother();
+    rebuilt = true;
     VecSet(x[k], 0.0);
     reason = run_solver(k, its);
   }
@@ -236,6 +312,7 @@ void DistElasticity::Impl::solve_case(const Eigen::MatrixXd& loads, long k, Eige
   for (long i = 0; i < U.rows(); ++i) U(i, k) = dof[i] >= 0 ? u[i] : 0.0;
   VecRestoreArrayRead(local, &u);
   VecGhostRestoreLocalForm(x[k], &local);
+  return rebuilt;
 }
 
 DistElasticity::DistElasticity(const MpiSession& session, const DistMesh& mesh, const fem::Material& material,
@@ -260,14 +337,35 @@ Eigen::MatrixXd DistElasticity::solve(const Eigen::MatrixXd& loads) {
   if (m.dirty) {
     check_petsc(MatZeroEntries(m.K), "MatZeroEntries");
     m.insert(m.K, true);
-    check_petsc(KSPSetOperators(m.ksp, m.K, m.K), "KSPSetOperators");
+    // the serial multigrid's rule (fem::HierarchyReuse): keep the preconditioner while solves on
+    // it stay within 1.5 × the first one's iterations plus 4; a refresh after a cut short solve
+    // is, on PETSc, a new set-up (the Galerkin products are most of GAMG's set-up)
+    bool keep = m.reuse.keep(m.built);
+    if (keep && m.reuse.refresh_coarse_on_update()) {
+      keep = false;
+    } else if (!keep) {
+      m.reuse.set_up();
+    }
+    m.set_operators(keep);
     m.dirty = false;
   }
   m.iterations = 0;
+  bool rebuilt = false;
   Eigen::MatrixXd U(3 * m.mesh.local.V.rows(), loads.cols());
-  for (long k = 0; k < loads.cols(); ++k) m.solve_case(loads, k, U);
+  for (long k = 0; k < loads.cols(); ++k) rebuilt = m.solve_case(loads, k, U) || rebuilt;
+  if (!rebuilt) m.reuse.record(m.iterations);
   return U;
 }
+
+void DistElasticity::set_tolerance(double tolerance) {
+  Impl& m = *impl_;
+  if (tolerance == m.params.tolerance) return;
+  m.params.tolerance = tolerance;
+  m.reuse.rebaseline();  // iteration counts at another tolerance say nothing of a stale preconditioner
+  check_petsc(KSPSetTolerances(m.ksp, tolerance, 1e-300, 1e300, m.params.max_iterations), "KSPSetTolerances");
+}
+
+int DistElasticity::setups() const { return impl_->setups; }
 
 /// f(t, ε_t) for each local tet t, ε_t its strain under the local displacements u.
 template <class F>

@@ -23,6 +23,11 @@ struct DistSolverParams {
   double tolerance = 1e-8;    ///< relative residual ‖b − K u‖ / ‖b‖
   int max_iterations = 5000;  ///< CG iterations per solve
   Amg amg = Amg::GAMG;        ///< the preconditioner (PETSC_OPTIONS may still override it)
+  /// Keep the multigrid built for an earlier matrix while it still pays, by the serial
+  /// multigrid's rule (fem::HierarchyReuse: until a solve needs 1.5 × the iterations of the first
+  /// one on it, plus 4; a solve that reaches that is finished on a new set-up). SIMP's
+  /// SolverParams::recycle_factor; false: a new set-up for every new matrix.
+  bool reuse = true;
 };
 
 /// The Amg named `name` ("gamg" or "boomeramg"); throws Error(InvalidParameter) naming the
@@ -57,6 +62,13 @@ class DistElasticity {
 
   /// CG iterations of the last solve (the largest over the load cases).
   int last_iterations() const;
+
+  /// CG's relative residual from the next solve on (SIMP's early loose tolerance,
+  /// simp::solver_tolerance). Collective (every rank must pass the same value).
+  void set_tolerance(double tolerance);
+
+  /// Preconditioner set-ups so far (the rest of the solves ran on a kept one).
+  int setups() const;
 
  private:
   struct Impl;

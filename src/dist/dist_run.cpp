@@ -32,17 +32,19 @@ struct SimpCore {
   double tol_change = 0.01;
   double tol_objective = 1e-4;
   fem::SolverParams solver;
+  double early_solver_tolerance = 1e-3;
 
   static SimpCore of(const simp::SimpParams& p) {
     return {p.volume_fraction, p.law,           p.filter, p.sensitivity_filter,
             p.projection,      p.update,        p.move,   p.max_iterations,
-            p.tol_change,      p.tol_objective, p.solver};
+            p.tol_change,      p.tol_objective, p.solver, p.early_solver_tolerance};
   }
   simp::SimpParams params() const {
     simp::SimpParams p;
     p.volume_fraction = volume_fraction, p.law = law, p.filter = filter, p.sensitivity_filter = sensitivity_filter;
     p.projection = projection, p.update = update, p.move = move, p.max_iterations = max_iterations;
     p.tol_change = tol_change, p.tol_objective = tol_objective, p.solver = solver;
+    p.early_solver_tolerance = early_solver_tolerance;
     return p;
   }
 };
@@ -178,6 +180,7 @@ simp::SimpResult optimize_on_ranks(const MpiSession& session, const TetMesh& mes
   settings.solver.tolerance = params.solver.tolerance;
   settings.solver.max_iterations = params.solver.max_iterations;
   settings.solver.amg = amg;
+  settings.solver.reuse = params.solver.recycle_factor;
   settings.cases = static_cast<int>(loads.cols());
   simp::FilterParams& f = settings.simp.filter;
   f.radius = simp::filter_radius(mesh, f);

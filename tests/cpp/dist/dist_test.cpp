@@ -149,6 +149,49 @@ TEST(DistElasticity, DisplacementsEqualTheSerialSolve) {
   EXPECT_GT(stats[1].peak_bytes, 0);
 }
 
+/// Element factors of this rank's tets: 1 + amplitude · sin of the centroid's x (a smooth
+/// change of stiffness, as one SIMP step makes), floored at `floor`.
+VecXd wavy_scale(const DistMesh& d, double amplitude, double floor) {
+  VecXd s(d.local.T.rows());
+  for (long t = 0; t < s.size(); ++t) {
+    double x = 0;
+    for (int a = 0; a < 4; ++a) x += 0.25 * d.local.V(d.local.T(t, a), 0);
+    s[t] = std::max(floor, 1 + amplitude * std::sin(x / 4));
+  }
+  return s;
+}
+
+/// SIMP's next matrix solves on the multigrid set up for the previous one (no new set-up) and
+/// still meets the tolerance: its displacements equal those of a solver set up for it. A
+/// large change solves as accurately (on a kept or a new set-up, the reuse rule's choice);
+/// with reuse off every new matrix gets its own set-up.
+TEST(DistElasticity, AKeptMultigridSolvesTheNextMatrixToTheTolerance) {
+  const Beam b = make_beam();
+  const DistMesh d = distribute(b);
+  DistSolverParams params;
+  params.tolerance = 1e-10;
+  DistElasticity kept(session(), d, b.material, params);
+  params.reuse = false;
+  DistElasticity fresh(session(), d, b.material, params);
+  for (DistElasticity* fe : {&kept, &fresh}) fe->solve(d.loads);
+  const int first = kept.last_iterations();
+  for (double amplitude : {0.2, 0.999}) {
+    const VecXd scale = wavy_scale(d, amplitude, 1e-3);
+    kept.set_scale(scale);
+    fresh.set_scale(scale);
+    const Eigen::MatrixXd Uk = kept.solve(d.loads), Uf = fresh.solve(d.loads);
+    double diff = (Uk - Uf).squaredNorm(), norm = Uf.squaredNorm();
+    MPI_Allreduce(MPI_IN_PLACE, &diff, 1, MPI_DOUBLE, MPI_SUM, session().comm());
+    MPI_Allreduce(MPI_IN_PLACE, &norm, 1, MPI_DOUBLE, MPI_SUM, session().comm());
+    EXPECT_LT(std::sqrt(diff), 1e-6 * std::sqrt(norm)) << "amplitude " << amplitude;
+    if (amplitude == 0.2) {
+      EXPECT_EQ(kept.setups(), 1) << "a small change keeps the set-up";
+      EXPECT_LE(kept.last_iterations(), static_cast<int>(1.5 * first) + 4);
+    }
+  }
+  EXPECT_EQ(fresh.setups(), 3);
+}
+
 /// A user's smoother setting that makes Chebyshev amplify the highest modes (it aims at a fifth
 /// of the largest eigenvalue) breaks CG; the solve is run again with SOR smoothing and still
 /// gives the direct solver's displacements, and says so.
