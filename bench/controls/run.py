@@ -69,6 +69,13 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
     """Share of the surface's downward-facing area (normal n with n·up < 0, off the base plate
     at the lowest point along up) whose normal lies within `angle` of −up: too flat to print
     without supports (the measure of simp/controls/overhang_measure.h)."""
+    _, area, down, flat = _down_and_flat(stl, up, angle, tol)
+    return area[flat].sum() / max(area[down].sum(), 1e-30)
+
+
+def _down_and_flat(stl, up, angle, tol):
+    """The STL's triangles (#T x 3 x 3), their areas, and flags: facing down along `up` (off the
+    base plate at the lowest point), and of those, within `angle` of −up."""
     tris = benchlib.read_stl(stl)
     n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     area = np.linalg.norm(n, axis=1) / 2
@@ -77,7 +84,7 @@ def overhang_share(stl, up, angle=45.0, tol=1e-3):
     on_plate = (s.min(1) >= plate - tol) & (s.max(1) <= plate + tol)
     down = (n @ up < 0) & ~on_plate & (area > 0)
     flat = down & (-(n @ up) > np.cos(np.radians(angle)) * 2 * area)
-    return area[flat].sum() / max(area[down].sum(), 1e-30)
+    return tris, area, down, flat
 
 
 def _nondesign_boundary(points, tets, domain):
@@ -122,14 +129,7 @@ def overhang_on_given_faces(stl, up, vtu, angle=45.0, tol=1e-3):
     import crisp  # noqa: E402
     points, tets, arrays = crisp.read_vtu(vtu)
     inside, outside = _nondesign_boundary(points, tets, arrays["domain"].astype(np.int64))
-    tris = benchlib.read_stl(stl)
-    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    area = np.linalg.norm(n, axis=1) / 2
-    s = tris @ up
-    plate = s.min()
-    on_plate = (s.min(1) >= plate - tol) & (s.max(1) <= plate + tol)
-    down = (n @ up < 0) & ~on_plate & (area > 0)
-    flat = down & (-(n @ up) > np.cos(np.radians(angle)) * 2 * area)
+    tris, area, down, flat = _down_and_flat(stl, up, angle, tol)
     centroids = tris[down].mean(axis=1)
     bared, given = np.zeros(len(tris), dtype=bool), np.zeros(len(tris), dtype=bool)
     if len(inside):
