@@ -296,8 +296,9 @@ TEST(DesignHygiene, ANodeAtTheThresholdWhoseTetsAllAverageBelowItLeavesNoCrumb) 
   const VecXd nd = node_densities(m, d);
   ASSERT_GE(nd[n], 0.5);
   for (long t = 0; t < m.T.rows(); ++t)
-    if ((m.T.row(t).array() == n).any())
+    if ((m.T.row(t).array() == n).any()) {
       ASSERT_LT(0.25 * (nd[m.T(t, 0)] + nd[m.T(t, 1)] + nd[m.T(t, 2)] + nd[m.T(t, 3)]), 0.5);
+    }
   // the premise holds: the crisp tets make one piece, the result shape two
   int crisp_count = 0, level_count = 0;
   node_components(m, crisp_tets(m, nd, 0.5), crisp_count);
@@ -337,8 +338,9 @@ TEST(DesignHygiene, ANodeBelowTheThresholdWhoseTetsAllAverageAboveItLeavesNoCavi
   const VecXd nd = node_densities(m, d);
   ASSERT_LT(nd[n], 0.5);
   for (long t = 0; t < m.T.rows(); ++t)
-    if ((m.T.row(t).array() == n).any())
+    if ((m.T.row(t).array() == n).any()) {
       ASSERT_GE(0.25 * (nd[m.T(t, 0)] + nd[m.T(t, 1)] + nd[m.T(t, 2)] + nd[m.T(t, 3)]), 0.5);
+    }
   for (const bool fill : {true, false}) {
     SCOPED_TRACE(fill ? "voids filled" : "voids allowed");
     HygieneParams params;
