@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/types.h"
+#include "mesh/core/tet_components.h"
 #include "result/iso_surface.h"
 
 namespace topopt::result {
@@ -52,15 +53,9 @@ MatX4i tet_neighbours(const MatX4i& T);
 /// densities (#V) average at least `threshold`.
 std::vector<char> crisp_tets(const TetMesh& mesh, const VecXd& node_density, double threshold);
 
-/// Face-connected components of the tets with mask[t] set, over `neighbours` (#T by 4).
-/// Returns #T labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
-VecXi tet_components(const MatX4i& neighbours, const std::vector<char>& mask, int& count);
-
-/// Components of the tets with mask[t] set that share a node (pieces touching at an edge or a
-/// corner are one; the verification's tets, which fill the result surface, are joined so;
-/// the pieces of the result shape cut from node densities are level_components'). Returns #T
-/// labels, 0..count-1 for masked tets, -1 for the others; `count` gets the number.
-VecXi node_components(const TetMesh& mesh, const std::vector<char>& mask, int& count);
+// the pieces of a set of tets, by shared faces or shared nodes (mesh/core/tet_components.h)
+using mesh::node_components;
+using mesh::tet_components;
 
 /// Pieces of the result shape: the region where the interpolated node densities (#V) reach
 /// `threshold` (nodes at or above it are inside, as extract_iso_surface decides) in the design

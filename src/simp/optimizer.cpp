@@ -3,10 +3,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <numeric>
 #include <sstream>
 
 #include "common/blas_threads.h"
+#include "mesh/core/tet_components.h"
 #include "common/error.h"
 #include "simp/controls/design_map.h"
 #include "simp/controls/draw_filter.h"
@@ -305,36 +305,28 @@ void report_iteration(const IterationRecord& rec, int max_iterations, SimpResult
 
 /// With a minimum member size: whether the eroded design (the physical densities `eroded`, #D, of
 /// the design tets `design`) joins the supports to the loads — its tets at ρ̄ ≥ ½ and the
-/// non-design tets, joined when they share a node (the hygiene's rule for crisp pieces), hold a
-/// piece that touches a supported node (`supported_dofs`, 3 per node) and a loaded one (`loads`,
-/// 3#V by cases).
+/// non-design tets, joined when they share a node (mesh::node_components, the hygiene's rule for
+/// crisp pieces), hold a piece that touches a supported node (`supported_dofs`, 3 per node) and a
+/// loaded one (`loads`, 3#V by cases).
 bool eroded_design_joins(const TetMesh& mesh, const std::vector<int>& design, const VecXd& eroded,
                          const std::vector<int>& supported_dofs, const Eigen::MatrixXd& loads) {
   const long nt = mesh.T.rows(), nv = mesh.V.rows();
   std::vector<char> solid(static_cast<size_t>(nt), 1), supported(static_cast<size_t>(nv), 0),
-      loaded(static_cast<size_t>(nv), 0), holds_support(static_cast<size_t>(nt), 0);
+      loaded(static_cast<size_t>(nv), 0);
   for (size_t i = 0; i < design.size(); ++i) solid[design[i]] = eroded[static_cast<long>(i)] >= 0.5;
-  std::vector<long> parent(static_cast<size_t>(nt)), at_node(static_cast<size_t>(nv), -1);
-  std::iota(parent.begin(), parent.end(), 0L);
-  auto root = [&](long t) {
-    while (parent[t] != t) t = parent[t] = parent[parent[t]];
-    return t;
-  };
-  for (long t = 0; t < nt; ++t)
-    for (int a = 0; a < 4 && solid[t]; ++a) {
-      long& first = at_node[mesh.T(t, a)];
-      if (first < 0) first = t;
-      parent[root(t)] = root(first);
-    }
   for (int dof : supported_dofs) supported[dof / 3] = 1;
   for (long i = 0; i < loads.rows() && i / 3 < nv; ++i)
     if (loads.row(i).cwiseAbs().maxCoeff() > 0) loaded[i / 3] = 1;
+  int count = 0;
+  const VecXi piece = mesh::node_components(mesh, solid, count);
+  std::vector<char> holds_support(static_cast<size_t>(count), 0), holds_load(static_cast<size_t>(count), 0);
   for (long t = 0; t < nt; ++t)
-    for (int a = 0; a < 4 && solid[t]; ++a)
-      if (supported[mesh.T(t, a)]) holds_support[root(t)] = 1;
-  for (long t = 0; t < nt; ++t)
-    for (int a = 0; a < 4 && solid[t]; ++a)
-      if (loaded[mesh.T(t, a)] && holds_support[root(t)]) return true;
+    for (int a = 0; a < 4 && piece[t] >= 0; ++a) {
+      holds_support[piece[t]] |= supported[mesh.T(t, a)];
+      holds_load[piece[t]] |= loaded[mesh.T(t, a)];
+    }
+  for (int c = 0; c < count; ++c)
+    if (holds_support[c] && holds_load[c]) return true;
   return false;
 }
 

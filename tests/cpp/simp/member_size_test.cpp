@@ -17,6 +17,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/elasticity.h"
 #include "mesh/core/structured_box.h"
+#include "mesh/core/tet_components.h"
 #include "result/design_hygiene.h"
 #include "result/iso_surface.h"
 #include "simp/controls/member_measure.h"
@@ -137,23 +138,16 @@ bool eroded_design_connects(const Cantilever& b, const SimpParams& p, const Simp
   std::vector<char> solid(static_cast<size_t>(nt), 0);
   for (long t = 0; t < nt; ++t) solid[t] = b.mesh.domain[t] != 0;
   for (size_t i = 0; i < prob.design().size(); ++i) solid[prob.design()[i]] = prob.physical_densities()[i] >= 0.5;
-  std::vector<long> parent(static_cast<size_t>(nt)), at_node(static_cast<size_t>(b.mesh.V.rows()), -1);
-  std::iota(parent.begin(), parent.end(), 0L);
-  std::function<long(long)> root = [&](long t) { return parent[t] == t ? t : parent[t] = root(parent[t]); };
-  for (long t = 0; t < nt; ++t)
-    for (int a = 0; a < 4 && solid[t]; ++a) {
-      long& first = at_node[b.mesh.T(t, a)];
-      if (first < 0) first = t;
-      parent[root(t)] = root(first);
-    }
+  int count = 0;
+  const VecXi piece = mesh::node_components(b.mesh, solid, count);
   std::vector<char> supported(static_cast<size_t>(b.mesh.V.rows()), 0);
   for (int dof : b.supports.dofs) supported[dof / 3] = 1;
   long pad = -1;
   for (long t = 0; t < nt && pad < 0; ++t)
-    if (b.mesh.domain[t] != 0) pad = root(t);
+    if (b.mesh.domain[t] != 0) pad = piece[t];
   for (long t = 0; t < nt; ++t)
     for (int a = 0; a < 4; ++a)
-      if (solid[t] && supported[b.mesh.T(t, a)] && root(t) == pad) return true;
+      if (solid[t] && supported[b.mesh.T(t, a)] && piece[t] == pad) return true;
   return false;
 }
 
