@@ -55,7 +55,10 @@ EXAMPLES = {
                     "load_cases": [{"name": "down", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 0, -10000]}]},
                                    {"name": "side", "loads": [{"type": "force", "faces": ["Face8"], "vector": [0, 5000, 0]}]}]}),
 }
-SETTINGS = {"before": {"heaviside": False}, "after": {}}
+SETTINGS = {"before": {"heaviside": False}, "after": {},
+            # today's defaults with the non-design solids the design leaves apart not joined
+            # (the job's "result" section; branch join7)
+            "apart": {"result": {"join_non_design": False}}}
 # --surface: the result surface as it was (Taubin smoothing only) and as it is now (remeshed
 # before and after the smoothing, crossings repaired), on the same job with the new SIMP defaults
 SURFACE_SETTINGS = {"surface before": {"surface_remesh": False, "surface_repair": False}, "surface after": {}}
@@ -100,14 +103,19 @@ def stl_shells(path):
 
 
 def optimize(build, work, name, setting, options, size=None):
-    """topopt optimize on the example with the "optimization" options; returns (job path,
-    output folder, wall s, CPU s, history.json)."""
+    """topopt optimize on the example with the "optimization" options (a "result" key among
+    them is the job's "result" section); returns (job path, output folder, wall s, CPU s,
+    history.json)."""
     size = size or EXAMPLES[name][0]
+    options = dict(options)
+    result = options.pop("result", None)
     out = os.path.join(work, (name + "_" + setting).replace(" ", "_"))
     job = {"part": os.path.join(DATA, name + ".step"), "nondesign": os.path.join(DATA, name + "_nondesign.step"),
            "mesh": {"size": size}, "material": {"E": 210000.0, "nu": 0.3},
            "optimization": dict({"volume_fraction": 0.3}, **options), "output": {"directory": out}}
     job.update(EXAMPLES[name][1])
+    if result:
+        job["result"] = result
     path = out + ".json"
     json.dump(job, open(path, "w"), indent=1)
     wall, cpu, _ = run([os.path.join(build, "topopt"), "optimize", path, "--quiet"])
@@ -153,7 +161,8 @@ def one(build, work, name, setting):
     c, per_case, solved = crisp_compliance(build, path, out, points, tets, keep, name)
     cad = cad_columns(out)
     solids, voids = stl_shells(os.path.join(out, "result.stl"))
-    return {**cad, "stl_solids": solids, "stl_voids": voids, "warnings": h.get("design", {}).get("warnings", []), "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
+    return {**cad, "stl_solids": solids, "stl_voids": voids, "warnings": h.get("design", {}).get("warnings", []),
+            "bridges": h.get("design", {}).get("bridges", []), "tets": len(tets), "iterations": len(h["history"]), "status": h["status"], "simp_s": h["seconds"]["simp"],
             "wall_s": wall, "cpu_s": cpu, "grey": crisp.grey_share(density, domain, vol),
             "compliance_simp": h["history"][-1]["compliance"], "crisp": c, "crisp_cases": per_case, "crisp_tets": solved,
             "kept_tets": int(keep.sum()), **surface_row(h)}

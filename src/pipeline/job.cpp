@@ -149,10 +149,12 @@ OutputSettings parse_output(const json& section, const std::string& base_dir) {
   return o;
 }
 
-/// The "result" section: how the result surface is made; only its resolution for now.
+/// The "result" section: how the result surface is made (its resolution) and whether the
+/// non-design solids the design leaves apart are joined to it (join_non_design).
 void parse_result(const json& section, OptimizeSettings& o) {
-  const Fields f(section, "result", {"resolution"}, "{\"resolution\": 2}");
+  const Fields f(section, "result", {"resolution", "join_non_design"}, "{\"resolution\": 2}");
   o.smooth.resolution = f.integer("resolution", o.smooth.resolution, 1, 2);
+  o.hygiene.join_non_design = f.boolean("join_non_design", o.hygiene.join_non_design);
 }
 
 /// A list section: each element parsed by `one(element, index)`.

@@ -59,9 +59,17 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
   json apart = json::array();
   for (const auto& p : h.apart)
     apart.push_back({{"volume", p.volume}, {"nondesign", p.nondesign}, {"removed", p.removed}});
+  json bridges = json::array();
+  for (const auto& b : h.bridges)
+    bridges.push_back({{"nondesign", b.nondesign},
+                       {"volume", b.volume},
+                       {"length", b.length},
+                       {"size", b.size},
+                       {"joined", b.joined}});
   j["design"] = {{"pieces", h.pieces},
                  {"anchored_pieces", h.anchored_pieces},
                  {"apart", apart},
+                 {"bridges", bridges},
                  {"voids_filled", h.voids_filled},
                  {"void_volume_filled", h.void_volume_filled},
                  {"voids_kept", h.voids_kept},
@@ -156,6 +164,13 @@ double held_share(const TetMesh& mesh, const TetMesh& held) {
 }
 
 }  // namespace
+
+result::HygieneParams hygiene_params(const TetMesh& mesh, const OptimizeSettings& settings) {
+  result::HygieneParams h = settings.hygiene;
+  const double min_size = settings.simp.controls.member.min_size;
+  h.bridge_size = min_size > 0 ? min_size : 2 * simp::filter_radius(mesh, settings.simp.filter);
+  return h;
+}
 
 std::vector<int> loaded_faces(const Job& job) {
   std::vector<int> faces;
@@ -279,7 +294,7 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   const double kept = simp_kept + (1 - simp_kept) * share;
   r.surface =
       result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold, anchor_nodes(mesh, job),
-                     set.hygiene, &r.hygiene, &r.design, progress, &r.surface_report, source);
+                     hygiene_params(mesh, set), &r.hygiene, &r.design, progress, &r.surface_report, source);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();

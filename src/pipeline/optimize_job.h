@@ -52,6 +52,12 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
                             const std::function<void(const simp::IterationRecord&)>& on_iteration = {},
                             const SimpRunner& runner = {}, const result::SourceFaces* source = nullptr);
 
+/// The hygiene of a job's result on `mesh`: settings.hygiene with the bridges' diameter (the
+/// non-design solids joined, result::HygieneParams::bridge_size) the minimum member size when
+/// set (controls.member.min_size), else the density filter's diameter (twice the radius SIMP
+/// uses on this mesh, simp::filter_radius).
+result::HygieneParams hygiene_params(const TetMesh& mesh, const OptimizeSettings& settings);
+
 /// The faces of Ω a support or a force or pressure of `job` acts on (1-based, ascending;
 /// gravity has none).
 std::vector<int> loaded_faces(const Job& job);

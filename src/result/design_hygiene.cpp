@@ -13,6 +13,7 @@
 #include "common/face_key.h"
 #include "common/triangle_closest.h"
 #include "result/iso_surface.h"
+#include "result/join_bridges.h"
 
 namespace topopt::result {
 
@@ -45,14 +46,6 @@ double tet_volume(const TetMesh& mesh, long t) {
   return std::abs(
              (node(mesh, mesh.T(t, 1)) - a).cross(node(mesh, mesh.T(t, 2)) - a).dot(node(mesh, mesh.T(t, 3)) - a)) /
          6;
-}
-
-/// "non-design solid 2", "non-design solids 2 and 3", "non-design solids 1, 2 and 4".
-std::string solids_named(const std::vector<int>& tags) {
-  std::ostringstream s;
-  s << (tags.size() == 1 ? "non-design solid " : "non-design solids ");
-  for (size_t i = 0; i < tags.size(); ++i) s << (i == 0 ? "" : i + 1 == tags.size() ? " and " : ", ") << tags[i];
-  return s.str();
 }
 
 std::string mm3(double v) {
@@ -88,6 +81,13 @@ Pieces measure_pieces(const TetMesh& mesh, const VecXd& nd, double threshold, co
   }
   for (int c = 0; c < count; ++c) p.centre[c] /= std::max(p.volume[c], 1e-300);
   return p;
+}
+
+/// What piece_fates looks at of each piece.
+std::vector<PieceFacts> facts_of(const Pieces& p) {
+  std::vector<PieceFacts> facts(p.volume.size());
+  for (size_t c = 0; c < facts.size(); ++c) facts[c] = {p.touch[c], !p.nondesign[c].empty(), p.volume[c]};
+  return facts;
 }
 
 std::string at(const Point& x) {
@@ -134,9 +134,7 @@ void remove_pieces(const TetMesh& mesh, const VecXd& nd, double threshold, const
   int count = 0;
   const VecXi label = level_components(mesh, nd, threshold, count);
   const Pieces p = measure_pieces(mesh, nd, threshold, label, count, anchors);
-  std::vector<PieceFacts> facts(count);
-  for (int c = 0; c < count; ++c) facts[c] = {p.touch[c], !p.nondesign[c].empty(), p.volume[c]};
-  const std::vector<PieceFate> fate = piece_fates(facts);
+  const std::vector<PieceFate> fate = piece_fates(facts_of(p));
   report.pieces = count;
   std::vector<std::string> main_names;
   for (int c = 0; c < count; ++c) {
@@ -298,6 +296,18 @@ bool changed_design(const HygieneReport& round) {
 
 }  // namespace
 
+std::string solids_named(const std::vector<int>& tags) {
+  std::ostringstream s;
+  s << (tags.size() == 1 ? "non-design solid " : "non-design solids ");
+  for (size_t i = 0; i < tags.size(); ++i) s << (i == 0 ? "" : i + 1 == tags.size() ? " and " : ", ") << tags[i];
+  return s.str();
+}
+
+std::vector<PieceFacts> level_piece_facts(const TetMesh& mesh, const VecXd& nd, double threshold, const VecXi& label,
+                                          int count, const std::vector<char>& anchors) {
+  return facts_of(measure_pieces(mesh, nd, threshold, label, count, anchors));
+}
+
 MatX4i tet_neighbours(const MatX4i& T) {
   MatX4i nb = MatX4i::Constant(T.rows(), 4, -1);
   std::unordered_map<FaceKey, long, FaceKeyHash> open;
@@ -432,7 +442,10 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
                    const HygieneParams& params, HygieneReport& report) {
   report = HygieneReport{};
   const MatX4i nb = tet_neighbours(mesh.T);
-  VecXd out = density;
+  std::vector<Bridge> bridges;
+  VecXd out = params.join_non_design
+                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges)
+                  : density;
   // Taking a piece out lowers the node densities of the tets around it, filling a void raises
   // them, so the crisp design of the cleaned densities can hold a piece or a void the first
   // round did not see: clean again until a round changes nothing, so that the design handed
@@ -456,6 +469,9 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
     if (!changed_design(round == 0 ? report : found)) break;
   }
   warn_voids(report);
+  for (const Bridge& b : bridges)
+    if (b.joined) report.warnings.push_back(bridge_warning(b));
+  report.bridges = std::move(bridges);
   solid = crisp_tets(mesh, node_densities(mesh, out), threshold);
   report.min_feature = min_feature_size(mesh, nb, solid, report.min_feature_at);
   return out;

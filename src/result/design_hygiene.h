@@ -5,7 +5,9 @@
 // internal voids (unless allowed), those of the crisp design (non-design tets, and design tets
 // whose node densities reach the threshold on average) and those of the result shape, and
 // measures the thinnest member of the crisp design. The finished surface's pieces are checked
-// by the same rule (clean_surface_pieces).
+// by the same rule (clean_surface_pieces). Before all that, the non-design solids the design
+// leaves apart are joined to the rest by bridges through the design (join_bridges.h), unless
+// join_non_design is off.
 #pragma once
 #include <array>
 #include <string>
@@ -22,6 +24,23 @@ inline constexpr char kAnchorSupport = 1, kAnchorLoad = 2;
 
 struct HygieneParams {
   bool fill_voids = true;  ///< fill closed internal voids; false keeps them (printed lattices)
+  /// Join every non-design solid the design leaves apart from the load-carrying piece to it by
+  /// a bridge of solid design tets (join_bridges.h; the job's "result": "join_non_design").
+  /// false: such a solid stays apart, named in a warning.
+  bool join_non_design = true;
+  /// The bridges' diameter (mm): the job's minimum member size if set, else the filter's
+  /// diameter (pipeline::hygiene_params); <= 0: 3 × the mean edge length of the design tets
+  /// (the diameter of the automatic filter).
+  double bridge_size = 0;
+};
+
+/// A bridge that joins a non-design solid apart to the load-carrying piece (join_bridges.h).
+struct Bridge {
+  std::vector<int> nondesign;  ///< the non-design solids of the piece it joins (domain tags)
+  double volume = 0;           ///< material added (mm³): Σ volume × (1 − density) of the tets set solid
+  double length = 0;           ///< along its path, from the piece to the load-carrying one (mm)
+  double size = 0;             ///< its diameter (mm)
+  bool joined = false;         ///< the piece is one with the load-carrying one afterwards
 };
 
 /// A solid piece of the result shape apart from the ones that carry the loads.
@@ -40,10 +59,14 @@ struct HygieneReport {
   double void_volume_filled = 0;   ///< mm³
   int voids_kept = 0;              ///< closed internal voids kept (fill_voids false)
   double void_volume_kept = 0;     ///< mm³
+  std::vector<Bridge> bridges;     ///< bridges made (join_non_design), before the rest of the cleaning
   double min_feature = 0;          ///< thinnest member of the design (mm), 0 if none measured
   std::array<double, 3> min_feature_at{0, 0, 0};  ///< where (the centre of a design tet)
   std::vector<std::string> warnings;              ///< one sentence each, in the user's terms
 };
+
+/// "non-design solid 2", "non-design solids 2 and 3", "non-design solids 1, 2 and 4".
+std::string solids_named(const std::vector<int>& tags);
 
 /// Face neighbours of tets T (#T by 4, positively oriented): #T by 4, entry k the tet across
 /// the face opposite vertex k, -1 on the mesh boundary.
@@ -67,19 +90,26 @@ using mesh::tet_components;
 /// of one piece), -1 for design tets with none inside; `count` gets the number of pieces.
 VecXi level_components(const TetMesh& mesh, const VecXd& node_density, double threshold, int& count);
 
+/// What the rule looks at of a piece.
+struct PieceFacts {
+  char touch = 0;          ///< kAnchorSupport | kAnchorLoad of the anchors it reaches
+  bool nondesign = false;  ///< holds non-design material
+  double volume = 0;       ///< mm³
+};
+
+/// The facts of the pieces of the result shape (labels #T and `count` of level_components at
+/// `threshold` of the node densities nd, #V): the anchors (#V flags; empty when unknown) of its
+/// nodes inside the level and of its non-design tets, whether it holds non-design tets, its
+/// volume (kept_tet_volume). Returns `count` facts.
+std::vector<PieceFacts> level_piece_facts(const TetMesh& mesh, const VecXd& nd, double threshold, const VecXi& label,
+                                          int count, const std::vector<char>& anchors);
+
 /// What becomes of a piece of the result (PieceFate): the one rule, applied to the density
 /// field (clean_design) and to the finished surface (clean_surface_pieces).
 enum class PieceFate : char {
   Carries,  ///< carries the loads: kept
   Removed,  ///< design material only, no load on it: taken out
   Named     ///< apart but kept (non-design solids in it, or a load): named in a warning
-};
-
-/// What the rule looks at of a piece.
-struct PieceFacts {
-  char touch = 0;          ///< kAnchorSupport | kAnchorLoad of the anchors it reaches
-  bool nondesign = false;  ///< holds non-design material
-  double volume = 0;       ///< mm³
 };
 
 /// The rule: the pieces that hold both a support and a load carry the loads (failing those,
@@ -95,7 +125,10 @@ std::vector<PieceFate> piece_fates(const std::vector<PieceFacts>& pieces);
 double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std::vector<char>& solid,
                         std::array<double, 3>& at);
 
-/// Cleans element densities (#T) at the threshold of the result shape. anchors: #V flags
+/// Cleans element densities (#T) at the threshold of the result shape. First, with
+/// params.join_non_design, every non-design solid apart from the load-carrying piece is joined
+/// to it (join_non_design_solids; report.bridges, a warning for each naming the solid, the
+/// material added, the bridge's length and the key that turns it off). anchors: #V flags
 /// (kAnchorSupport | kAnchorLoad) of the nodes where supports and loads act; empty when
 /// unknown. The pieces of the result shape (level_components; a piece reaches the anchors of
 /// its nodes inside the level) go by piece_fates: a removed piece's tets are set to density 0,

@@ -141,6 +141,7 @@ def study_to_job(study):
     }
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]
+    job["result"] = {"join_non_design": bool(getattr(study, "JoinNonDesign", True))}
     job["output"] = {"step": bool(getattr(study, "WriteStep", True)), "verification": bool(getattr(study, "Verify", False))}
     job["optimization"].update(study_responses(study))
     controls = study_controls(study)

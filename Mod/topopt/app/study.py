@@ -175,6 +175,10 @@ class Study:
              "faces stay solid (one element layer, outside the volume fraction), so the result keeps every "
              "face a load or support acts on. Off: the optimisation may remove it (the verification then "
              "stops, naming the face it lost)", True)
+        _add(obj, "App::PropertyBool", "JoinNonDesign", "Optimization",
+             "Join every non-design solid the optimised design leaves apart (a boss or pad that carries no "
+             "load) to the part by a bridge through the design, so the result is one piece; a warning names "
+             "each bridge's solid, material and length. Off: such a solid stays apart, named in a warning", True)
         _add(obj, "App::PropertyString", "GeometryControls", "Optimization",
              "Geometry controls as the job's \"controls\" object in JSON (symmetry planes, cyclic, "
              "patterns, extrusion; docs/optimization.md; lengths in mm, angles in degrees); empty = none. Set with "

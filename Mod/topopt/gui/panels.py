@@ -92,6 +92,9 @@ def _bindings():
     keep = QtGui.QCheckBox("Keep loaded faces")  # its own label: the label column stays narrow
     keep.setToolTip("Keep the material under every supported and loaded face (one element layer stays solid); "
                     "off: the optimisation may remove it, and the verification then stops naming the face")
+    join = QtGui.QCheckBox("Join non-design solids")
+    join.setToolTip("Join every non-design solid the design leaves apart to the part by a bridge through the "
+                    "design, so the result is one piece; off: such a solid stays apart, named in a warning")
     return [
         _Binding("VolumeFraction", volume, lambda w: w.value(), lambda w, v: w.setValue(float(v)),
                  volume.valueChanged),
@@ -102,6 +105,7 @@ def _bindings():
                  mesher.currentIndexChanged),
         _Binding("WallLayers", layers, lambda w: w.value(), lambda w, v: w.setValue(int(v)), layers.valueChanged),
         _Binding("KeepLoadedFaces", keep, lambda w: w.isChecked(), lambda w, v: w.setChecked(bool(v)), keep.toggled),
+        _Binding("JoinNonDesign", join, lambda w: w.isChecked(), lambda w, v: w.setChecked(bool(v)), join.toggled),
     ]
 
 

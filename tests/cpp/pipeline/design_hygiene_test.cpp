@@ -104,12 +104,20 @@ TEST(DesignHygiene, ALoosePieceIsRemovedWithItsVolumeAndTheRestIsOnePiece) {
   EXPECT_TRUE(again.warnings.empty());
 }
 
+/// The hygiene with result.join_non_design off: non-design solids apart stay apart, named.
+HygieneParams apart_kept() {
+  HygieneParams h;
+  h.join_non_design = false;
+  return h;
+}
+
 TEST(DesignHygiene, ANonDesignSolidApartFromTheSupportsIsNamedAndKept) {
   // non-design solids 1 at x = 0 (supported) and 2 at x = 10, the design between them empty
+  // (join_non_design off; join_bridges_test has it on)
   const TetMesh m = cube({{0, 0, 0, 2, 10, 10}, {8, 0, 0, 10, 10, 10}});
   const VecXd d = densities(m, {});
   HygieneReport rep;
-  const VecXd clean = clean_design(m, d, 0.5, anchors_at_x0(m), {}, rep);
+  const VecXd clean = clean_design(m, d, 0.5, anchors_at_x0(m), apart_kept(), rep);
   ASSERT_EQ(rep.apart.size(), 1u);
   EXPECT_FALSE(rep.apart[0].removed);
   EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{2});
@@ -122,7 +130,7 @@ TEST(DesignHygiene, ANonDesignSolidApartFromTheSupportsIsNamedAndKept) {
   std::vector<char> both = anchors_at_x0(m);
   for (long v = 0; v < m.V.rows(); ++v)
     if (m.V(v, 0) > 10 - 1e-9) both[v] = kAnchorLoad;
-  clean_design(m, d, 0.5, both, {}, rep);
+  clean_design(m, d, 0.5, both, apart_kept(), rep);
   EXPECT_EQ(rep.anchored_pieces, 2);
   ASSERT_EQ(rep.warnings.size(), 1u);
   EXPECT_NE(rep.warnings[0].find("falls apart into 2 pieces"), std::string::npos) << rep.warnings[0];
@@ -139,7 +147,7 @@ TEST(DesignHygiene, APieceWithASupportButNoLoadIsApartFromTheOneCarryingTheLoad)
     if (m.V(v, 2) > 10 - 1e-9 && m.V(v, 0) < 2 + 1e-9) anchors[v] |= kAnchorLoad;
   }
   HygieneReport rep;
-  clean_design(m, densities(m, {}), 0.5, anchors, {}, rep);
+  clean_design(m, densities(m, {}), 0.5, anchors, apart_kept(), rep);
   EXPECT_EQ(rep.anchored_pieces, 1);
   ASSERT_EQ(rep.apart.size(), 1u);
   EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{2});

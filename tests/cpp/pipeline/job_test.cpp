@@ -188,6 +188,13 @@ TEST(Job, ResultResolutionIsOneOrTwoAndNamedWhenWrong) {
   expect_message(R"({"result": {"resolutoin": 2}})", ErrorCode::InvalidParameter, {"resolutoin"});
 }
 
+TEST(Job, JoiningNonDesignSolidsIsOnUnlessTheResultSaysFalse) {
+  EXPECT_TRUE(parse_job(R"({})", "/d").optimization.hygiene.join_non_design);
+  EXPECT_TRUE(parse_job(R"({"result": {"join_non_design": true}})", "/d").optimization.hygiene.join_non_design);
+  EXPECT_FALSE(parse_job(R"({"result": {"join_non_design": false}})", "/d").optimization.hygiene.join_non_design);
+  expect_message(R"({"result": {"join_non_design": 1}})", ErrorCode::InvalidParameter, {"'result.join_non_design'"});
+}
+
 TEST(Job, TheStepTriangleBudgetReachesTheExport) {
   // absent: the export's own budget; set: that number; 0: no budget
   const long own = result::StepExportParams{}.max_triangles;

@@ -65,6 +65,9 @@ class ManufacturingPanel(BoxPanelCase):
         keep = [b for b in self.panel.bindings if b.prop == "KeepLoadedFaces"][0]
         self.assertTrue(keep.widget.isChecked())  # on by default
         keep.widget.setChecked(False)
+        join = [b for b in self.panel.bindings if b.prop == "JoinNonDesign"][0]
+        self.assertTrue(join.widget.isChecked())  # on by default
+        join.widget.setChecked(False)
         settle()
 
     def test_each_entry_reaches_the_job_and_shows_again_on_reopen(self):
@@ -86,6 +89,8 @@ class ManufacturingPanel(BoxPanelCase):
         opt = runner.prepare(self.study).job["optimization"]  # what a run hands to the worker
         self.assertEqual(opt["controls"], c)
         self.assertIs(opt["keep_loaded_faces"], False)
+        self.assertFalse(self.study.JoinNonDesign)
+        self.assertIs(runner.prepare(self.study).job["result"]["join_non_design"], False)
         self.assertEqual(opt["update"], "mma")
         reopened = panels.open_study_panel(self.study)
         self.panel = reopened
@@ -100,6 +105,8 @@ class ManufacturingPanel(BoxPanelCase):
         self.assertEqual((p.min_member.value(), p.max_member.value()), (8.0, 12.0))
         keep = [b for b in reopened.bindings if b.prop == "KeepLoadedFaces"][0]
         self.assertFalse(keep.widget.isChecked())
+        join = [b for b in reopened.bindings if b.prop == "JoinNonDesign"][0]
+        self.assertFalse(join.widget.isChecked())
         self.assertTrue(reopened.accept())  # unchanged values are written back unchanged
         self.assertEqual(json.loads(self.study.GeometryControls), c)
 
@@ -119,6 +126,7 @@ class ManufacturingPanel(BoxPanelCase):
         self.assertEqual(c["overhang"], {"direction": [0.0, 0.0, 1.0], "angle": 45.0})
         self.assertNotIn("min_member_size", c)
         self.assertIs(api.job_of(self.study)["optimization"]["keep_loaded_faces"], True)
+        self.assertIs(api.job_of(self.study)["result"]["join_non_design"], True)
 
     def test_a_base_face_off_the_part_or_an_edge_is_refused(self):
         p = self.panel.controls.process

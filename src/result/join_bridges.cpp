@@ -1,0 +1,202 @@
+// Bridges for the non-design solids the optimum leaves apart (see join_bridges.h).
+#include "result/join_bridges.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <set>
+#include <sstream>
+
+#include "result/iso_surface.h"
+
+namespace topopt::result {
+
+namespace {
+
+using Point = Eigen::Vector3d;
+
+Point tet_centre(const TetMesh& mesh, long t) {
+  Point c = Point::Zero();
+  for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(t, k)).transpose();
+  return 0.25 * c;
+}
+
+double tet_volume(const TetMesh& mesh, long t) {
+  const Point a = mesh.V.row(mesh.T(t, 0)).transpose();
+  const Point b = mesh.V.row(mesh.T(t, 1)).transpose(), c = mesh.V.row(mesh.T(t, 2)).transpose(),
+              d = mesh.V.row(mesh.T(t, 3)).transpose();
+  return std::abs((b - a).cross(c - a).dot(d - a)) / 6;
+}
+
+/// 3 × the mean edge length of the design tets (of all tets when there is no design tet).
+double default_size(const TetMesh& mesh) {
+  double sum = 0;
+  long n = 0;
+  for (int pass = 0; pass < 2 && n == 0; ++pass)
+    for (long t = 0; t < mesh.T.rows(); ++t) {
+      if (pass == 0 && mesh.domain[t] != 0) continue;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) sum += (mesh.V.row(mesh.T(t, a)) - mesh.V.row(mesh.T(t, b))).norm(), ++n;
+    }
+  return n ? 3 * sum / n : 0;
+}
+
+/// The pieces of the result shape at `threshold` of the densities: labels (#T), and fates.
+struct Shape {
+  VecXi label;
+  std::vector<PieceFacts> facts;
+  std::vector<PieceFate> fate;
+};
+
+Shape shape_of(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors) {
+  const VecXd nd = node_densities(mesh, density);
+  Shape s;
+  int count = 0;
+  s.label = level_components(mesh, nd, threshold, count);
+  s.facts = level_piece_facts(mesh, nd, threshold, s.label, count, anchors);
+  s.fate = piece_fates(s.facts);
+  return s;
+}
+
+/// The cheapest path of tets from any tet with from[t] to one with to[t] (Dijkstra over the
+/// face neighbours; a step costs the centres' distance × bridge_penalty of the tet entered,
+/// 1 for a non-design tet). Returns the path's tets from `from` to `to`; empty if none.
+std::vector<long> cheapest_path(const TetMesh& mesh, const MatX4i& nb, const std::vector<Point>& centre,
+                                const VecXd& density, const std::vector<char>& from, const std::vector<char>& to) {
+  const long nt = mesh.T.rows();
+  std::vector<double> cost(nt, std::numeric_limits<double>::infinity());
+  std::vector<long> previous(nt, -1);
+  using Item = std::pair<double, long>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (long t = 0; t < nt; ++t)
+    if (from[t]) cost[t] = 0, queue.push({0.0, t});
+  long end = -1;
+  while (!queue.empty()) {
+    const auto [c, t] = queue.top();
+    queue.pop();
+    if (c > cost[t]) continue;
+    if (to[t]) {
+      end = t;
+      break;
+    }
+    for (int k = 0; k < 4; ++k) {
+      const int n = nb(t, k);
+      if (n < 0) continue;
+      const double step =
+          (centre[n] - centre[t]).norm() * (mesh.domain[n] != 0 ? 1.0 : bridge_penalty(density[n]));
+      if (c + step >= cost[n]) continue;
+      cost[n] = c + step, previous[n] = t;
+      queue.push({cost[n], n});
+    }
+  }
+  std::vector<long> path;
+  for (long t = end; t >= 0; t = previous[t]) path.push_back(t);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+/// Distance from x to the segment a-b.
+double to_segment(const Point& x, const Point& a, const Point& b) {
+  const Point d = b - a;
+  const double len2 = d.squaredNorm();
+  const double s = len2 > 0 ? std::clamp((x - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return (x - (a + s * d)).norm();
+}
+
+/// Per node (#V): within `radius` of the polyline through `points`.
+std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& points, double radius) {
+  Point lo = points[0], hi = points[0];
+  for (const Point& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  lo.array() -= radius, hi.array() += radius;
+  std::vector<char> near(mesh.V.rows(), 0);
+  for (long v = 0; v < mesh.V.rows(); ++v) {
+    const Point x = mesh.V.row(v).transpose();
+    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+    for (size_t i = 0; i + 1 < points.size() && !near[v]; ++i) near[v] = to_segment(x, points[i], points[i + 1]) <= radius;
+    if (points.size() == 1) near[v] = (x - points[0]).norm() <= radius;
+  }
+  return near;
+}
+
+std::string mm(double v, const char* unit) {
+  std::ostringstream s;
+  s.precision(v < 10 ? 2 : 4);
+  s << v << unit;
+  return s.str();
+}
+
+}  // namespace
+
+double bridge_penalty(double rho) { return 1 + (kVoidPenalty - 1) * (1 - std::clamp(rho, 0.0, 1.0)); }
+
+VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
+                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges) {
+  const long nt = mesh.T.rows();
+  const Shape before = shape_of(mesh, density, threshold, anchors);
+  std::vector<char> carrying(nt, 0);  // the load-carrying pieces' tets, and those joined to them
+  std::vector<int> apart;             // the pieces to join
+  for (size_t c = 0; c < before.fate.size(); ++c)
+    if (before.fate[c] == PieceFate::Named && before.facts[c].nondesign) apart.push_back(static_cast<int>(c));
+  if (apart.empty()) return density;
+  for (long t = 0; t < nt; ++t)
+    carrying[t] = before.label[t] >= 0 && before.fate[before.label[t]] == PieceFate::Carries;
+  if (size <= 0) size = default_size(mesh);
+  std::vector<Point> centre(nt);
+  for (long t = 0; t < nt; ++t) centre[t] = tet_centre(mesh, t);
+  VecXd out = density;
+  std::vector<long> first_tet;  // a tet of each bridged piece, to check it is joined
+  for (int c : apart) {
+    Bridge bridge;
+    bridge.size = size;
+    std::set<int> tags;
+    std::vector<char> piece(nt, 0);
+    for (long t = 0; t < nt; ++t)
+      if (before.label[t] == c) {
+        piece[t] = 1;
+        if (mesh.domain[t] != 0) tags.insert(mesh.domain[t]);
+      }
+    bridge.nondesign.assign(tags.begin(), tags.end());
+    first_tet.push_back(std::find(piece.begin(), piece.end(), 1) - piece.begin());
+    const std::vector<long> path = cheapest_path(mesh, neighbours, centre, out, piece, carrying);
+    if (path.empty()) {
+      bridges.push_back(bridge);
+      continue;
+    }
+    std::vector<Point> points;
+    for (long t : path) points.push_back(centre[t]);
+    for (size_t i = 0; i + 1 < points.size(); ++i) bridge.length += (points[i + 1] - points[i]).norm();
+    // the path's own nodes too: a chain of nodes inside the level from the piece to the
+    // load-carrying one, whatever the size against the elements
+    std::vector<char> near = nodes_near(mesh, points, 0.5 * size);
+    for (long t : path)
+      for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
+    for (long t = 0; t < nt; ++t) {
+      if (piece[t]) carrying[t] = 1;
+      if (mesh.domain[t] != 0 || !(near[mesh.T(t, 0)] || near[mesh.T(t, 1)] || near[mesh.T(t, 2)] || near[mesh.T(t, 3)]))
+        continue;
+      bridge.volume += tet_volume(mesh, t) * (1 - std::clamp(out[t], 0.0, 1.0));
+      out[t] = 1, carrying[t] = 1;
+    }
+    bridges.push_back(bridge);
+  }
+  // joined: the piece now lies in a load-carrying piece of the result shape
+  const Shape after = shape_of(mesh, out, threshold, anchors);
+  for (size_t i = 0; i < apart.size(); ++i) {
+    Bridge& b = bridges[bridges.size() - apart.size() + i];
+    const int c = after.label[first_tet[i]];
+    b.joined = b.length > 0 && c >= 0 && after.fate[c] == PieceFate::Carries;
+  }
+  return out;
+}
+
+std::string bridge_warning(const Bridge& bridge) {
+  const std::string it = bridge.nondesign.size() > 1 ? "them" : "it";
+  return "joined " + solids_named(bridge.nondesign) + " to the part with a bridge through the design (" +
+         mm(bridge.volume, " mm³") + " of material added, " + mm(bridge.length, " mm") + " long, " +
+         mm(bridge.size, " mm") +
+         " across): the design left " + it + " apart from the supports and loads; \"result\": "
+         "{\"join_non_design\": false} leaves " + it + " apart instead";
+}
+
+}  // namespace topopt::result

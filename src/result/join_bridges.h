@@ -1,0 +1,41 @@
+// Bridges for the non-design solids the optimum leaves apart. A designer's non-design solid (a
+// boss a bolt goes through, a clamp pad) is part of the product even when it carries no load
+// of the study, so the delivered part is one piece: each such solid is joined to the piece that
+// carries the loads by the cheapest path through the design tets, the cost of a step its length
+// times a penalty that grows as the density falls (the path follows the optimum's grey or solid
+// material where there is some), thickened to a member of a given diameter and set solid.
+#pragma once
+#include <vector>
+
+#include "common/types.h"
+#include "result/design_hygiene.h"
+
+namespace topopt::result {
+
+/// The penalty of a step into a design tet of density rho (clamped to [0, 1]): 1 in solid
+/// material, kVoidPenalty in void, linear between.
+inline constexpr double kVoidPenalty = 10;
+double bridge_penalty(double rho);
+
+/// Joins every piece of the result shape (level_components at `threshold` of the node
+/// densities of `density`, #T element densities) that piece_fates names (apart from the
+/// load-carrying pieces, kept) and that holds non-design tets to the load-carrying pieces:
+/// Dijkstra on the tets' face adjacency (neighbours #T by 4, tet_neighbours) from the piece's
+/// tets to the nearest load-carrying tet (or one joined before), a step costing the distance
+/// between the tets' centres times bridge_penalty of the density of the tet entered
+/// (non-design tets: 1); then every design tet with a node within size / 2 of the path (the
+/// polyline through the path's tet centres) or on a tet of the path is set to density 1, so
+/// every such node has node density 1 (the path's nodes join the piece to the load-carrying
+/// one) and the result shape's member there is at least `size` across.
+/// anchors: #V flags (kAnchorSupport | kAnchorLoad; empty: the largest piece carries). size:
+/// the bridges' diameter (mm; <= 0: 3 × the mean edge length of the design tets). Appends one
+/// Bridge per piece to `bridges` (joined: the piece is one with a load-carrying piece in the
+/// returned densities; false when no path exists) and returns the densities (#T).
+VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
+                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges);
+
+/// The warning for a bridge made: the solids it joins, the material it adds, its length and
+/// diameter, and the job key that leaves them apart instead.
+std::string bridge_warning(const Bridge& bridge);
+
+}  // namespace topopt::result

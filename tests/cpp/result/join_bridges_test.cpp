@@ -1,0 +1,215 @@
+// Bridges for the non-design solids the design leaves apart (result/join_bridges.h), on a beam
+// between a supported and a loaded non-design block with an unloaded pad above it, built in
+// code: with the option on the result is one piece, the bridge is at least its set size across
+// beyond a cell, adds little material and says how much, follows grey material where there is
+// some, and the as-built compliance does not rise; with it off the pad stays apart, named.
+#include "result/join_bridges.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mesh/core/structured_box.h"
+#include "pipeline/optimize_job.h"
+#include "result/iso_surface.h"
+#include "result/verification.h"
+#include "simp/density_filter.h"
+
+namespace topopt::result {
+namespace {
+
+constexpr double kCell = 1.0;  // mm, the structured mesh's cell
+constexpr double kSize = 3.0;  // mm, the bridges' diameter
+
+/// 24 x 12 x 12 mm in 1 mm cells (20 736 tets); non-design solid 1 at x = 0 (supported on Ω's
+/// Face1), solid 2 at x = 24 (loaded on its end face, NonDesign:Face8), solid 3 a pad on top
+/// (x 10..18, z 9..12) that no support or load touches. Design densities: 1 in the beam
+/// (y 4..8, z 1..5) between the blocks, `background` elsewhere, `grey` in x 16..18, z 5..9
+/// (a column from the beam to the pad) when given.
+struct PadFixture {
+  TetMesh mesh;
+  VecXd density;
+  std::vector<char> anchors;
+  VerificationProblem problem;
+};
+
+bool in(const Eigen::Vector3d& c, std::array<double, 6> b) {
+  return c[0] > b[0] && c[1] > b[1] && c[2] > b[2] && c[0] < b[3] && c[1] < b[4] && c[2] < b[5];
+}
+
+PadFixture pad_fixture(double background = 0.02, double grey = -1) {
+  mesh::StructuredBoxParams p;
+  p.size = {24, 12, 12};
+  p.cells = {24, 12, 12};
+  p.nondesign = {{0, 3, 0, 3, 9, 6}, {21, 3, 0, 24, 9, 6}, {10, 3, 9, 18, 9, 12}};
+  PadFixture f;
+  f.mesh = mesh::structured_box_mesh(p);
+  const MatX3d c = simp::tet_centroids(f.mesh);
+  f.density.resize(f.mesh.T.rows());
+  for (long t = 0; t < f.mesh.T.rows(); ++t) {
+    const Eigen::Vector3d x = c.row(t).transpose();
+    f.density[t] = f.mesh.domain[t] != 0 || in(x, {0, 4, 1, 24, 8, 5}) ? 1.0
+                   : grey >= 0 && in(x, {16, 3, 5, 18, 9, 9})  ? grey
+                                                               : background;
+  }
+  f.anchors.assign(f.mesh.V.rows(), 0);
+  for (long v = 0; v < f.mesh.V.rows(); ++v) {
+    const Eigen::Vector3d x = f.mesh.V.row(v).transpose();
+    if (x[0] < 1e-9) f.anchors[v] |= kAnchorSupport;
+    if (x[0] > 24 - 1e-9 && x[1] > 3 - 1e-9 && x[1] < 9 + 1e-9 && x[2] < 6 + 1e-9) f.anchors[v] |= kAnchorLoad;
+  }
+  fem::SupportSpec fixed;
+  fixed.faces = {1};
+  fem::LoadSpec down;
+  down.vector = {0, 0, -100};
+  down.nd_faces = {8};
+  f.problem.supports = {fixed};
+  f.problem.load_cases = {{"down", {down}, 1.0}};
+  return f;
+}
+
+HygieneParams joining(bool on) {
+  HygieneParams h;
+  h.join_non_design = on;
+  h.bridge_size = kSize;
+  return h;
+}
+
+double volume_of(const TetMesh& m, long t) {
+  const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                        d = m.V.row(m.T(t, 3));
+  return std::abs((b - a).cross(c - a).dot(d - a)) / 6;
+}
+
+int level_pieces(const TetMesh& m, const VecXd& density) {
+  int count = 0;
+  level_components(m, node_densities(m, density), 0.5, count);
+  return count;
+}
+
+TEST(JoinBridges, ThePenaltyIsOneInSolidAndGrowsAsTheDensityFalls) {
+  EXPECT_DOUBLE_EQ(bridge_penalty(1), 1);
+  EXPECT_DOUBLE_EQ(bridge_penalty(0), kVoidPenalty);
+  EXPECT_DOUBLE_EQ(bridge_penalty(-0.5), kVoidPenalty);
+  for (double r = 0; r < 1; r += 0.1) EXPECT_GT(bridge_penalty(r), bridge_penalty(r + 0.1)) << r;
+}
+
+TEST(JoinBridges, ADetachedPadIsJoinedByABridgeOfTheSetSizeThatAddsLittle) {
+  const PadFixture f = pad_fixture();
+  ASSERT_EQ(level_pieces(f.mesh, f.density), 2);  // the beam with its blocks, and the pad
+  HygieneReport rep;
+  const VecXd clean = clean_design(f.mesh, f.density, 0.5, f.anchors, joining(true), rep);
+  // one piece, nothing named apart
+  EXPECT_EQ(level_pieces(f.mesh, clean), 1);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_TRUE(rep.apart.empty());
+  ASSERT_EQ(rep.bridges.size(), 1u);
+  const Bridge& b = rep.bridges[0];
+  EXPECT_TRUE(b.joined);
+  EXPECT_EQ(b.nondesign, std::vector<int>{3});
+  EXPECT_DOUBLE_EQ(b.size, kSize);
+  // from the pad (z = 9) down to the beam (z = 5): the 4 mm gap, give or take a cell each end
+  EXPECT_GE(b.length, 4 - 2 * kCell);
+  EXPECT_LE(b.length, 4 + 2 * kCell * std::sqrt(3.0));
+  // the material added is what the densities gained, all of it in the gap, and small: within
+  // the tube of the tets reaching within size / 2 of the path
+  double gained = 0, design = 0;
+  for (long t = 0; t < f.mesh.T.rows(); ++t) {
+    if (f.mesh.domain[t] != 0) continue;
+    design += volume_of(f.mesh, t);
+    EXPECT_GE(clean[t], f.density[t]) << t;  // bridges only add
+    gained += volume_of(f.mesh, t) * (clean[t] - f.density[t]);
+  }
+  EXPECT_NEAR(b.volume, gained, 1e-9 * gained);
+  const double reach = kSize / 2 + kCell * std::sqrt(3.0);
+  EXPECT_GT(b.volume, M_PI * kSize * kSize / 4 * 4 * 0.9);  // at least the set size across the gap
+  EXPECT_LT(b.volume, M_PI * reach * reach * (b.length + 2 * reach));
+  EXPECT_LT(b.volume, 0.1 * design);
+  // its thickness: the crisp design's cross-section halfway across the gap (z 6.5 .. 7.5, only
+  // the bridge there): as wide in x and in y as the set size less a cell, and as large as a
+  // disc of that diameter
+  const std::vector<char> crisp = crisp_tets(f.mesh, node_densities(f.mesh, clean), 0.5);
+  const MatX3d cc = simp::tet_centroids(f.mesh);
+  double area = 0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (long t = 0; t < f.mesh.T.rows(); ++t) {
+    if (!crisp[t] || cc(t, 2) < 6.5 || cc(t, 2) > 7.5) continue;
+    area += volume_of(f.mesh, t);
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d x = f.mesh.V.row(f.mesh.T(t, k)).transpose();
+      lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+    }
+  }
+  EXPECT_GE(std::sqrt(4 * area / M_PI), kSize - kCell) << area;
+  EXPECT_GE(hi[0] - lo[0], kSize - kCell);
+  EXPECT_GE(hi[1] - lo[1], kSize - kCell);
+  // the warning names the solid, the material, the length and the key
+  ASSERT_FALSE(rep.warnings.empty());
+  const std::string& w = rep.warnings.back();
+  EXPECT_NE(w.find("joined non-design solid 3"), std::string::npos) << w;
+  EXPECT_NE(w.find("mm³ of material added"), std::string::npos) << w;
+  EXPECT_NE(w.find("long"), std::string::npos) << w;
+  EXPECT_NE(w.find("join_non_design"), std::string::npos) << w;
+  // cleaned once, clean for good: no second bridge
+  HygieneReport again;
+  clean_design(f.mesh, clean, 0.5, f.anchors, joining(true), again);
+  EXPECT_TRUE(again.bridges.empty());
+  EXPECT_TRUE(again.warnings.empty());
+}
+
+TEST(JoinBridges, WithTheOptionOffThePadStaysApartAndNamed) {
+  const PadFixture f = pad_fixture();
+  HygieneReport rep;
+  const VecXd clean = clean_design(f.mesh, f.density, 0.5, f.anchors, joining(false), rep);
+  EXPECT_EQ(clean, f.density);
+  EXPECT_TRUE(rep.bridges.empty());
+  EXPECT_EQ(level_pieces(f.mesh, clean), 2);
+  ASSERT_EQ(rep.apart.size(), 1u);
+  EXPECT_EQ(rep.apart[0].nondesign, std::vector<int>{3});
+  EXPECT_FALSE(rep.apart[0].removed);
+  ASSERT_EQ(rep.warnings.size(), 1u);
+  EXPECT_NE(rep.warnings[0].find("non-design solid 3 is not connected"), std::string::npos) << rep.warnings[0];
+  EXPECT_NE(rep.warnings[0].find("touches no support and no load"), std::string::npos) << rep.warnings[0];
+}
+
+TEST(JoinBridges, TheBridgeFollowsGreyMaterialWhereThereIsSome) {
+  // a grey column (0.4, below the threshold) under the pad's end x 16..18: the path through it
+  // costs less than the void straight below the pad's middle
+  const PadFixture f = pad_fixture(0.02, 0.4);
+  HygieneReport rep;
+  const VecXd clean = clean_design(f.mesh, f.density, 0.5, f.anchors, joining(true), rep);
+  ASSERT_EQ(rep.bridges.size(), 1u);
+  EXPECT_TRUE(rep.bridges[0].joined);
+  const MatX3d c = simp::tet_centroids(f.mesh);
+  double x_sum = 0, v_sum = 0;
+  for (long t = 0; t < f.mesh.T.rows(); ++t)
+    if (f.mesh.domain[t] == 0 && c(t, 2) > 5.5 && c(t, 2) < 8.5 && clean[t] > f.density[t]) {
+      x_sum += volume_of(f.mesh, t) * c(t, 0), v_sum += volume_of(f.mesh, t);
+    }
+  ASSERT_GT(v_sum, 0);
+  EXPECT_GT(x_sum / v_sum, 15.0);  // the column's x 16..18, not the pad's middle (14)
+  EXPECT_LT(x_sum / v_sum, 19.0);
+}
+
+TEST(JoinBridges, TheResultIsOneSolidAndItsAsBuiltComplianceDoesNotRise) {
+  const PadFixture f = pad_fixture();
+  Verification v[2];
+  for (const bool on : {false, true}) {
+    VecXd design;
+    HygieneReport rep;
+    const TriSurface s = pipeline::result_surface(f.mesh, f.density, 0.5, -1, SmoothParams{}, nullptr, f.anchors,
+                                                  joining(on), &rep, &design);
+    v[on] = verify_result(s, f.mesh, design, 0.5, f.problem);
+    // off: the pad is a second solid the as-built analysis leaves out; on: one solid
+    EXPECT_EQ(v[on].unheld_volumes.size(), on ? 0u : 1u);
+  }
+  EXPECT_GT(v[0].as_built.compliance, 0);
+  EXPECT_LE(v[1].as_built.compliance, v[0].as_built.compliance * (1 + 1e-6));
+  EXPECT_LE(v[1].crisp.compliance, v[0].crisp.compliance * (1 + 1e-9));
+}
+
+}  // namespace
+}  // namespace topopt::result
