@@ -61,6 +61,12 @@ class StudyFromScript(unittest.TestCase):
         self.assertEqual(job["mesh"]["mesher"], "auto")
         self.assertNotIn("wall_layers", job["mesh"])  # off unless asked for
 
+    def test_joining_non_design_solids_is_on_unless_the_study_turns_it_off(self):
+        study = self.make()
+        self.assertIs(api.job_of(study)["result"]["join_non_design"], True)
+        study.JoinNonDesign = False
+        self.assertIs(api.job_of(study)["result"]["join_non_design"], False)
+
     def test_wall_layers_reach_the_job_and_are_checked(self):
         study = self.make()
         study.WallLayers = 2
