@@ -48,7 +48,7 @@ const char* kUsage =
     "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
     "     DIR/result.step, the shape as one CAD solid, its curved faces analytic when \"part\"\n"
-    "     is given; optimize: result_first: 1 writes result.json and prints {\"stage\":\n"
+    "     is given, join_non_design: 0 leaves non-design solids apart unjoined; optimize: result_first: 1 writes result.json and prints {\"stage\":\n"
     "     \"result\"} before the verification, result.json again after it),\n"
     "     \"output\": DIR}\n"
     "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
@@ -366,8 +366,10 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   ch.progress("surface", -1, "extracting the result shape");
   double used = 0;
   result::HygieneReport hygiene;  // without supports and loads: the largest piece is kept
+  result::HygieneParams clean;    // the study's JoinNonDesign (1, the default: join)
+  clean.join_non_design = param(r, "join_non_design", 1) != 0;
   const result::TriSurface s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
-                                                        volume_fraction, smooth, &used, {}, {}, &hygiene);
+                                                        volume_fraction, smooth, &used, {}, clean, &hygiene);
   json result = {{"threshold", used}, {"warnings", hygiene.warnings}, {"min_feature", hygiene.min_feature}};
   ch.progress("write", -1, "writing the results");
   put_result_surface(result, r.output, s);

@@ -244,7 +244,9 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     shapes = _source_shapes(study) if step else {}
     return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
                                                  "densities": densities},
-                      params=dict({"threshold": threshold}, **({"step": 1} if step else {})), cancel=cancel,
+                      params=dict({"threshold": threshold,
+                                   "join_non_design": 1 if getattr(study, "JoinNonDesign", True) else 0},
+                                  **({"step": 1} if step else {})), cancel=cancel,
                       timeout=REEXTRACT_TIMEOUT, **shapes)
 
 
