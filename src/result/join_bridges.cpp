@@ -83,8 +83,7 @@ std::vector<long> cheapest_path(const TetMesh& mesh, const MatX4i& nb, const std
     for (int k = 0; k < 4; ++k) {
       const int n = nb(t, k);
       if (n < 0) continue;
-      const double step =
-          (centre[n] - centre[t]).norm() * (mesh.domain[n] != 0 ? 1.0 : bridge_penalty(density[n]));
+      const double step = (centre[n] - centre[t]).norm() * (mesh.domain[n] != 0 ? 1.0 : bridge_penalty(density[n]));
       if (c + step >= cost[n]) continue;
       cost[n] = c + step, previous[n] = t;
       queue.push({cost[n], n});
@@ -113,7 +112,8 @@ std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& poin
   for (long v = 0; v < mesh.V.rows(); ++v) {
     const Point x = mesh.V.row(v).transpose();
     if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
-    for (size_t i = 0; i + 1 < points.size() && !near[v]; ++i) near[v] = to_segment(x, points[i], points[i + 1]) <= radius;
+    for (size_t i = 0; i + 1 < points.size() && !near[v]; ++i)
+      near[v] = to_segment(x, points[i], points[i + 1]) <= radius;
     if (points.size() == 1) near[v] = (x - points[0]).norm() <= radius;
   }
   return near;
@@ -173,7 +173,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     for (long t = 0; t < nt; ++t) {
       if (piece[t]) carrying[t] = 1;
-      if (mesh.domain[t] != 0 || !(near[mesh.T(t, 0)] || near[mesh.T(t, 1)] || near[mesh.T(t, 2)] || near[mesh.T(t, 3)]))
+      if (mesh.domain[t] != 0 ||
+          !(near[mesh.T(t, 0)] || near[mesh.T(t, 1)] || near[mesh.T(t, 2)] || near[mesh.T(t, 3)]))
         continue;
       bridge.volume += tet_volume(mesh, t) * (1 - std::clamp(out[t], 0.0, 1.0));
       out[t] = 1, carrying[t] = 1;
@@ -194,9 +195,10 @@ std::string bridge_warning(const Bridge& bridge) {
   const std::string it = bridge.nondesign.size() > 1 ? "them" : "it";
   return "joined " + solids_named(bridge.nondesign) + " to the part with a bridge through the design (" +
          mm(bridge.volume, " mm³") + " of material added, " + mm(bridge.length, " mm") + " long, " +
-         mm(bridge.size, " mm") +
-         " across): the design left " + it + " apart from the supports and loads; \"result\": "
-         "{\"join_non_design\": false} leaves " + it + " apart instead";
+         mm(bridge.size, " mm") + " across): the design left " + it +
+         " apart from the supports and loads; \"result\": "
+         "{\"join_non_design\": false} leaves " +
+         it + " apart instead";
 }
 
 }  // namespace topopt::result

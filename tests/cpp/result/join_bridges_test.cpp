@@ -52,8 +52,8 @@ PadFixture pad_fixture(double background = 0.02, double grey = -1) {
   for (long t = 0; t < f.mesh.T.rows(); ++t) {
     const Eigen::Vector3d x = c.row(t).transpose();
     f.density[t] = f.mesh.domain[t] != 0 || in(x, {0, 4, 1, 24, 8, 5}) ? 1.0
-                   : grey >= 0 && in(x, {16, 3, 5, 18, 9, 9})  ? grey
-                                                               : background;
+                   : grey >= 0 && in(x, {16, 3, 5, 18, 9, 9})          ? grey
+                                                                       : background;
   }
   f.anchors.assign(f.mesh.V.rows(), 0);
   for (long v = 0; v < f.mesh.V.rows(); ++v) {
@@ -79,8 +79,7 @@ HygieneParams joining(bool on) {
 }
 
 double volume_of(const TetMesh& m, long t) {
-  const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
-                        d = m.V.row(m.T(t, 3));
+  const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)), d = m.V.row(m.T(t, 3));
   return std::abs((b - a).cross(c - a).dot(d - a)) / 6;
 }
 
