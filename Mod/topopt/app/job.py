@@ -142,6 +142,8 @@ def study_to_job(study):
     if n["FilterRadius"] > 0:
         job["optimization"]["filter_radius"] = n["FilterRadius"]
     job["output"] = {"step": bool(getattr(study, "WriteStep", True)), "verification": bool(getattr(study, "Verify", False))}
+    if "StepMaxTriangles" in n:
+        job["output"]["step_max_triangles"] = n["StepMaxTriangles"]
     job["optimization"].update(study_responses(study))
     controls = study_controls(study)
     if controls:
@@ -191,6 +193,7 @@ _NUMBERS = [
     ("Penalty", None, 1.0, 10.0, False, False),
     ("FilterRadius", "mm", 0.0, None, False, False),
     ("MaxIterations", None, 1, 10000, False, False),
+    ("StepMaxTriangles", None, 0, 2000000000, False, False),
 ]
 
 
@@ -206,6 +209,8 @@ def study_numbers(study):
                 value = units.value_in(value, unit, name)
             out[name] = checks.in_range(value, name, low, high, open_low, open_high)
     out.setdefault("WallLayers", 0)
-    for name in ("WallLayers", "MaxIterations"):
+    for name in ("WallLayers", "MaxIterations", "StepMaxTriangles"):
+        if name not in out:
+            continue
         out[name] = int(out[name])
     return out
