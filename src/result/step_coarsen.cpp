@@ -176,6 +176,7 @@ TriSurface coarsen_to_budget(const TriSurface& s, const CoarsenParams& params, c
     TriSurface candidate = coarsen_free_form(s, harder, &next);
     ++attempts;
     if (next.volume_change > budget.max_volume_change) break;
+    if (next.reverted || next.triangles_after >= r.triangles_after) continue;  // crossed itself: the next may not
     out = std::move(candidate), r = next;
   }
   r.attempts = attempts;

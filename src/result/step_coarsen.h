@@ -60,8 +60,9 @@ TriSurface coarsen_free_form(const TriSurface& s, const CoarsenParams& params = 
 /// `s` coarsened by coarsen_free_form with params.tolerance (0 or less: 0.05) and, while more
 /// than budget.max_triangles triangles remain, coarsened again from `s` with the tolerance
 /// doubled, up to budget.max_tolerance, as long as the enclosed volume stays within
-/// budget.max_volume_change of s's. Returns the last surface within those bounds (the one given
-/// when even the first is not); report->fits says whether it is within the budget,
+/// budget.max_volume_change of s's (a coarsening that crossed itself and was reverted is
+/// passed over). Returns the surface with the fewest triangles within those bounds (the one
+/// given when even the first is not); report->fits says whether it is within the budget,
 /// report->attempts how many coarsenings ran. Each coarsening starts from `s`, so the chordal
 /// tolerance reported holds against the surface given.
 TriSurface coarsen_to_budget(const TriSurface& s, const CoarsenParams& params, const CoarsenBudget& budget,
