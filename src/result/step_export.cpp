@@ -289,8 +289,9 @@ Error over_budget(const TriSurface& given, const CoarsenReport& r, long budget) 
   std::ostringstream o;
   o.precision(3);
   o << "result.step is not written: the result surface has " << given.F.rows() << " triangles and, coarsened as far "
-    << "as its volume allows (within " << 100 * CoarsenBudget{}.max_volume_change << " %, chordal tolerance "
-    << r.tolerance << " mm), still " << r.triangles_after << ", more than the STEP export's budget of " << budget
+    << "as its volume (within " << 100 * CoarsenBudget{}.max_volume_change
+    << " %) and the check against self-intersection allow (chordal tolerance " << r.tolerance << " mm), still "
+    << r.triangles_after << ", more than the STEP export's budget of " << budget
     << "; result.stl holds the shape. To write it anyway set \"" << max_triangles_key
     << "\" in the job's \"output\" to " << r.triangles_after << " or more (0: no budget), or optimise on a coarser mesh";
   return Error(ErrorCode::TooLarge, o.str());
