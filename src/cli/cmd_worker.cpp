@@ -48,8 +48,9 @@ const char* kUsage =
     "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
     "     DIR/result.step, the shape as one CAD solid, its curved faces analytic when \"part\"\n"
-    "     is given, join_non_design: 0 leaves the non-design solids apart; optimize:\n"
-    "     result_first: 1 writes result.json and prints {\"stage\":\n"
+    "     is given, join_non_design: 0 leaves the non-design solids apart;\n"
+    "     step_max_triangles: its triangle budget as the job's output key, 0: none;\n"
+    "     optimize: result_first: 1 writes result.json and prints {\"stage\":\n"
     "     \"result\"} before the verification, result.json again after it),\n"
     "     \"output\": DIR}\n"
     "  Relative paths are taken from REQUEST.json's folder. Prints one JSON object per line:\n"
@@ -376,8 +377,12 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   put_result_surface(result, r.output, s);
   if (param(r, "step", 0) != 0) {  // the shape at this threshold as one CAD solid, DIR/result.step
     ch.progress("step", -1, "writing the result as a STEP solid");
+    result::StepExportParams params;  // the study's budget when it sends one (its job's output.step_max_triangles)
+    const double budget = param(r, "step_max_triangles", -1);
+    if (budget > 2e9) throw Error(ErrorCode::InvalidParameter, "step_max_triangles must lie in [0, 2000000000]");
+    if (budget >= 0) params.max_triangles = static_cast<long>(budget);
     const result::StepExportReport step =
-        result::write_result_step((fs::path(r.output) / "result.step").string(), s, {}, {}, &source);
+        result::write_result_step((fs::path(r.output) / "result.step").string(), s, params, {}, &source);
     result["step"] = {{"faces", step.faces},
                       {"triangles", step.triangles},
                       {"volume", step.volume},

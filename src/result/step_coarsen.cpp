@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/closed_surface.h"
 #include "common/triangle_closest.h"
 #include "result/editable_surface.h"
 #include "result/result_check.h"
@@ -156,6 +157,30 @@ TriSurface coarsen_free_form(const TriSurface& s, const CoarsenParams& params, C
   r.reverted = !check_result(out, 1).valid();
   if (r.reverted) out = s;
   r.triangles_after = out.F.rows();
+  r.volume_change = std::abs(check_surface(out.V, out.F).volume / check_surface(s.V, s.F).volume - 1);
+  if (report) *report = r;
+  return out;
+}
+
+TriSurface coarsen_to_budget(const TriSurface& s, const CoarsenParams& params, const CoarsenBudget& budget,
+                             CoarsenReport* report) {
+  CoarsenReport r;
+  TriSurface out = coarsen_free_form(s, params, &r);
+  const auto over = [&](const CoarsenReport& c) { return budget.max_triangles > 0 && c.triangles_after > budget.max_triangles; };
+  CoarsenParams harder = params;
+  harder.tolerance = params.tolerance > 0 ? params.tolerance : CoarsenParams{}.tolerance;
+  int attempts = 1;
+  if (r.volume_change > budget.max_volume_change) out = s, r = CoarsenReport{s.F.rows(), s.F.rows()};
+  while (over(r) && (harder.tolerance *= 2) <= budget.max_tolerance * (1 + 1e-9)) {
+    CoarsenReport next;
+    TriSurface candidate = coarsen_free_form(s, harder, &next);
+    ++attempts;
+    if (next.volume_change > budget.max_volume_change) break;
+    if (next.reverted || next.triangles_after >= r.triangles_after) continue;  // crossed itself: the next may not
+    out = std::move(candidate), r = next;
+  }
+  r.attempts = attempts;
+  r.fits = !over(r);
   if (report) *report = r;
   return out;
 }

@@ -30,6 +30,16 @@ struct CoarsenReport {
   bool reverted = false;      ///< the coarsened surface crossed itself: the one given was returned
   /// Set by result_solid: bodies whose merged faces OCCT's check refused, written as facets.
   int unmerged_bodies = 0;
+  int attempts = 1;          ///< coarsenings run by coarsen_to_budget (1: the tolerance given sufficed)
+  double volume_change = 0;  ///< |volume returned - volume given| / volume given
+  bool fits = true;          ///< coarsen_to_budget: triangles_after is within the budget
+};
+
+/// How far coarsen_to_budget may go to bring a surface within a triangle budget.
+struct CoarsenBudget {
+  long max_triangles = 0;          ///< the budget (<= 0: none; the tolerance given is used)
+  double max_tolerance = 1.6;      ///< the largest relative tolerance tried (CoarsenParams::tolerance)
+  double max_volume_change = 0.005;  ///< the largest relative change of the enclosed volume allowed
 };
 
 /// Distance (mm) from point p to the triangle (a, b, c) (all 3-vectors), by the region of
@@ -46,5 +56,16 @@ double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& 
 /// s.V and the per-point arrays are kept as they are (removed points are simply unused);
 /// s.F and s.tag shrink.
 TriSurface coarsen_free_form(const TriSurface& s, const CoarsenParams& params = {}, CoarsenReport* report = nullptr);
+
+/// `s` coarsened by coarsen_free_form with params.tolerance (0 or less: 0.05) and, while more
+/// than budget.max_triangles triangles remain, coarsened again from `s` with the tolerance
+/// doubled, up to budget.max_tolerance, as long as the enclosed volume stays within
+/// budget.max_volume_change of s's (a coarsening that crossed itself and was reverted is
+/// passed over). Returns the surface with the fewest triangles within those bounds (the one
+/// given when even the first is not); report->fits says whether it is within the budget,
+/// report->attempts how many coarsenings ran. Each coarsening starts from `s`, so the chordal
+/// tolerance reported holds against the surface given.
+TriSurface coarsen_to_budget(const TriSurface& s, const CoarsenParams& params, const CoarsenBudget& budget,
+                             CoarsenReport* report = nullptr);
 
 }  // namespace topopt::result

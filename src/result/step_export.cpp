@@ -40,6 +40,7 @@
 #include <filesystem>
 #include <gp_Pln.hxx>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -49,6 +50,7 @@
 #include "common/error.h"
 #include "common/isolate.h"
 #include "result/step_export_analytic.h"
+#include "result/step_planar_faces.h"
 
 namespace topopt::result {
 namespace {
@@ -173,42 +175,83 @@ SurfacePieces surface_pieces(const TriSurface& s) {
   return out;
 }
 
+/// The planar face `f` (step_planar_faces.h) on its plane, its loops as wires of the shared
+/// edges between their kept points.
+TopoDS_Face planar_face(const PlanarFace& f, SharedTopology& topo) {
+  BRep_Builder builder;
+  TopoDS_Face face;
+  builder.MakeFace(face, new Geom_Plane(gp_Pnt(f.origin.x(), f.origin.y(), f.origin.z()),
+                                        gp_Dir(f.normal.x(), f.normal.y(), f.normal.z())),
+                   Precision::Confusion());
+  for (const std::vector<int>& loop : f.loops) {
+    TopoDS_Wire w;
+    builder.MakeWire(w);
+    for (size_t i = 0; i < loop.size(); ++i) builder.Add(w, topo.edge(loop[i], loop[(i + 1) % loop.size()]));
+    w.Closed(true);
+    builder.Add(face, w);
+  }
+  return face;
+}
+
 /// The faces of one piece of the surface (`tris`) into `shell`: the triangles on a curved
 /// analytic input face (`on_source`: per triangle its SourceFaces id, or -1; empty: none) as
-/// faces on that surface (analytic_faces; `refused` counts the pieces left as facets), every
-/// other triangle a planar face.
-void add_piece_faces(TopoDS_Shell& shell, const TriSurface& s, SharedTopology& topo, const std::vector<long>& tris,
-                     const SourceFaces* source, const std::vector<int>& on_source, int& refused) {
+/// faces on that surface (analytic_faces; `refused` counts the pieces left as facets), the
+/// piece's planar faces `planar` (one triangle: its own face) and the triangles of refused
+/// analytic pieces as planar faces of their own. Returns true when an input face's region came
+/// back as several faces (a full bore's two halves).
+bool add_piece_faces(TopoDS_Shell& shell, const TriSurface& s, SharedTopology& topo, const std::vector<long>& tris,
+                     const SourceFaces* source, const std::vector<int>& on_source,
+                     const std::vector<const PlanarFace*>& planar, int& refused) {
   BRep_Builder builder;
   std::map<int, std::vector<long>> regions;
   std::vector<long> facets;
-  for (long q : tris) (on_source.empty() || on_source[q] < 0 ? facets : regions[on_source[q]]).push_back(q);
+  for (long q : tris)
+    if (!on_source.empty() && on_source[q] >= 0) regions[on_source[q]].push_back(q);
   const EdgeSource edges = [&topo](int a, int b) { return topo.edge(a, b); };
-  for (const auto& [id, region] : regions)
-    for (const TopoDS_Face& f : analytic_faces(s, region, source->surface(id), edges, facets, refused))
-      builder.Add(shell, f);
+  bool split = false;
+  for (const auto& [id, region] : regions) {
+    const std::vector<TopoDS_Face> faces = analytic_faces(s, region, source->surface(id), edges, facets, refused);
+    split = split || faces.size() > 1;
+    for (const TopoDS_Face& f : faces) builder.Add(shell, f);
+  }
   for (long q : facets) builder.Add(shell, triangle_face(s, topo, q));
+  for (const PlanarFace* f : planar)
+    builder.Add(shell, f->triangles.size() == 1 ? triangle_face(s, topo, f->triangles[0]) : planar_face(*f, topo));
+  return split;
 }
 
 /// One solid per body of the surface, each void's shell added to the body that holds it (by
 /// OCCT's classifier, at one of the void's points); curved input faces as analytic faces where
-/// `source` is given (add_piece_faces).
+/// `source` is given (add_piece_faces), coplanar triangles merged into one planar face with
+/// `merge` (step_planar_faces.h), else a face per triangle. `split` (optional): per body, whether
+/// an input face's region came back as several faces.
 std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pieces, const SourceFaces* source,
-                                    int& refused) {
+                                    const std::optional<PlanarFacesParams>& merge, int& refused,
+                                    std::vector<char>* split = nullptr) {
   SharedTopology topo(s);
   BRep_Builder builder;
   const std::vector<int> on_source = source && !source->empty() ? source->classify(s) : std::vector<int>{};
+  std::vector<char> mergeable(s.F.rows(), 1);
+  for (size_t q = 0; q < on_source.size(); ++q) mergeable[q] = on_source[q] < 0;
+  // without merging, the angle no two normals are within: every triangle its own face
+  const std::vector<PlanarFace> planar = planar_faces(s, mergeable, merge.value_or(PlanarFacesParams{-1, -1}));
+  std::vector<int> piece_of(s.F.rows(), -1);
+  for (size_t k = 0; k < pieces.triangles.size(); ++k)
+    for (long q : pieces.triangles[k]) piece_of[q] = static_cast<int>(k);
+  std::vector<std::vector<const PlanarFace*>> planar_of(pieces.triangles.size());
+  for (const PlanarFace& f : planar) planar_of[piece_of[f.triangles[0]]].push_back(&f);
   std::vector<TopoDS_Solid> bodies;
   std::vector<std::pair<TopoDS_Shell, long>> voids;  // (shell, one of its triangles)
   for (size_t k = 0; k < pieces.triangles.size(); ++k) {
     TopoDS_Shell shell;
     builder.MakeShell(shell);
-    add_piece_faces(shell, s, topo, pieces.triangles[k], source, on_source, refused);
+    const bool halves = add_piece_faces(shell, s, topo, pieces.triangles[k], source, on_source, planar_of[k], refused);
     shell.Closed(true);
     if (pieces.volume[k] < 0) {
       voids.emplace_back(shell, pieces.triangles[k][0]);
       continue;
     }
+    if (split) split->push_back(halves);
     TopoDS_Solid solid;
     builder.MakeSolid(solid);
     builder.Add(solid, shell);
@@ -229,17 +272,29 @@ std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pi
   return bodies;
 }
 
-/// `body` with coplanar faces and collinear edges merged, body by body (OCCT's
-/// ShapeUpgrade_UnifySameDomain). Where the merged body fails OCCT's check and the facets
-/// passed it, the facets are kept (`refused` counts such bodies): on the bracket's detached
-/// clamp pad the merge made a shell BRepCheck calls unorientable (near a bore's facets).
-TopoDS_Shape merged(const TopoDS_Solid& body, const StepExportParams& params, int& refused) {
-  ShapeUpgrade_UnifySameDomain unify(body, true, true, false);
-  unify.SetAngularTolerance(params.angular_tolerance);
+/// `body` with the faces on one input surface that touch each other joined into one face (a
+/// full bore's two halves become one face with a seam: ShapeUpgrade_UnifySameDomain, faces only,
+/// whose edge merge re-orients the whole shell at a cost growing as its square); `body` itself
+/// when the joined shape fails OCCT's check.
+TopoDS_Shape halves_joined(const TopoDS_Shape& body, double angular_tolerance) {
+  ShapeUpgrade_UnifySameDomain unify(body, false, true, false);
+  unify.SetAngularTolerance(angular_tolerance);
   unify.Build();
-  if (BRepCheck_Analyzer(unify.Shape()).IsValid() || !BRepCheck_Analyzer(body).IsValid()) return unify.Shape();
-  ++refused;
-  return body;
+  return BRepCheck_Analyzer(unify.Shape()).IsValid() ? unify.Shape() : body;
+}
+
+/// The refusal of a surface that coarsen_to_budget could not bring within `budget` triangles,
+/// naming the job key that raises the budget.
+Error over_budget(const TriSurface& given, const CoarsenReport& r, long budget) {
+  std::ostringstream o;
+  o.precision(3);
+  o << "result.step is not written: the result surface has " << given.F.rows() << " triangles and, coarsened as far "
+    << "as its volume (within " << 100 * CoarsenBudget{}.max_volume_change
+    << " %) and the check against self-intersection allow (chordal tolerance " << r.tolerance << " mm), still "
+    << r.triangles_after << ", more than the STEP export's budget of " << budget
+    << "; result.stl holds the shape. To write it anyway set \"" << max_triangles_key
+    << "\" in the job's \"output\" to " << r.triangles_after << " or more (0: no budget), or optimise on a coarser mesh";
+  return Error(ErrorCode::TooLarge, o.str());
 }
 
 /// What a piece of the surface is made of, from its triangles' tags (iso_surface.h): the
@@ -296,20 +351,35 @@ TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& param
         ErrorCode::InvalidShape,
         "the result surface is not closed and outward (" + std::to_string(check.unpaired_edges) +
             " unpaired edges): it cannot become a solid; try other smoothing settings (\"optimization.smooth\")");
-  const TriSurface s = coarsen_free_form(given, params.coarsen, coarsened);
+  CoarsenReport report;
+  const TriSurface s = coarsen_to_budget(given, params.coarsen, {params.max_triangles}, &report);
+  if (coarsened) *coarsened = report;
+  if (!report.fits) throw over_budget(given, report, params.max_triangles);
   // the bodies of the result (a detached non-design solid is one more) with their voids
   // inside, not a single shell of several pieces (BRepCheck: not connected)
   int refused = 0, analytic = 0;
-  const std::vector<TopoDS_Solid> bodies = solids_of(s, surface_pieces(s), source, analytic);
+  const SurfacePieces pieces = surface_pieces(s);
+  const auto merge = params.unify ? std::optional<PlanarFacesParams>({params.angular_tolerance}) : std::nullopt;
+  std::vector<char> split;
+  std::vector<TopoDS_Shape> bodies;
+  for (const TopoDS_Solid& body : solids_of(s, pieces, source, merge, analytic, &split)) bodies.push_back(body);
   if (analytic_refused) *analytic_refused = analytic;
+  // a body whose merged faces OCCT's check refuses while its facets pass is written as facets
+  std::vector<TopoDS_Solid> facets;
+  for (size_t b = 0; merge && b < bodies.size(); ++b) {
+    if (split[b]) bodies[b] = halves_joined(bodies[b], params.angular_tolerance);
+    if (BRepCheck_Analyzer(bodies[b]).IsValid()) continue;
+    int ignored = 0;
+    if (facets.empty()) facets = solids_of(s, pieces, source, std::nullopt, ignored);
+    if (BRepCheck_Analyzer(facets[b]).IsValid()) bodies[b] = facets[b], ++refused;
+  }
+  if (coarsened) coarsened->unmerged_bodies = refused;
+  if (bodies.size() == 1) return bodies[0];
   BRep_Builder builder;
   TopoDS_Compound all;
   builder.MakeCompound(all);
-  for (const TopoDS_Solid& body : bodies)
-    builder.Add(all, params.unify ? merged(body, params, refused) : TopoDS_Shape(body));
-  if (coarsened) coarsened->unmerged_bodies = refused;
-  if (bodies.size() != 1) return all;
-  return TopoDS_Iterator(all).Value();
+  for (const TopoDS_Shape& body : bodies) builder.Add(all, body);
+  return all;
 }
 
 std::string solid_faults(const TopoDS_Shape& shape, int limit) {
@@ -370,14 +440,6 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
 
 StepExportReport write_result_step(const std::string& path, const TriSurface& s, const StepExportParams& params,
                                    const Progress& progress, const SourceFaces* source) {
-  if (params.max_triangles > 0 && s.F.rows() > params.max_triangles)
-    throw Error(ErrorCode::TooLarge,
-                "result.step is not written: the result surface has " + std::to_string(s.F.rows()) +
-                    " triangles, more than the STEP export's budget of " + std::to_string(params.max_triangles) +
-                    " (OCCT's face merging grows faster than the surface and would take many CPU minutes); "
-                    "result.stl holds the shape. To write it anyway set \"" +
-                    max_triangles_key + "\" in the job's \"output\" to " + std::to_string(s.F.rows()) +
-                    " or more (0: no budget), or optimise on a coarser mesh");
   const std::vector<std::string> parts = body_descriptions(s);
   if (parts.size() > 1) {
     std::string named;

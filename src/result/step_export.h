@@ -1,10 +1,12 @@
 // The result shape back in CAD: the closed, tagged triangle surface (iso_surface.h) made into
-// one OCCT solid and written as STEP. Every triangle becomes a planar face and every mesh edge
-// one B-Rep edge shared by its two faces, so the shell is closed by construction (no sewing
-// by distance, which is slow and can glue the wrong edges where the design is thin); OCCT's
-// ShapeUpgrade_UnifySameDomain then merges coplanar neighbours into one planar face (Ω's
-// planar faces come back whole, bounded by the polygon of the kept region) and collinear
-// edges into one. The free-form region stays a shell of planar facets.
+// one OCCT solid and written as STEP. Every triangle belongs to one B-Rep face and every mesh
+// edge between two faces to one B-Rep edge shared by both, so the shell is closed by
+// construction (no sewing by distance, which is slow and can glue the wrong edges where the
+// design is thin). Coplanar neighbouring triangles are one planar face (Ω's planar faces come
+// back whole, bounded by the polygon of the kept region) and a straight run of boundary between
+// the same two faces one edge, worked out on the triangles before OCCT builds anything
+// (step_planar_faces.h), so the cost grows with the surface, not with its square. The free-form
+// region stays a shell of planar facets.
 #pragma once
 #include <string>
 #include <vector>
@@ -26,7 +28,7 @@ struct StepExportParams {
   /// backstop for a fault inside OCCT, large enough for a machine whose wall clock runs 20 to
   /// 30 times the CPU time (the rocker needs a few CPU seconds).
   double seconds = 900;
-  bool unify = true;  ///< merge coplanar faces and collinear edges (ShapeUpgrade_UnifySameDomain)
+  bool unify = true;  ///< merge coplanar faces and collinear edges (step_planar_faces.h)
   /// Angle (radians) within which two facets count as coplanar when merging. Ω's planar faces
   /// are exactly planar; a small value keeps the free-form region's facets apart.
   double angular_tolerance = 1e-6;
@@ -37,12 +39,13 @@ struct StepExportParams {
   /// written as 3D lines only (a reader computes the 2D curves of a planar face), which
   /// makes the file about half as large.
   bool pcurves = false;
-  /// The largest result surface (triangles as given, before coarsening) written as STEP
-  /// (<= 0: any size). OCCT's face merging and checking grow faster than the surface (measured
-  /// in BENCHMARKS.md, branch step6), so past this budget the export would look like a hang:
-  /// write_result_step then writes nothing and throws Error(TooLarge) naming the job key that
-  /// raises it (max_triangles_key), before any OCCT work, so the refusal costs nothing.
-  long max_triangles = 60000;
+  /// The most triangles that become faces (after coarsening) in the STEP (<= 0: any number):
+  /// past it the free-form region is coarsened harder (coarsen_to_budget: the tolerance doubled
+  /// up to 1.6 times the median edge, the enclosed volume within 0.5 % of the surface's) until
+  /// it fits; when it cannot, result_solid and write_result_step write nothing and throw
+  /// Error(TooLarge) naming the job key that raises it (max_triangles_key). A bound on the
+  /// file's size and on what a CAD program must read; the export's cost grows linearly.
+  long max_triangles = 100000;
 };
 
 /// The key of the job's "output" section that sets StepExportParams::max_triangles, as the
@@ -68,9 +71,11 @@ struct StepExportReport {
 };
 
 /// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): the
-/// free-form region coarsened (params.coarsen; `coarsened`, optional: what it did), a planar
-/// face per triangle sharing its edges with the neighbours, then, with params.unify, coplanar
-/// faces merged. One solid per body of the surface (result_bodies; a compound of them when
+/// free-form region coarsened (params.coarsen; `coarsened`, optional: what it did), then with
+/// params.unify coplanar neighbouring triangles as one planar face and straight boundary runs
+/// as one edge (step_planar_faces.h; a body whose merged faces OCCT's check refuses while its
+/// facets pass is built as facets: coarsened->unmerged_bodies), else a planar face per
+/// triangle, every face sharing its edges with its neighbours. One solid per body of the surface (result_bodies; a compound of them when
 /// there are several, e.g. a detached non-design solid), closed voids as inner shells of the
 /// body holding them. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
 /// first triangle without area or an open surface (what to change: the smoothing settings).
@@ -105,7 +110,7 @@ std::string solid_faults(const TopoDS_Shape& shape, int limit = 5);
 /// Builds result_solid(s) and writes it to `path` as STEP (AP214, mm), in a child process
 /// with the time budget params.seconds, so that a fault or a hang inside OCCT costs the
 /// export, never the caller. Returns the report of the solid written. Throws Error(TooLarge),
-/// writing nothing, when `s` has more triangles than params.max_triangles; Error(Timeout)
+/// writing nothing, when `s` cannot be coarsened within params.max_triangles; Error(Timeout)
 /// past the budget, Error(Crashed) when OCCT ends the child, Error(InvalidShape) when the
 /// shape is not valid or not one solid per body (result_bodies), Error(Io) when the file cannot be written.
 /// A result of several bodies is written as one compound of solids (a STEP reader shows several

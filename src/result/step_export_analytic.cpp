@@ -1,5 +1,6 @@
 // The input's curved analytic faces in the result's STEP (see step_export_analytic.h).
 #include "result/step_export_analytic.h"
+#include "result/step_planar_faces.h"
 
 #include <BRepBndLib.hxx>
 #include <BRepCheck_Analyzer.hxx>
@@ -124,29 +125,6 @@ std::vector<std::vector<long>> connected_pieces(const TriSurface& s, const std::
     }
   }
   return out;
-}
-
-/// The boundary loops of the piece `tris` (points in order, each step a half-edge of a piece
-/// triangle whose twin belongs to no piece triangle); nullopt where the boundary pinches (a
-/// point with two boundary edges leaving it).
-std::optional<std::vector<std::vector<int>>> boundary_loops(const TriSurface& s, const std::vector<long>& tris) {
-  std::map<std::pair<int, int>, bool> half;
-  for (long q : tris)
-    for (int k = 0; k < 3; ++k) half[{s.F(q, k), s.F(q, (k + 1) % 3)}] = true;
-  std::map<int, int> next;
-  for (const auto& [e, unused] : half)
-    if (!half.count({e.second, e.first}) && !next.emplace(e.first, e.second).second) return std::nullopt;
-  std::vector<std::vector<int>> loops;
-  while (!next.empty()) {
-    std::vector<int> loop{next.begin()->first};
-    for (int at = next.begin()->second; at != loop.front(); at = next.at(at)) {
-      if (!next.count(at)) return std::nullopt;
-      loop.push_back(at);
-    }
-    for (int p : loop) next.erase(p);
-    loops.push_back(loop);
-  }
-  return loops;
 }
 
 /// True when a loop of the piece goes round the surface's axis (its angle turns by a full turn).

@@ -88,6 +88,9 @@ def _why_no_step(study):
     if study.Result is None:
         return "the study has no result yet: run it first"
     failed = verification_report(study).get("failed", {}).get("step")
+    if failed and failed.get("code") == "TooLarge":  # past the budget: the core names the job's key
+        return ("the last run could not write the result as a STEP solid (%s): raise the study's "
+                "StepMaxTriangles (Output) and run again" % failed.get("message", "unknown reason"))
     if failed:
         return ("the last run could not write the result as a STEP solid (%s): try another mesh size or "
                 "threshold and run again" % failed.get("message", "unknown reason"))

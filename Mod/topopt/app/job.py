@@ -143,6 +143,8 @@ def study_to_job(study):
         job["optimization"]["filter_radius"] = n["FilterRadius"]
     job["result"] = {"join_non_design": bool(getattr(study, "JoinNonDesign", True))}
     job["output"] = {"step": bool(getattr(study, "WriteStep", True)), "verification": bool(getattr(study, "Verify", False))}
+    if "StepMaxTriangles" in n:
+        job["output"]["step_max_triangles"] = n["StepMaxTriangles"]
     job["optimization"].update(study_responses(study))
     controls = study_controls(study)
     if controls:
@@ -192,6 +194,7 @@ _NUMBERS = [
     ("Penalty", None, 1.0, 10.0, False, False),
     ("FilterRadius", "mm", 0.0, None, False, False),
     ("MaxIterations", None, 1, 10000, False, False),
+    ("StepMaxTriangles", None, 0, 2000000000, False, False),
 ]
 
 
@@ -207,6 +210,8 @@ def study_numbers(study):
                 value = units.value_in(value, unit, name)
             out[name] = checks.in_range(value, name, low, high, open_low, open_high)
     out.setdefault("WallLayers", 0)
-    for name in ("WallLayers", "MaxIterations"):
+    for name in ("WallLayers", "MaxIterations", "StepMaxTriangles"):
+        if name not in out:
+            continue
         out[name] = int(out[name])
     return out

@@ -232,8 +232,9 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     """The result shape of the study's stored densities at `threshold` (in (0, 1)), extracted in
     the worker process; the document is not touched. stored: checks.stored_mesh(study) when
     the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]),
-    with the study's part and non-design shapes so that their cylinders, cones, spheres and tori
-    come back as analytic faces, as in the run's result.step.
+    within the study's StepMaxTriangles, with the study's part and non-design shapes so that
+    their cylinders, cones, spheres and tori come back as analytic faces, as in the run's
+    result.step.
     Returns the worker's answer (surface_points #P×3, surface_triangles #Q×3, surface_tags #Q,
     files). cancel(): polled, True cancels. Raises TopOptError if the study has no result, if
     what it stored is damaged, or if the worker fails or runs past REEXTRACT_TIMEOUT seconds."""
@@ -242,12 +243,25 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     threshold = checks.in_range(threshold, "threshold", 0.0, 1.0, open_low=True, open_high=True)
     nodes, tets, domain, densities = stored if stored is not None else checks.stored_mesh(study)
     shapes = _source_shapes(study) if step else {}
-    return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
-                                                 "densities": densities},
-                      params=dict({"threshold": threshold,
-                                   "join_non_design": 1 if getattr(study, "JoinNonDesign", True) else 0},
-                                  **({"step": 1} if step else {})), cancel=cancel,
-                      timeout=REEXTRACT_TIMEOUT, **shapes)
+    params = {"threshold": threshold, "join_non_design": 1 if getattr(study, "JoinNonDesign", True) else 0}
+    if step:  # the study's STEP budget, as its job's output.step_max_triangles gives it to a run
+        params.update(_step_budget(study), step=1)
+    try:
+        return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
+                                                     "densities": densities},
+                          params=params, cancel=cancel, timeout=REEXTRACT_TIMEOUT, **shapes)
+    except TopOptError as e:
+        if e.code == "TooLarge" and "step_max_triangles" in str(e):  # the core names the job's key
+            raise TopOptError("%s (in the workbench: the study's StepMaxTriangles, under Output)" % e,
+                              e.code) from e
+        raise
+
+
+def _step_budget(study):
+    """{"step_max_triangles": N} from the study's StepMaxTriangles (checked, as job_of checks it),
+    {} for a study saved before it had one (the core's default)."""
+    numbers = jobmod.study_numbers(study)
+    return {"step_max_triangles": numbers["StepMaxTriangles"]} if "StepMaxTriangles" in numbers else {}
 
 
 def _source_shapes(study):

@@ -9,6 +9,9 @@ import FreeCAD
 from . import units
 
 PROXY_TYPE = "TopOpt::Study"
+#: StepMaxTriangles of a new study: the core's own default budget (StepExportParams::max_triangles
+#: in src/result/step_export.h), which a job without "step_max_triangles" gets
+STEP_MAX_TRIANGLES = 100000
 
 #: the study's links to what runs and the Mesh command made: (name, doc)
 RESULT_LINKS = [
@@ -221,6 +224,10 @@ class Study:
         _add(obj, "App::PropertyBool", "WriteStep", "Output",
              "Write the result as one CAD solid (result.step) with each run: Result as solid and Export STEP "
              "need it", True)
+        _add(obj, "App::PropertyInteger", "StepMaxTriangles", "Output",
+             "The most triangles of the result surface that become faces of result.step (0: no bound): a larger "
+             "surface is coarsened until it fits, its volume within 0.5 %, or not written (a warning names this "
+             "property). Also bounds the STEP written when the threshold slider moves", STEP_MAX_TRIANGLES)
         _add(obj, "App::PropertyBool", "Verify", "Output",
              "Analyse the result solid after each run (its own tet mesh, the study's supports and loads): "
              "the as-built compliance and stresses", True)

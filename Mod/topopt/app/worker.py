@@ -43,7 +43,8 @@ _STAGES = {
     "surface": ("the result-shape extraction", "extracting the result shape",
                 "try another threshold"),
     "step": ("the STEP export", "writing the result as a STEP solid",
-             "turn off the study's WriteStep (Output) or try another mesh size"),
+             "raise the study's StepMaxTriangles (Output; the job's step_max_triangles), turn off its "
+             "WriteStep or try another mesh size"),
     "verification": ("the verification", "meshing and analysing the result solid",
                      "turn off the study's Verify (Output) or try another mesh size"),
     "write": ("the TopOpt worker", "writing the results",

@@ -185,43 +185,68 @@ TriSurface grid_cube(int n) {
   return s;
 }
 
-TEST(StepExport, ASurfaceOverTheTriangleBudgetIsRefusedByNameAndWritesNothing) {
-  // the default budget: a closed surface just past it (a cube of 12 n² triangles) is refused
-  // before OCCT does anything, with the key that writes it anyway
-  const StepExportParams defaults;
-  ASSERT_GT(defaults.max_triangles, 0);
-  const int n = static_cast<int>(std::ceil(std::sqrt(defaults.max_triangles / 12.0))) + 1;
+TEST(StepExport, ASurfaceOverTheOldBudgetIsWrittenWithItsPlanarFacesWhole) {
+  // past the 60 000 triangles the export refused until branch step7 (a cube of 12 n² triangles,
+  // free-form): written with the default budget as one valid solid of the cube's volume and
+  // its six planar faces whole
+  const int n = 71;
   const TriSurface big = grid_cube(n);
+  ASSERT_GT(big.F.rows(), 60000);
   const SurfaceCheck check = check_surface(big.V, big.F);
   ASSERT_TRUE(check.closed_manifold());
-  ASSERT_NEAR(check.volume, double(n) * n * n, 1e-6 * n * n * n);  // outward, so a body
-  ASSERT_GT(big.F.rows(), defaults.max_triangles);
   const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_big.step").string();
   std::filesystem::remove(path);
+  const StepExportReport written = write_result_step(path, big);
+  EXPECT_TRUE(written.valid);
+  EXPECT_EQ(written.solids, 1);
+  EXPECT_NEAR(written.volume, double(n) * n * n, 1e-6 * n * n * n);
+  EXPECT_EQ(written.faces, 6);
+  const StepExportReport back = describe_solid(read_step(path));
+  EXPECT_TRUE(back.valid);
+  EXPECT_EQ(back.solids, 1);
+  EXPECT_EQ(back.faces, 6);
+  std::filesystem::remove(path);
+}
+
+TEST(StepExport, ASurfaceOverTheBudgetIsCoarsenedToItOrRefusedByName) {
+  // a budget below what the default coarsening leaves of a curved result surface: coarsened
+  // harder until it fits, one valid solid within 0.5 % of the surface's volume, read back
+  const TriSurface s = bar_surface();
+  const double volume = check_surface(s.V, s.F).volume;
+  CoarsenReport usual;
+  coarsen_free_form(s, CoarsenParams{}, &usual);
+  StepExportParams params;
+  params.max_triangles = static_cast<long>(0.9 * usual.triangles_after);
+  ASSERT_LT(params.max_triangles, usual.triangles_after);
+  const std::string path = (std::filesystem::temp_directory_path() / "topopt_step_export_budget.step").string();
+  std::filesystem::remove(path);
+  const StepExportReport written = write_result_step(path, s, params);
+  EXPECT_LE(written.triangles, params.max_triangles);
+  EXPECT_TRUE(written.valid);
+  EXPECT_EQ(written.solids, 1);
+  EXPECT_NEAR(written.volume, volume, 0.005 * volume);
+  const StepExportReport back = describe_solid(read_step(path));
+  EXPECT_TRUE(back.valid);
+  EXPECT_EQ(back.solids, 1);
+  EXPECT_NEAR(back.volume, volume, 0.005 * volume);
+  std::filesystem::remove(path);
+  // nothing to coarsen (every triangle on Ω's faces): past the budget it is refused by the key
+  // that raises it, and nothing is written
+  TriSurface fixed = grid_cube(8);
+  fixed.tag.setOnes();
+  params.max_triangles = fixed.F.rows() - 1;
   try {
-    write_result_step(path, big);
-    FAIL() << "a surface of " << big.F.rows() << " triangles was written past the budget";
+    write_result_step(path, fixed, params);
+    FAIL() << "a surface of " << fixed.F.rows() << " triangles was written past a budget of " << params.max_triangles;
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::TooLarge);
     const std::string message = e.what();
     EXPECT_NE(message.find(max_triangles_key), std::string::npos) << message;
-    EXPECT_NE(message.find(std::to_string(big.F.rows()) + " triangles"), std::string::npos) << message;
+    EXPECT_NE(message.find(std::to_string(fixed.F.rows()) + " triangles"), std::string::npos) << message;
   }
   EXPECT_FALSE(std::filesystem::exists(path));
-  // the budget counts the triangles given: one fewer than the result surface's refuses it, its
-  // own count writes one valid solid within 0.5 % of the surface's volume
-  const TriSurface s = bar_surface();
-  StepExportParams params;
-  params.max_triangles = s.F.rows() - 1;
-  EXPECT_THROW(write_result_step(path, s, params), Error);
-  EXPECT_FALSE(std::filesystem::exists(path));
-  params.max_triangles = s.F.rows();
-  const StepExportReport written = write_result_step(path, s, params);
-  EXPECT_TRUE(written.valid);
-  EXPECT_EQ(written.solids, 1);
-  const double volume = check_surface(s.V, s.F).volume;
-  EXPECT_NEAR(written.volume, volume, 0.005 * volume);
-  EXPECT_GT(written.bytes, 0);
+  params.max_triangles = fixed.F.rows();
+  EXPECT_TRUE(write_result_step(path, fixed, params).valid);
   std::filesystem::remove(path);
 }
 

@@ -14,6 +14,7 @@ from helpers import box_study, top_loaded_box_study
 
 from topopt.app import api, asbuilt, results, units, vtu
 from topopt.app.errors import TopOptError
+from topopt.app.study import STEP_MAX_TRIANGLES
 
 
 class ResultAsBuilt(unittest.TestCase):
@@ -31,7 +32,8 @@ class ResultAsBuilt(unittest.TestCase):
         FreeCAD.closeDocument(cls.doc.Name)
 
     def test_the_job_asks_for_the_files(self):
-        self.assertEqual(api.job_of(self.study)["output"], {"step": True, "verification": True})
+        self.assertEqual(api.job_of(self.study)["output"],
+                         {"step": True, "verification": True, "step_max_triangles": STEP_MAX_TRIANGLES})
 
     def test_result_solid_is_one_valid_closed_solid_of_the_result_mesh_volume(self):
         feature = api.result_solid(self.study)
@@ -139,6 +141,22 @@ class ResultAsBuilt(unittest.TestCase):
         with self.assertRaises(TopOptError) as e:
             api.result_solid(self.study, threshold=1.5)
         self.assertIn("strictly between 0 and 1", str(e.exception))
+
+    def test_the_step_at_another_threshold_keeps_the_studys_triangle_budget(self):
+        # the worker's re-extraction honours StepMaxTriangles as a run does: a budget no
+        # coarsening within 0.5 % of the volume can meet is refused naming the job's key, the
+        # default writes the solid
+        run = self.study.RunThreshold
+        lower = round(max(0.1, run - 0.15), 2)
+        self.study.StepMaxTriangles = 10
+        try:
+            with self.assertRaises(TopOptError) as e:
+                api.result_solid(self.study, threshold=lower)
+            self.assertIn("step_max_triangles", str(e.exception))
+            self.assertIn("StepMaxTriangles", str(e.exception))
+        finally:
+            self.study.StepMaxTriangles = STEP_MAX_TRIANGLES
+        self.assertEqual(len(api.result_solid(self.study, threshold=lower).Shape.Solids), 1)
 
     def test_zz_rerun_without_the_files_removes_what_they_made_and_refuses(self):
         api.result_solid(self.study)

@@ -7,7 +7,7 @@ import FreeCAD
 import Part
 
 from topopt.app import api, units
-from topopt.app.study import is_study
+from topopt.app.study import STEP_MAX_TRIANGLES, is_study
 from helpers import bundled
 
 
@@ -75,6 +75,16 @@ class StudyFromScript(unittest.TestCase):
         with self.assertRaises(api.TopOptError) as ctx:
             api.job_of(study)
         self.assertIn("WallLayers is 7, outside [0, 4]", str(ctx.exception))
+
+    def test_step_budget_reaches_the_job_and_is_checked(self):
+        study = self.make()
+        self.assertEqual(api.job_of(study)["output"]["step_max_triangles"], STEP_MAX_TRIANGLES)
+        study.StepMaxTriangles = 0  # no budget
+        self.assertEqual(api.job_of(study)["output"]["step_max_triangles"], 0)
+        study.StepMaxTriangles = -5
+        with self.assertRaises(api.TopOptError) as ctx:
+            api.job_of(study)
+        self.assertIn("StepMaxTriangles", str(ctx.exception))
 
     def test_native_mesh_is_tagged_with_the_brep_volumes(self):
         # the 14-step mesher through the study: every domain's tet volume is its solid's
