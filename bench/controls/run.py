@@ -1,20 +1,20 @@
 #!/usr/bin/python3
 """Geometry controls benchmark (issue 22): the cantilever and the bracket (suggested load cases
 of ../shared/data/README.md, steel, volume fraction 0.3) through `topopt optimize`, once free
-and once with each geometry control (docs/optimization.md, "controls"; member sizes on the
-cantilever only — with a minimum size the compliance is the eroded design's, what SIMP minimises). For each run: tets,
+and once with each geometry control (docs/optimization.md, "controls"; the maximum member size on the
+cantilever only, the minimum on both — with a minimum size the compliance is the eroded design's, what SIMP minimises). For each run: tets,
 iterations, final compliance (SIMP's, on the tet mesh), SIMP wall time, whole-command wall
 and CPU time (user + sys), all with OMP_NUM_THREADS=1 and one run after another in this one script; the overhang
 share of the result surface built along +x and +y (45°); and a picture of the result surface
 (result.stl, rendered with matplotlib) in the work folder. Runs with a minimum member size get a
 second table: the smallest member and the share of thin solid tets of the crisp design the user
 gets, by the product's member measure (`_native.measure_members`, reach of a mesh size; also
-beyond a mesh size of the non-design tets, where the one-element layer over the supported face
-sits), and that
+beyond one and two mesh sizes of the non-design tets, where the one-element layer over the supported
+face sits and crumbs on its face), and that
 design's compliance as `topopt optimize` prints it (the SIMP compliance is the eroded design's).
 
 usage: bench/controls/run.py [--build build] [--work /tmp/controls_bench] [--only cantilever]
-                             [--controls free,draw]  (labels containing one of these words)
+                             [--controls free,draw] [--volume 0.3] [--iterations 60]  (labels containing one of these words)
 Prints Markdown for BENCHMARKS.md.
 """
 import argparse, json, os, re, resource, subprocess, sys, time
@@ -49,6 +49,7 @@ def controls_for(name, box):
         out["max member 8 mm"] = {"max_member_size": 8}
     if name == "bracket":  # printed lying on its base plate, build +z from its lowest point
         out["overhang lying (build +z)"] = {"overhang": {"direction": [0, 0, 1]}}
+        out["min member 9 mm"] = {"min_member_size": 9}  # three mesh sizes of 3 mm
     out["draw z one-sided"] = {"draw_direction": {"direction": [0, 0, 1]}}
     out["draw z split at mid-height"] = {"draw_direction": {"direction": [0, 0, 1], "parting_point": mid}}
     return out
@@ -163,11 +164,15 @@ def member_columns(build, out, size, mesh_size, stdout):
     # supported face is one element thick, and the design row on it reads as thin as that layer)
     from scipy.spatial import cKDTree
     centre = points[tets].mean(axis=1)
-    far = cKDTree(centre[domain != 0]).query(centre)[0] > mesh_size if (domain != 0).any() else np.ones(len(tets), bool)
-    beyond = np.asarray(m["thickness"])[design_solid & far]
+    # ... and beyond two (crumbs on that layer's face sit in the second row)
+    gap = cKDTree(centre[domain != 0]).query(centre)[0] if (domain != 0).any() else np.full(len(tets), np.inf)
+    beyond = np.asarray(m["thickness"])[design_solid & (gap > mesh_size)]
+    beyond2 = np.asarray(m["thickness"])[design_solid & (gap > 2 * mesh_size)]
     c = re.search(r"crisp design ([0-9.eE+-]+) N\*mm", stdout)
-    return (m["smallest_member"], beyond.min() if beyond.size else float("nan"), thin,
-            float(c.group(1)) if c else float("nan"))
+    apart = "came apart" if "eroded design came apart" in stdout else \
+        "not joined" if "does not join the supports" in stdout else "no"
+    return (m["smallest_member"], beyond.min() if beyond.size else float("nan"),
+            beyond2.min() if beyond2.size else float("nan"), thin, float(c.group(1)) if c else float("nan"), apart)
 
 
 def run(cmd):
@@ -188,6 +193,7 @@ def main():
     ap.add_argument("--work", default="/tmp/controls_bench")
     ap.add_argument("--only", default="")
     ap.add_argument("--iterations", type=int, default=60)
+    ap.add_argument("--volume", type=float, default=0.3, help="the volume fraction of every run")
     ap.add_argument("--controls", default="", help="comma-separated words: run only the controls whose label has one")
     ap.add_argument("--pictures-only", action="store_true", help="render the result.stl files of an earlier run")
     a = ap.parse_args()
@@ -214,8 +220,8 @@ def main():
             if a.controls and not any(w in label for w in a.controls.split(",")):
                 continue
             slug = re.sub(r"[^a-z0-9]+", "_", label.lower()).strip("_")
-            out = os.path.join(a.work, name + "_" + slug)
-            opt = {"volume_fraction": 0.3, "max_iterations": a.iterations}
+            out = os.path.join(a.work, name + "_" + slug + ("" if a.volume == 0.3 else "_vf%g" % a.volume))
+            opt = {"volume_fraction": a.volume, "max_iterations": a.iterations}
             if controls:
                 opt["controls"] = controls
             job = {"part": part, "nondesign": os.path.join(DATA, name + "_nondesign.step"), "mesh": {"size": size},
@@ -244,17 +250,19 @@ def main():
                 shares += " (%.1f mm²: %.1f on bared non-design faces, %.1f on non-design faces on Ω's boundary; " \
                           "without those: **%.1f %%**)" % (over, bared, given, 100 * share)
             if controls and "min_member_size" in controls:
-                small, beyond, thin, crisp_c = member_columns(a.build, out, controls["min_member_size"], size, p.stdout)
-                members.append("| %s | %s | %.2f mm | %.2f mm | %.1f %% | %.4g | %.4g |" % (
-                    name, label, small, beyond, 100 * thin, c, crisp_c))
+                small, beyond, beyond2, thin, crisp_c, apart = member_columns(
+                    a.build, out, controls["min_member_size"], size, p.stdout + p.stderr)
+                members.append("| %s | %s | %g | %.2f mm | %.2f / %.2f mm | %.1f %% | %.4g | %.4g | %s |" % (
+                    name, label, a.volume, small, beyond, beyond2, 100 * thin, c, crisp_c, apart))
             print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f / %.1f | %s | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
                 "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, cpu, shares, os.path.basename(png)))
             sys.stdout.flush()
     if members:
-        print("\n| example | control | smallest member (reach 1 mesh size) | beyond a mesh size of the non-design tets | "
-              "solid design tets thinner than size − mesh size | SIMP compliance (eroded) | crisp design's compliance (N·mm) |")
-        print("|---|---|---|---|---|---|---|")
+        print("\n| example | control | volume | smallest member (reach 1 mesh size) | beyond one / two mesh sizes of the non-design tets | "
+              "solid design tets thinner than size − mesh size | SIMP compliance (eroded) | crisp design's compliance (N·mm) | "
+              "eroded design warned |")
+        print("|---|---|---|---|---|---|---|---|---|")
         print("\n".join(members))
 
 

@@ -3,7 +3,7 @@
 // e's nodes) as a PETSc MatMPIAIJ on the nodes, assembled once from the same element matrix and
 // solved by CG with Jacobi to the serial filter's tolerance. Nodes of no design tet get a
 // diagonal alone and stay 0, so they neither give nor take.
-// Not padded (simp::FilterParams::pad_free_faces, the serial filter's Robin term on the part's
+// Not padded (simp::FilterParams::pad_free_faces and its pad_weight κ, the serial filter's Robin term on the part's
 // free faces): the padding serves the minimum member size alone, and mpirun refuses it with the
 // other geometry controls (check_distributable, dist_simp.h); it comes with the robust
 // formulation if that is ever distributed.

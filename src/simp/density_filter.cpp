@@ -199,9 +199,10 @@ DensityFilter::DensityFilter(const TetMesh& mesh, const std::vector<int>& design
   weighted_sum_ = product(volume_);
   plain_sum_ = product(VecXd::Ones(nd));
   padded_ = params.pad_free_faces && r > 0 && nd > 0;
+  pad_weight_ = params.pad_weight;
   if (padded_) {
     const auto [G, vg] = void_ghosts(mesh, design, r, held);
-    weighted_sum_ += ghost_mass(centre, G, vg, params.kind, r, threads_);
+    weighted_sum_ += params.pad_weight * ghost_mass(centre, G, vg, params.kind, r, threads_);
   }
 }
 
@@ -266,7 +267,7 @@ double DensityFilter::mean_neighbours() const {
 std::string DensityFilter::describe() const {
   std::ostringstream s;
   s << kind_ << " filter, radius " << radius_ << " mm, " << mean_neighbours() << " neighbours per element";
-  if (padded_) s << ", free faces padded with void";
+  if (padded_) s << ", free faces padded with void (weight " << pad_weight_ << ")";
   return s.str();
 }
 

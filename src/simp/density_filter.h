@@ -43,6 +43,7 @@ class DensityFilter final : public Filter {
   std::string kind_;
   double radius_ = 0;
   bool padded_ = false;
+  double pad_weight_ = 1;  // FilterParams::pad_weight of the padding
 };
 
 /// #T element volumes (positive for positively oriented tets).

@@ -45,6 +45,12 @@ struct FilterParams {
   /// Helmholtz: the same free faces get the Robin condition ℓ ∂ρ̃/∂n + ρ̃ = 0, the void half-space's
   /// (helmholtz_filter.h).
   bool pad_free_faces = false;
+  /// κ in (0, 1], how much of the void beyond a padded face the filter sees: the ghost layers'
+  /// kernel mass is weighed by κ (explicit kinds), the Robin condition is ℓ ∂ρ̃/∂n + κ ρ̃ = 0
+  /// (Helmholtz); either way a full design reads about 1/(1 + κ) at a padded face. 1 is the void
+  /// half-space; towards 0 the filter normalises over the part (the mirror). MemberSizeParams::
+  /// pad_weight says which the minimum size takes, and why.
+  double pad_weight = 1.0;
 };
 
 /// The length ℓ of the Helmholtz filter for a radius r (mm): r/(2√3), Lazarov & Sigmund's match

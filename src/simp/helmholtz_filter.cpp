@@ -64,7 +64,8 @@ HelmholtzFilter::HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& de
   volume_.resize(static_cast<long>(design.size()));
   for (size_t i = 0; i < design.size(); ++i) volume_[static_cast<long>(i)] = volume[design[i]];
   assemble(mesh, design);
-  if (params.pad_free_faces) pad_free_faces(mesh, design, held);
+  pad_weight_ = params.pad_weight;
+  if (params.pad_free_faces) pad_free_faces(mesh, design, held, params.pad_weight);
   mean_edge_ = mean_edge_length(mesh, design);
   if (helmholtz_uses_multigrid(params.helmholtz_solver, length_, mean_edge_)) set_up_multigrid();
 }
@@ -129,7 +130,7 @@ void HelmholtzFilter::assemble(const TetMesh& mesh, const std::vector<int>& desi
 }
 
 void HelmholtzFilter::pad_free_faces(const TetMesh& mesh, const std::vector<int>& design,
-                                     const std::vector<char>& held) {
+                                     const std::vector<char>& held, double weight) {
   // the design nodes' local numbers (assemble's: the mesh's order) and the faces of non-design tets
   std::vector<int> local(static_cast<size_t>(mesh.V.rows()), -1);
   std::vector<char> is_design(static_cast<size_t>(mesh.T.rows()), 0);
@@ -142,7 +143,7 @@ void HelmholtzFilter::pad_free_faces(const TetMesh& mesh, const std::vector<int>
     if (!is_design[t])
       for (int a = 0; a < 4; ++a)
         fixed.insert(face_key(mesh.T(t, (a + 1) % 4), mesh.T(t, (a + 2) % 4), mesh.T(t, (a + 3) % 4)));
-  // ℓ ∫_Γ ρ̃ v on each free face: its triangle's mass matrix area/12 (1 + δ_ab), times ℓ
+  // κ ℓ ∫_Γ ρ̃ v on each free face: its triangle's mass matrix area/12 (1 + δ_ab), times κ ℓ
   const MatX3i faces = boundary_triangles(mesh.T);
   for (long f = 0; f < faces.rows(); ++f) {
     const int n[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
@@ -154,7 +155,7 @@ void HelmholtzFilter::pad_free_faces(const TetMesh& mesh, const std::vector<int>
       const int* begin = A_.col.data() + A_.ptr[row];
       const int* end = A_.col.data() + A_.ptr[row + 1];
       for (int b = 0; b < 3; ++b)
-        A_.val[std::lower_bound(begin, end, local[n[b]]) - A_.col.data()] += length_ * area / 12.0 * (a == b ? 2 : 1);
+        A_.val[std::lower_bound(begin, end, local[n[b]]) - A_.col.data()] += weight * length_ * area / 12.0 * (a == b ? 2 : 1);
     }
     ++padded_faces_;
   }
@@ -219,7 +220,8 @@ std::string HelmholtzFilter::describe() const {
     << " mean edges), " << A_.rows << " nodes, " << static_cast<double>(A_.nonzeros()) / std::max(1, A_.rows)
     << " entries per row, CG preconditioned by "
     << (amg_ ? "multigrid (" + std::to_string(amg_->levels()) + " levels)" : std::string("Jacobi"));
-  if (padded_faces_ > 0) s << ", the part's free faces padded (" << padded_faces_ << " triangles)";
+  if (padded_faces_ > 0)
+    s << ", the part's free faces padded (" << padded_faces_ << " triangles, weight " << pad_weight_ << ")";
   return s.str();
 }
 

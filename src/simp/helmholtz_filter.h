@@ -46,10 +46,11 @@ Eigen::Matrix4d helmholtz_element_matrix(const Eigen::Matrix<double, 4, 3>& p, d
 class HelmholtzFilter final : public Filter {
  public:
   /// mesh, design (#D), volume (#T), held (#V or empty): as make_filter; params.radius > 0 (mm).
-  /// With params.pad_free_faces the part's free faces get the Robin condition ℓ ∂ρ̃/∂n + ρ̃ = 0
-  /// instead of ∂ρ̃/∂n = 0: the equation's solution in a void half-space beyond the face decays as
-  /// e^(−s/ℓ), whose slope at the face is this, so the filter sees void beyond a free face as the
-  /// explicit filter's ghost layers do (a full design reads ½ there). Free: as the explicit
+  /// With params.pad_free_faces the part's free faces get the Robin condition ℓ ∂ρ̃/∂n + κ ρ̃ = 0
+  /// (κ = params.pad_weight) instead of ∂ρ̃/∂n = 0: with κ = 1 the slope at the face of the
+  /// equation's solution in a void half-space beyond it (which decays as e^(−s/ℓ)), so the filter
+  /// sees void beyond a free face as the explicit filter's ghost layers do (a full design reads ½
+  /// there; 1/(1 + κ) in general). Free: as the explicit
   /// filter's (filter.h) — not a face of a non-design tet, not all of its nodes held.
   HelmholtzFilter(const TetMesh& mesh, const std::vector<int>& design, const VecXd& volume, const FilterParams& params,
                   const Progress& progress = {}, const std::vector<char>& held = {});
@@ -70,8 +71,10 @@ class HelmholtzFilter final : public Filter {
  private:
   void assemble(const TetMesh& mesh, const std::vector<int>& design);
   void set_up_multigrid();
-  /// Adds ℓ × the free faces' triangle mass matrices to A_ (the Robin condition above).
-  void pad_free_faces(const TetMesh& mesh, const std::vector<int>& design, const std::vector<char>& held);
+  /// Adds κ ℓ × the free faces' triangle mass matrices to A_ (the Robin condition above, κ = weight:
+  /// FilterParams::pad_weight).
+  void pad_free_faces(const TetMesh& mesh, const std::vector<int>& design, const std::vector<char>& held,
+                      double weight);
   VecXd nodal_load(const VecXd& per_element) const;  // Σ over each node's elements of value/4
   VecXd element_mean(const VecXd& nodal) const;      // each element's mean of its four nodes
   VecXd solve(const VecXd& b, VecXd& warm) const;
@@ -88,6 +91,7 @@ class HelmholtzFilter final : public Filter {
   mutable VecXd forward_, backward_;                  // the last solutions: warm starts for the next solve
   mutable int last_iterations_ = 0;
   long padded_faces_ = 0;  // free-face triangles with the Robin condition
+  double pad_weight_ = 1;  // κ of that condition
 };
 
 }  // namespace topopt::simp

@@ -74,6 +74,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fp.radius =
       robust_ ? robust_filter_radius(member.min_size, fp.kind, eta_, fp.like_gaussian) : filter_radius(mesh, fp);
   fp.pad_free_faces = robust_ && member.pad_faces;  // a member along a free face held too (member_size.h)
+  fp.pad_weight = member.pad_weight;
   filter_ = make_filter(mesh, design_, volume, fp, progress,
                         fp.pad_free_faces ? held_nodes(mesh.V.rows(), supports.dofs, loads) : std::vector<char>{});
   progress.info("filter: " + filter_->describe());

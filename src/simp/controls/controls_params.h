@@ -92,6 +92,9 @@ struct MemberSizeParams {
   /// its 10 × 10 mm section once the faces are padded (a square bar must be 5.3 mm wide to
   /// survive erosion at a 4 mm size, 28 mm²); at 0.4 it converges (docs/optimization.md).
   bool pad_faces = true;
+  /// κ of the padding (FilterParams::pad_weight): how much of the void beyond a free face the
+  /// filter sees; a full design reads 1/(1 + κ) at the face.
+  double pad_weight = 1.0;
   /// Largest member: no solid ball of this diameter (the local volume constraint, with MMA).
   double max_size = 0;
   double max_solid = 0.9;  ///< 1 − ε: the largest solid share of an element's ball; in (0.5, 1)

@@ -12,6 +12,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <sstream>
 
 #include "common/error.h"
 #include "fem/boundary_conditions.h"
@@ -274,6 +275,19 @@ TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
   EXPECT_LT(peak(full, 0, 0.4), 0.7);  // the tets whose centroid lies 0.25 mm from the face
   EXPECT_GT(peak(full, 0, 0.4), 0.45);
   EXPECT_NE(padded.describe().find("padded"), std::string::npos);
+  // the padding weighed by κ (FilterParams::pad_weight): the ghosts' mass times κ in every
+  // element's normalisation, so a full design reads in/(in + κ ghost): 1/ρ̃ − 1 scales with κ, and
+  // the tets by the free face read about 1/(1 + κ) instead of ½
+  fp.pad_weight = 1.0 / 3;
+  const DensityFilter weighed(mesh, design, tet_volumes(mesh), fp, held);
+  const VecXd full_weighed = weighed.apply(VecXd::Ones(c.rows()));
+  double worst = 0;
+  for (long t = 0; t < c.rows(); ++t)
+    worst = std::max(worst, std::abs((1 / full_weighed[t] - 1) - fp.pad_weight * (1 / full[t] - 1)));
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(peak(full_weighed, 0, 0.4), 0.7);
+  EXPECT_LT(peak(full_weighed, 0, 0.4), 0.9);
+  EXPECT_NE(weighed.describe().find("weight 0.333"), std::string::npos) << weighed.describe();
 }
 
 TEST(MemberSize, RatioMatchesTheHelmholtzFiltersClosedForm) {
@@ -324,13 +338,22 @@ TEST(MemberSize, RobustGradientsMatchFiniteDifferences) {
   prob.compliance(x);
   EXPECT_LT(prob.physical_densities().sum(), rho_i.sum());
   EXPECT_TRUE((prob.physical_densities().array() <= rho_i.array() + 1e-12).all());
-  // the padded filter (the default) through the dilated volume
+  // the padded filter (the default) through the dilated volume, explicit and Helmholtz, with the
+  // void's full weight and a third of it (MemberSizeParams::pad_weight)
   p.controls.member.pad_faces = true;
-  ComplianceProblem padded(b.mesh, b.mat, b.supports, b.loads, {}, p);
-  padded.compliance(x);
-  VecXd dvp;
-  padded.volume_fraction(x, &dvp);
-  expect_gradient([&](const VecXd& y) { return padded.volume_fraction(y); }, x, dvp, 1e-5, "padded dilated volume");
+  for (FilterKind kind : {FilterKind::Gaussian, FilterKind::Helmholtz})
+    for (double kappa : {1.0, 1.0 / 3}) {
+      p.filter.kind = kind;
+      p.controls.member.pad_weight = kappa;
+      ComplianceProblem padded(b.mesh, b.mat, b.supports, b.loads, {}, p);
+      padded.compliance(x);
+      VecXd dvp;
+      padded.volume_fraction(x, &dvp);
+      std::ostringstream what;
+      what << "padded dilated volume, " << (kind == FilterKind::Helmholtz ? "Helmholtz" : "Gaussian") << " filter, weight "
+           << kappa;
+      expect_gradient([&](const VecXd& y) { return padded.volume_fraction(y); }, x, dvp, 1e-5, what.str());
+    }
 }
 
 TEST(MemberSize, LocalVolumeGradientMatchesFiniteDifferences) {
