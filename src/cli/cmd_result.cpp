@@ -94,9 +94,10 @@ int cmd_result(const Args& args) {
   const TetMesh mesh = pipeline::job_mesh(job, {}, progress);
   const VecXd density = run_densities(dir, mesh);
   progress.say("surface", -1, "extracting the result shape");
-  const result::TriSurface s = pipeline::result_surface(
-      mesh, density, threshold, job.optimization.simp.volume_fraction, job.optimization.smooth, nullptr,
-      pipeline::anchor_nodes(mesh, job), job.optimization.hygiene, nullptr, nullptr, progress);
+  const result::TriSurface s =
+      pipeline::result_surface(mesh, density, threshold, job.optimization.simp.volume_fraction,
+                               pipeline::surface_settings(job.optimization, mesh), nullptr,
+                               pipeline::anchor_nodes(mesh, job), job.optimization.hygiene, nullptr, nullptr, progress);
   if (!stl.empty()) io::write_stl(stl, s.V, s.F);
   progress.say("step", -1, "writing the result as a STEP solid");
   const result::SourceFaces source = facets ? result::SourceFaces() : pipeline::source_faces(job, {}, progress);
