@@ -230,6 +230,8 @@ def main():
             path = out + ".json"
             json.dump(job, open(path, "w"), indent=1)
             wall, cpu, p = run([topopt, "optimize", path, "--verbose"])
+            with open(out + ".log", "w") as log:  # the command's messages (the overhang pass's line among them)
+                log.write(p.stdout + p.stderr)
             if p.returncode:
                 print("| %s | %s | failed: %s |" % (name, label, (p.stderr or p.stdout).strip().splitlines()[-1]))
                 continue

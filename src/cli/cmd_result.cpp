@@ -95,8 +95,9 @@ int cmd_result(const Args& args) {
   const VecXd density = run_densities(dir, mesh);
   progress.say("surface", -1, "extracting the result shape");
   const result::TriSurface s = pipeline::result_surface(
-      mesh, density, threshold, job.optimization.simp.volume_fraction, job.optimization.smooth, nullptr,
-      pipeline::anchor_nodes(mesh, job), pipeline::hygiene_params(mesh, job.optimization), nullptr, nullptr, progress);
+      mesh, density, threshold, job.optimization.simp.volume_fraction,
+      pipeline::surface_settings(job.optimization, mesh), nullptr, pipeline::anchor_nodes(mesh, job),
+      pipeline::hygiene_params(mesh, job.optimization), nullptr, nullptr, progress);
   if (!stl.empty()) io::write_stl(stl, s.V, s.F);
   progress.say("step", -1, "writing the result as a STEP solid");
   const result::SourceFaces source = facets ? result::SourceFaces() : pipeline::source_faces(job, {}, progress);

@@ -16,6 +16,7 @@
 #include "pipeline/problem_checks.h"
 #include "result/curved_faces.h"
 #include "result/iso_surface_refine.h"
+#include "simp/controls/overhang_filter.h"
 #include "simp/density_filter.h"
 
 namespace topopt::pipeline {
@@ -221,6 +222,16 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
   return anchors;
 }
 
+result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh& mesh) {
+  result::SmoothParams smooth = set.smooth;
+  const simp::OverhangControl& o = set.simp.controls.overhang;
+  if (!o.enabled) return smooth;
+  smooth.build.direction = o.direction.normalized();
+  smooth.build.angle = o.angle;
+  smooth.build.plate = simp::base_plate_height(mesh, smooth.build.direction, o.base_face);
+  return smooth;
+}
+
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used,
                                   const std::vector<char>& anchors, const result::HygieneParams& hygiene,
@@ -244,6 +255,13 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   }
   const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
   result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
+  if (smooth.build.active()) {
+    std::ostringstream says;
+    says << "overhang: the result surface's downward facets rising less than " << smooth.build.angle
+         << " deg from the plate lifted from " << finished.lift.before << " to " << finished.lift.after << " mm2 ("
+         << finished.lift.moves << " point moves)";
+    progress.info(says.str());
+  }
   // the finished surface by the hygiene's rule: a piece the cut or the smoothing left apart
   const int added = result::clean_surface_pieces(s, face_anchor_flags(mesh, anchors), found);
   for (size_t k = found.warnings.size() - added; k < found.warnings.size(); ++k) progress.warn(found.warnings[k]);
@@ -292,9 +310,9 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
   const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;
-  r.surface =
-      result_surface(mesh, r.simp.density, set.threshold, kept, set.smooth, &r.threshold, anchor_nodes(mesh, job),
-                     hygiene_params(mesh, set), &r.hygiene, &r.design, progress, &r.surface_report, source);
+  r.surface = result_surface(mesh, r.simp.density, set.threshold, kept, surface_settings(set, mesh), &r.threshold,
+                             anchor_nodes(mesh, job), hygiene_params(mesh, set), &r.hygiene, &r.design, progress,
+                             &r.surface_report, source);
   const auto t2 = std::chrono::steady_clock::now();
   r.seconds_simp = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_surface = std::chrono::duration<double>(t2 - t1).count();

@@ -74,6 +74,13 @@ std::vector<char> loaded_face_layer(const TetMesh& mesh, const std::vector<int>&
 /// everywhere and does not count.
 std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 
+/// The surface stage's settings of a job: set.smooth, and with an enabled overhang control its
+/// build (result::BuildDirection: the unit direction, the angle, the plate's height on `mesh` by
+/// simp::base_plate_height), so that the result surface's too-flat downward facets are lifted
+/// back to the angle (result/overhang_lift.h). Every extraction of a job's result (its run,
+/// `topopt result`) takes its settings here.
+result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh& mesh);
+
 /// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain, found on the densities as given), cleaned by
 /// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the

@@ -41,6 +41,7 @@ DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smo
     // smoothing bent some triangles: flip, collapse and move again
     if (smooth.remesh) remesh_unless_crossing(s, remesh, onto, report);
   }
+  if (smooth.build.active()) report.lift = lift_overhangs(s, smooth.build);
   report.check = check_result(s);
   return report;
 }

@@ -14,6 +14,7 @@ struct DesignSurfaceReport {
   long collapses = 0, flips = 0, moves = 0, splits = 0;  ///< remeshing, before and after smoothing
   long remesh_undone = 0;       ///< remeshing passes dropped because their surface crossed itself
   long crossings_smoothed = 0;  ///< crossing pairs right after smoothing (before the repair)
+  OverhangLiftReport lift;      ///< with a build direction (smooth.build): the last pass's
   ResultCheck check;            ///< the final surface's check
 };
 
@@ -21,9 +22,10 @@ struct DesignSurfaceReport {
 /// remesh, smooth (when smooth.iterations > 0), undo the smoothing where triangles cross,
 /// remesh (each edit that would make a crossing is refused by the remesher; a remeshing pass whose
 /// surface still crosses itself is dropped whole) (smooth.remesh and smooth.repair switch the
-/// remeshing and the repair off). Non-design points never move; Ω's face points stay in their planes. `onto` (may
-/// be empty) puts the points the remeshing adds inside Ω's curved faces onto their surfaces (remesh_surface).
-/// Returns the counts and the final check; the caller decides what an invalid check means (see
+/// remeshing and the repair off); with a build direction (smooth.build) the too-flat downward facets
+/// are lifted back to the angle last (lift_overhangs). Non-design points never move; Ω's face points stay in their
+/// planes. `onto` (may be empty) puts the points the remeshing adds inside Ω's curved faces onto their surfaces
+/// (remesh_surface). Returns the counts and the final check; the caller decides what an invalid check means (see
 /// pipeline::result_surface, which refuses it with a named error).
 DesignSurfaceReport finish_design_surface(TriSurface& s, const SmoothParams& smooth, const RemeshParams& remesh = {},
                                           const FaceProjector& onto = {});

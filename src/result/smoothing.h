@@ -3,6 +3,7 @@
 // correction so that members a few edges thick do not shrink either.
 #pragma once
 #include "result/iso_surface.h"
+#include "result/overhang_lift.h"
 
 namespace topopt::result {
 
@@ -35,6 +36,9 @@ struct SmoothParams {
   /// The resolution the surface is cut at (job key "result.resolution"): 1 on the FE mesh, 2 on
   /// the FE mesh with the design tets near the level split once (iso_surface_refine.h).
   int resolution = 1;
+  /// The job's overhang control (pipeline::surface_settings fills it): with a build direction the
+  /// finished surface's too-flat downward facets are lifted back to the angle (overhang_lift.h).
+  BuildDirection build;
 };
 
 /// Smooths s.V in place. Vertices with lock 2 do not move; with lock 1 they move only

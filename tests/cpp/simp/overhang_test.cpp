@@ -3,8 +3,9 @@
 // on a lattice turned against the mesh, non-design solids and a picked base face support, bad
 // settings are named, the chain rule against finite differences, and the property on an
 // optimised beam: less of its downward-facing surface is flatter than the critical angle
-// with the control than without, the issue's ≤ 1 % on the crisp iso-surface of the design (not
-// on the smoothed surface the user gets: see the test).
+// with the control than without, the issue's ≤ 1 % on the result surface the user gets (its last
+// pass lifting the facets the surface stage tilted: result/overhang_lift.h) and on the crisp
+// iso-surface of the design.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -64,24 +65,23 @@ OverhangControl control(Eigen::Vector3d d = Eigen::Vector3d::UnitZ(), double ang
   return c;
 }
 
-/// The property test's settings and bounds. On the result surface the user gets the issue's
-/// target (<= 1 % with the control) is NOT reached: every triangle of it counted (the pad's faces
-/// too, none of which faces down on this beam), facets within 3 degrees of the limit not counted,
-/// β at its end: 1.79 % with the default margin of 20° (the main of 2026-12-03; 1.5 % on the
-/// surface stage of 2026-12-02), 32.7 % free (docs/optimization.md, "Overhang": what is left are
-/// facets of the lattice's staircase next to the pad, x = 24 … 27.5, and under the beam's middle,
-/// tilted below 45° by the surface stage). The test holds what is reached there, with the default
-/// margin, and the 1 % on the crisp iso-surface, where it is met.
+/// The property test's settings and bounds: the target, <= 1 % with the control, on the
+/// result surface the user gets, every triangle of it counted (the pad's faces too, none of which
+/// faces down on this beam), no tolerance, β at its end, the default margin of 20°. The surface
+/// stage lifts its downward facets back above the angle when the job prints along a direction
+/// (result/overhang_lift.h): 0.19 % on the surface of 2026-12-03 (2.10 % without that last pass:
+/// the crossing margin and the smoothing tilt facets of the lattice's staircase next to the pad and
+/// under the beam's middle below 45°), 34.6 % free (docs/optimization.md, "Overhang").
 constexpr int kBeamIterations = 200;
-constexpr double kBeamTolerance = 3;
 constexpr double kBeamMargin = 20;
-constexpr double kBeamShareBound = 0.02;
-/// The 1 %, met by the design the filter makes: the crisp iso-surface at the volume's
-/// threshold (marching tetrahedra, hygiene, no remeshing or smoothing), every facet, no tolerance:
-/// 0.81 % (0.64 % at 3°). The surface stage after it (crossings kept 0.2 of an edge off the
-/// nodes, Taubin smoothing) tilts facets of the lattice's staircase beside the pad and under the
-/// beam's middle below 45° again: 1.79 % at 3° on what the user gets (docs/optimization.md).
+constexpr double kBeamShareBound = 0.01;
+/// The same 1 %, met by the design the filter makes before the surface stage: the crisp
+/// iso-surface at the volume's threshold (marching tetrahedra, hygiene, no remeshing or
+/// smoothing), every facet, no tolerance: 0.81 %.
 constexpr double kBeamCrispShareBound = 0.01;
+/// The last pass restores slopes; it cannot print a design that does not: the free design's
+/// surface through the same stage keeps 25.4 % (34.6 % without the pass).
+constexpr double kFreeLiftedShareAtLeast = 0.2;
 
 TEST(Overhang, SmoothMinAndMaxBoundTheExactOnes) {
   double da, db, dx[5];
@@ -337,17 +337,23 @@ Beam test_beam() {
 
 /// The overhang share of the result surface the user gets (pipeline::result_surface with the
 /// product's defaults: the threshold that keeps the volume fraction, hygiene, smoothing,
-/// remeshing), every triangle a design could change (Ω's faces and the pad's too, split by kind:
-/// an exposed face of the pad that faces down needs supports as much as the design's own; the
-/// part's given faces, a non-design solid's on Ω's boundary, apart — none faces down on this
-/// beam), built along +z from
-/// z = −5; a facet counts when it rises less than angle − tolerance from the plate. `smooth`:
-/// the surface stage's settings (the crisp stage: no remeshing, no smoothing).
-OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, double angle,
-                               double tolerance, const result::SmoothParams& smooth = {}) {
+/// remeshing, and with `printed` the last pass of a job with an overhang control, which lifts the
+/// too-flat downward facets: pipeline::surface_settings), every triangle a design could change
+/// (Ω's faces and the pad's too, split by kind: an exposed face of the pad that faces down needs
+/// supports as much as the design's own; the part's given faces, a non-design solid's on Ω's
+/// boundary, apart — none faces down on this beam), built along +z from z = −5; a facet counts
+/// when it rises less than angle − tolerance from the plate. `smooth`: the surface stage's
+/// settings (the crisp stage: no remeshing, no smoothing).
+OverhangShare product_overhang(const Beam& b, const VecXd& density, double volume_fraction, bool printed,
+                               double tolerance, result::SmoothParams smooth = {}) {
+  if (printed) {
+    smooth.build.direction = Eigen::Vector3d::UnitZ();
+    smooth.build.angle = 45;
+    smooth.build.plate = base_plate_height(b.mesh, Eigen::Vector3d::UnitZ(), 0);
+  }
   const result::TriSurface s = pipeline::result_surface(b.mesh, density, -1, volume_fraction, smooth, nullptr, b.anchors);
   OverhangMeasureParams m;
-  m.angle = angle;
+  m.angle = 45;
   m.plate = -5;
   m.tolerance = tolerance;
   return overhang_share(s.V, s.F, Eigen::Vector3d::UnitZ(), m, &s.tag, &s.lock);
@@ -421,25 +427,29 @@ TEST(Overhang, BeamHasLessOverhangWithTheControl) {
   p.controls.overhang.margin = kBeamMargin;
   p.controls.overhang.cell = 10.0 / 6;
   const SimpResult printed = optimize(b.mesh, fem::Material{}, b.supports, b.loads, {}, p);
-  const OverhangShare with = product_overhang(b, printed.density, 0.3, 45, kBeamTolerance);
-  const OverhangShare without = product_overhang(b, free_run.density, 0.3, 45, kBeamTolerance);
+  const OverhangShare with = product_overhang(b, printed.density, 0.3, true, 0);
+  const OverhangShare unlifted = product_overhang(b, printed.density, 0.3, false, 0);
+  const OverhangShare without = product_overhang(b, free_run.density, 0.3, false, 0);
+  const OverhangShare free_lifted = product_overhang(b, free_run.density, 0.3, true, 0);
   result::SmoothParams crisp;  // the iso-surface the design's densities make, as marching tetrahedra cut it
   crisp.iterations = 0;
   crisp.remesh = false;
   crisp.repair = false;
-  const OverhangShare crisp_with = product_overhang(b, printed.density, 0.3, 45, 0, crisp);
+  const OverhangShare crisp_with = product_overhang(b, printed.density, 0.3, false, 0, crisp);
   std::cout << "overhang share with the control " << with.share() << " (" << with.overhang_area << " of "
             << with.downward_area << " mm2: design " << with.design_overhang << ", pad " << with.nondesign_overhang
-            << ", part " << with.omega_overhang << "), its crisp iso-surface " << crisp_with.share()
-            << " (tolerance 0), without the control " << without.share() << "; compliance "
+            << ", part " << with.omega_overhang << "), without the last pass " << unlifted.share()
+            << ", its crisp iso-surface " << crisp_with.share() << ", without the control " << without.share()
+            << " (through the last pass " << free_lifted.share() << "); compliance "
             << printed.history.back().compliance << " against " << free_run.history.back().compliance << ", beta "
             << printed.history.back().beta << ", grey " << printed.history.back().grey << ", " << printed.history.size()
             << " iterations\n";
   EXPECT_LE(crisp_with.share(), kBeamCrispShareBound) << "the filter's own design, before the surface stage";
   EXPECT_EQ(printed.history.back().beta, 32) << "beta should reach its end";
-  EXPECT_LE(with.share(), kBeamShareBound);
+  EXPECT_LE(with.share(), kBeamShareBound) << "the issue's 1 % on the surface the user gets";
   EXPECT_LE(with.share(), 0.2 * without.share());
   EXPECT_GE(without.share(), 0.2) << "the free design should need supports printed this way";
+  EXPECT_GE(free_lifted.share(), kFreeLiftedShareAtLeast) << "the last pass must not make a free design print";
   EXPECT_NEAR(printed.history.back().volume_fraction, 0.3, 0.01);
   EXPECT_LE(printed.history.back().compliance, 2 * free_run.history.back().compliance);
 }
