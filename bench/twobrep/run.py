@@ -257,12 +257,22 @@ def pipeline_run(topopt, part, nd, size, mesher, cpu, tmp, in_process=False):
         return {"error": (out.strip().splitlines() or ["failed"])[-1][-300:], "cpu_seconds": cpu_s}
     s = json.load(open(stats))
     q, c = s["quality"], s["conformity"]
-    return {"tets": s["tets"], "mesh_seconds": round(s["seconds"]["mesh"], 2), "cpu_seconds": cpu_s,
+    return {"tets": s["tets"], **below_counts(os.path.join(tmp, "m.msh")), "mesh_seconds": round(s["seconds"]["mesh"], 2), "cpu_seconds": cpu_s,
             "rr_min": q["radius_ratio"]["min"], "rr_mean": q["radius_ratio"]["mean"],
             "share_below_01": q["radius_ratio"]["share_below_0.1"], "dihedral_min": q["dihedral_deg"]["min"],
             "volume_error": c["max_volume_error"], "conformal": c["ok"],
             "degenerate": c["flat_tets"] + c["inverted_tets"], "mesher": s.get("mesher", mesher),
             "native_failed": s.get("native_failed"), "warnings": warnings}
+
+
+def below_counts(msh):
+    """The written mesh's tets below radius ratio 0.1 and 0.2 (counts, by bench/volume's reader)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("volume_bench", os.path.join(ROOT, "bench", "volume", "run.py"))
+    volume_bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(volume_bench)
+    rr = volume_bench.radius_ratios(*volume_bench.read_msh_tets(msh))
+    return {"below_01": int((rr < 0.1).sum()), "below_02": int((rr < 0.2).sum())}
 
 
 def rows(args):

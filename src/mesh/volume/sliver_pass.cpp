@@ -132,54 +132,29 @@ double ball_worst(const Work& w, const Adjacency::Row& ball, double floor, int& 
 }
 
 /// The directions a node tries: 16 spread over its (tangent) plane's circle, or 32 over the
-/// sphere (a Fibonacci lattice) for a free node.
+/// sphere (tet_improve's Fibonacci lattice) for a free node.
 std::vector<Vec3> directions(NodeFreedom kind, const Vec3& normal) {
+  if (kind == NodeFreedom::Free) return sphere_directions(32);
   std::vector<Vec3> d;
-  if (kind != NodeFreedom::Free) {
-    const Vec3 e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
-    for (int i = 0; i < 16; ++i) d.push_back(std::cos(M_PI * i / 8) * e1 + std::sin(M_PI * i / 8) * e2);
-    return d;
-  }
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < 32; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / 32, r = std::sqrt(1.0 - z * z);
-    d.push_back(Vec3(r * std::cos(golden * i), r * std::sin(golden * i), z));
-  }
+  const Vec3 e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+  for (int i = 0; i < 16; ++i) d.push_back(std::cos(M_PI * i / 8) * e1 + std::sin(M_PI * i / 8) * e2);
   return d;
 }
 
-/// Pattern search for node v along `dirs`: steps from a quarter of its mean edge, the best
-/// direction taken while it lifts the ball's worst tet with every tet positive and no more of
-/// the ball below floor, the step halved when none does (24 tries); with `onto`, each point
-/// tried is first moved onto the face by it. True when v moved.
+/// tet_improve's pattern search for node v along `dirs`, 24 tries, no more of the ball below
+/// floor; with `onto`, each point tried is first moved onto the face by it. Moves v and returns
+/// true when that lifts the ball's worst tet.
 bool move_node(Work& w, const Adjacency::Row& ball, int v, const std::vector<Vec3>& dirs, double floor,
                const std::function<bool(Vec3&)>& onto = {}) {
-  int below0 = 0, below = 0;
-  const double before = ball_worst(w, ball, floor, below0);
-  if (before < 0) return false;
-  double len = 0;
-  int cnt = 0;
-  for (int q : ball)
-    for (int x : w.tets[q])
-      if (x != v) len += (w.P[x] - w.P[v]).norm(), ++cnt;
-  double step = 0.25 * len / std::max(cnt, 1);
-  const Vec3 start = w.P[v];
-  double best = before;
-  for (int it = 0; it < 24; ++it) {
-    const Vec3 here = w.P[v];
-    Vec3 to = here;
-    for (const Vec3& d : dirs) {
-      w.P[v] = here + step * d;
-      if (onto && !onto(w.P[v])) continue;
-      const double now = ball_worst(w, ball, floor, below);
-      if (now > best && below <= below0) best = now, to = w.P[v];
-    }
-    w.P[v] = to;
-    if (to == here) step *= 0.5;
-  }
-  if (best > before) return true;
-  w.P[v] = start;
-  return false;
+  PatternSearchParams search;
+  search.directions = dirs;
+  search.tries = 24;
+  search.floor = floor;
+  search.onto = onto;
+  const NodeMove m = plan_pattern_search(w.P, w.tets, ball, v, search);
+  if (m.empty()) return false;
+  w.P[v] = m.to;
+  return true;
 }
 
 /// A free node: the pattern search, then tet_improve's steepest ascent of the ball's worst

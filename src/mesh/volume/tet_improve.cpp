@@ -322,18 +322,17 @@ NodeMove plan_search_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, co
   return m;
 }
 
-namespace {
-
-/// kPerturbDirections unit vectors spread evenly over the sphere (a Fibonacci lattice).
-std::array<Vec3, kPerturbDirections> sphere_directions() {
-  std::array<Vec3, kPerturbDirections> d;
+std::vector<Vec3> sphere_directions(int n) {
+  std::vector<Vec3> d(static_cast<size_t>(std::max(n, 0)));
   const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < kPerturbDirections; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / kPerturbDirections, r = std::sqrt(1.0 - z * z);
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(1.0 - z * z);
     d[i] = Vec3(r * std::cos(golden * i), r * std::sin(golden * i), z);
   }
   return d;
 }
+
+namespace {
 
 /// v's mean edge to the other nodes of its tets (0 when it has none).
 double mean_edge_at(const std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts, int v) {
@@ -345,23 +344,42 @@ double mean_edge_at(const std::vector<Vec3>& P, const std::vector<Tet>& tets, co
   return cnt ? len / cnt : 0.0;
 }
 
+/// The worst radius ratio of the tets `ts` (-1 when one of them is not positive) and, in
+/// `below`, how many of them are below `floor` (counted up to the first that is not positive).
+double worst_and_below(const std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ts,
+                       double floor, int& below) {
+  double w = 1;
+  below = 0;
+  for (int q : ts) {
+    const Tet& x = tets[q];
+    if (orient3d(P[x[0]].data(), P[x[1]].data(), P[x[2]].data(), P[x[3]].data()) <= 0) return -1.0;
+    const double r = rho(P, x);
+    w = std::min(w, r);
+    below += r < floor;
+  }
+  return w;
+}
+
 }  // namespace
 
-NodeMove plan_perturb_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
-  const std::array<Vec3, kPerturbDirections> dirs = sphere_directions();
-  const Adjacency::Row ts = stars.row(v);
-  double step = 0.25 * mean_edge_at(P, tets, ts, v);
+NodeMove plan_pattern_search(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency::Row& ball, int v,
+                             const PatternSearchParams& params) {
+  double step = 0.25 * mean_edge_at(P, tets, ball, v);
   if (!(step > 0)) return {};
+  const bool counted = params.floor > 0;
+  int below0 = 0, below = 0;
+  const double before = worst_and_below(P, tets, ball, params.floor, below0);
+  if (counted && before < 0) return {};  // the count below the floor means nothing on a ball not all positive
   const Vec3 old = P[v];
-  const double before = worst_positive(P, tets, ts);
   double best = before;
-  for (int it = 0; it < 12; ++it) {
+  for (int it = 0; it < params.tries; ++it) {
     const Vec3 here = P[v];
     Vec3 to = here;
-    for (const Vec3& d : dirs) {
+    for (const Vec3& d : params.directions) {
       P[v] = here + step * d;
-      const double now = worst_positive(P, tets, ts);
-      if (now > best) best = now, to = P[v];
+      if (params.onto && !params.onto(P[v])) continue;
+      const double now = worst_and_below(P, tets, ball, params.floor, below);
+      if (now > best && (!counted || below <= below0)) best = now, to = P[v];
     }
     P[v] = to;
     if (to == here) step *= 0.5;
@@ -370,6 +388,13 @@ NodeMove plan_perturb_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, c
   P[v] = old;
   if (!(best > before)) return {};
   return m;
+}
+
+NodeMove plan_perturb_node(std::vector<Vec3>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v) {
+  PatternSearchParams params;
+  params.directions = sphere_directions(kPerturbDirections);
+  params.tries = 12;
+  return plan_pattern_search(P, tets, stars.row(v), v, params);
 }
 
 namespace {
@@ -1022,6 +1047,8 @@ void improve_tets(std::vector<Vec3>& P, std::vector<Tet>& tets, int first_new, c
     remove_tets_below(P, tets, params.sliver_floor, 4, progress);
     remove_slivers(P, tets, first_new, params.sliver_floor, params.sliver_rounds, progress);
   }
+  if (params.shape_floor > params.sliver_floor)
+    remove_slivers(P, tets, first_new, params.shape_floor, params.sliver_rounds, progress);
 }
 
 }  // namespace topopt::mesh

@@ -21,6 +21,7 @@
 // when listed tets close a ring around it, and a cavity's faces stay faces of its star.
 #pragma once
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "common/progress.h"
@@ -109,13 +110,34 @@ NodeMove plan_smooth_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet
 /// worst radius ratio around v rises (halved when no direction helps, 40 tries), every tet
 /// staying positive; the best position found when it is better.
 NodeMove plan_search_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars, int v);
-/// Perturbation (check-only), for a node the compass search left at a sliver: pattern search
-/// over kPerturbDirections directions spread evenly over the sphere (a Fibonacci lattice),
-/// steps from a quarter of v's mean edge, the best direction taken while it raises the worst
-/// radius ratio around v, the step halved when none does (12 tries), every tet staying
-/// positive; the best position found when it is better. Its many directions find the moves
-/// that lift the worst tet of a star where the compass's six do not (the perturbation of
-/// sliver nodes of Tournois et al., with directions laid out instead of drawn).
+/// What plan_pattern_search tries.
+struct PatternSearchParams {
+  std::vector<Eigen::Vector3d> directions;  ///< unit directions tried from the current position at every step
+  int tries = 12;                           ///< steps; the step is halved after one that finds nothing better
+  /// > 0: a position is taken only when no more tets of the ball are below this radius ratio
+  /// than at the start (raising the worst alone can bring more of them below it), and a ball
+  /// that does not start all positive is left as it is; 0: the worst tet alone decides.
+  double floor = 0;
+  /// Set: each point tried is first moved by it (e.g. onto the B-Rep face the node lies on);
+  /// a point it returns false for is skipped. Empty: the points as they are.
+  std::function<bool(Eigen::Vector3d&)> onto;
+};
+/// Pattern search (check-only) for node v: from v, steps of a quarter of its mean edge along
+/// each of params.directions (moved by params.onto when given), the best point taken while it
+/// raises the worst radius ratio of the tets `ball` (v's ball: indices into tets) with every one
+/// of them positive (exact orientation) and, with params.floor, no more of them below it; the
+/// step halved when none does, params.tries steps. Returns the best position found when it is
+/// better. P is as it was on return. plan_perturb_node and the last sliver pass
+/// (sliver_pass.h: directions in a plane, the projection onto a face, the floor) are this search.
+NodeMove plan_pattern_search(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency::Row& ball,
+                             int v, const PatternSearchParams& params);
+/// n unit vectors spread evenly over the sphere (a Fibonacci lattice).
+std::vector<Eigen::Vector3d> sphere_directions(int n);
+/// Perturbation (check-only), for a node the compass search left at a sliver: plan_pattern_search
+/// over kPerturbDirections directions spread evenly over the sphere (sphere_directions),
+/// 12 tries, the worst tet alone deciding. Its many directions find the moves that lift the
+/// worst tet of a star where the compass's six do not (the perturbation of sliver nodes of
+/// Tournois et al., with directions laid out instead of drawn).
 NodeMove plan_perturb_node(std::vector<Eigen::Vector3d>& P, const std::vector<Tet>& tets, const Adjacency& stars,
                            int v);
 /// Directions the perturbation tries per step.
@@ -227,12 +249,19 @@ struct TetImproveParams {
   /// perturbation of their nodes, flips and wider cavities (remove_slivers; 0: none).
   double sliver_floor = 0.1;
   int sliver_rounds = 4;  ///< at most this many rounds of remove_slivers
+  /// Then the same rounds (remove_slivers, at most sliver_rounds) at this higher floor: the
+  /// tets between sliver_floor and it are left by everything above (the compass search alone
+  /// moves their nodes), and a fill that closed holes of the Delaunay bulk leaves many of them
+  /// (NIST 1's fillet corners: 1 731 below 0.2, 750 of them without a boundary node). Every
+  /// change lifts the worst tet it touches, so nothing falls below the worst there was
+  /// (not above sliver_floor, e.g. 0: none).
+  double shape_floor = 0.2;
 };
 
 /// The improvement after a fill: `quality_rounds` rounds of flips, smoothing of the nodes
 /// from first_new on and compass search at the bad tets; then up to three rounds of sliver
 /// insertion, each followed by flips and compass search; then remove_tets_below(sliver_floor)
-/// and remove_slivers(sliver_floor, sliver_rounds).
+/// and remove_slivers(sliver_floor, sliver_rounds), then remove_slivers(shape_floor, sliver_rounds).
 /// Nodes below first_new never move. Checks progress for cancellation between rounds.
 void improve_tets(std::vector<Eigen::Vector3d>& P, std::vector<Tet>& tets, int first_new,
                   const TetImproveParams& params, const Progress& progress = {});

@@ -14,6 +14,7 @@
 
 #include "common/face_key.h"
 #include "common/tet_boundary.h"
+#include "io/msh.h"
 #include "mesh/core/conformity.h"
 #include "mesh/core/predicates.h"
 #include "mesh/core/tet_quality.h"
@@ -493,6 +494,42 @@ TEST(TetImprove, RemoveSliversTakesOutTheClassicBadTetsKeepingTheMeshValid) {
   EXPECT_EQ(Q, Q0);
 }
 
+TEST(TetImprove, ShapeFloorLiftsTheTetsBelowPointTwoOfTheFillAtAFilletCorner) {
+  // NIST 1's fill at one fillet corner (tests/data/slivers/README.md): 1198 tets, 238 of them
+  // between 0.1 and 0.2, the boundary nodes (the part's faces and the cut) first. The whole
+  // improvement again without the shape floor still leaves 56 below 0.2 (measured), with it 2
+  // (measured); the worst never drops, the boundary and the volume stay
+  const TetMesh cut = io::read_msh(std::string(TOPOPT_TEST_DATA) + "/slivers/nist1_corner_fill.msh");
+  Points P0(static_cast<size_t>(cut.V.rows()));
+  for (long i = 0; i < cut.V.rows(); ++i) P0[i] = cut.V.row(i).transpose();
+  std::vector<Tet> tets0(static_cast<size_t>(cut.T.rows()));
+  for (long t = 0; t < cut.T.rows(); ++t) tets0[t] = positive(P0, {cut.T(t, 0), cut.T(t, 1), cut.T(t, 2), cut.T(t, 3)});
+  const int fixed = cut.F.maxCoeff() + 1;  // the nodes of the boundary are 0 .. fixed - 1
+  ASSERT_EQ(fixed, 289);
+  auto below = [](const Points& P, const std::vector<Tet>& tets, double floor) {
+    return std::count_if(tets.begin(), tets.end(), [&](const Tet& t) { return rho(P, t) < floor; });
+  };
+  const double worst0 = worst(P0, tets0), v0 = volume(P0, tets0);
+  ASSERT_EQ(below(P0, tets0, 0.2), 238);
+  ASSERT_GE(worst0, 0.1);
+
+  TetImproveParams without;
+  without.shape_floor = 0;
+  Points P = P0;
+  std::vector<Tet> tets = tets0;
+  improve_tets(P, tets, fixed, without);
+  EXPECT_GE(below(P, tets, 0.2), 40) << "the fixture no longer shows what the shape floor is for";
+
+  P = P0, tets = tets0;
+  improve_tets(P, tets, fixed, TetImproveParams());
+  EXPECT_LE(below(P, tets, 0.2), 10);
+  EXPECT_EQ(below(P, tets, 0.1), 0);
+  EXPECT_GE(worst(P, tets), worst0);
+  EXPECT_NEAR(volume(P, tets), v0, 1e-9 * v0);
+  for (int i = 0; i < fixed; ++i) EXPECT_EQ(P[i], P0[i]) << "boundary node " << i << " moved";
+  expect_valid(P, tets, cut.F, "the corner's fill");
+}
+
 TEST(TetImprove, RemoveTetsBelowTakesOutAFlatTetOnTheChordsOfACurvedFace) {
   // a convex boundary bent along the ridge a-c: boundary triangles abc and acd, with b and d
   // `drop` below the ridge; the tet abcd between them (both its faces on the boundary, all four
@@ -636,3 +673,4 @@ TEST(TetImprove, RemoveSliversMendsASliverOfBoundaryNodesThatNoPointNorFlipOfTwo
 
 }  // namespace
 }  // namespace topopt::mesh
+
