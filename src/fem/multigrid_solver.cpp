@@ -33,7 +33,7 @@ class MultigridSolver final : public LinearSolver {
   void set_tolerance(double tolerance) override {
     if (tolerance == params_.tolerance) return;
     params_.tolerance = tolerance;
-    reuse_.rebaseline();  // a new hierarchy for the next matrix, and a new baseline (solver_policy.h)
+    reuse_.rebaseline();  // iteration counts at another tolerance say nothing of a stale hierarchy
   }
 
  private:

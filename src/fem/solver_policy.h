@@ -55,13 +55,9 @@ class HierarchyReuse {
     refresh_ = 0;
   }
 
-  /// The tolerance changed (SIMP's final β): the next matrix gets a new hierarchy and its first
-  /// solve is the new baseline. The kept one may have been aggregated on a design far from this
-  /// one, and a baseline taken on it is too high for the patience ever to cut a solve. Rocker
-  /// (100 k tets) with SIMP's early tolerance 1e-2: its only setup was the uniform first design's,
-  /// and at the final tolerance the solves took 33–62 CG iterations (baseline 36, 1 052 in 25
-  /// solves), still 32 on coarse levels recomputed from the current matrix on those aggregates.
-  void rebaseline() { grown_ = true; }
+  /// The tolerance changed: the next solve's iteration count is the new baseline (the hierarchy
+  /// stays as it is).
+  void rebaseline() { baseline_ = -1; }
 
   /// A solve on the kept hierarchy was cut short (patience reached) and finished on recomputed
   /// coarse levels: the designs are changing fast, so the next kRefreshAfterCut kept matrices

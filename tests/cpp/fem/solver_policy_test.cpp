@@ -69,24 +69,6 @@ TEST(HierarchyReuse, CoarseLevelsRecomputedUpFrontForTwoMatricesAfterACut) {
   EXPECT_FALSE(r.refresh_coarse_on_update());
 }
 
-TEST(HierarchyReuse, ANewToleranceGetsANewHierarchyAndBaseline) {
-  // SIMP tightens the tolerance at the final β: the kept hierarchy was aggregated on an earlier
-  // design and its iteration counts were taken at the loose tolerance, so the next matrix gets a
-  // new one, whose first solve sets the baseline
-  HierarchyReuse r(true);
-  r.set_up();
-  r.record(8);  // the baseline at the loose tolerance
-  EXPECT_TRUE(r.keep(true));
-  EXPECT_EQ(r.patience(5000), 16);  // 1.5 * 8 + 4
-  r.rebaseline();
-  EXPECT_FALSE(r.keep(true));  // set up anew
-  r.set_up();
-  EXPECT_EQ(r.patience(5000), 5000);  // no baseline at the new tolerance yet
-  r.record(15);
-  EXPECT_TRUE(r.keep(true));
-  EXPECT_EQ(r.patience(5000), 26);  // 1.5 * 15 + 4
-}
-
 TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
   HierarchyReuse r(false);
   r.set_up();
