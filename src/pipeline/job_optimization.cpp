@@ -58,9 +58,9 @@ void parse_stopping(const Fields& f, simp::SimpParams& p) {
   p.move = f.number("move", 0.2);
   if (!(p.move > 0 && p.move <= 1)) f.bad("move", "must lie in (0, 1] (the largest change of a density per iteration)");
   p.max_iterations = f.integer("max_iterations", 100, 1, 10000);
-  p.tol_change = f.number("tol_change", 0.01);
+  p.tol_change = f.number("tol_change", p.tol_change);
   if (!(p.tol_change > 0 && p.tol_change <= 1)) f.bad("tol_change", "must lie in (0, 1]");
-  p.tol_objective = f.number("tol_objective", 1e-4);
+  p.tol_objective = f.number("tol_objective", p.tol_objective);
   if (!(p.tol_objective > 0 && p.tol_objective < 1)) f.bad("tol_objective", "must lie in (0, 1)");
 }
 
