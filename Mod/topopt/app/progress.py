@@ -44,7 +44,12 @@ def stage_of(record):
     return stage
 
 
-def simp_fraction(iteration, max_iterations, compliances, tol_objective=1e-4):
+# The core's default stopping tolerance on the compliance's relative change (simp::SimpParams::
+# tol_objective, docs/optimization.md); only the progress bar's estimate reads it here.
+TOL_OBJECTIVE = 2e-4
+
+
+def simp_fraction(iteration, max_iterations, compliances, tol_objective=TOL_OBJECTIVE):
     """How far SIMP has come, in [0, 1]: the larger of the share of the iteration cap used and
     how close the compliance's relative change per iteration is to the tolerance that stops
     the run (on a log scale), so that a run that converges early does not sit far from its end

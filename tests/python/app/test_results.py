@@ -174,7 +174,7 @@ class Progress(unittest.TestCase):
         return t.label
 
     def test_simp_share_follows_convergence_not_only_the_cap(self):
-        self.assertAlmostEqual(progress.simp_fraction(10, 100, [10.0, 9.0]), math.log(1 / 9.0) / math.log(1e-4))
+        self.assertAlmostEqual(progress.simp_fraction(10, 100, [10.0, 9.0]), math.log(1 / 9.0) / math.log(progress.TOL_OBJECTIVE))
         self.assertEqual(progress.simp_fraction(10, 100, [10.0, 10.0]), 1.0)  # converged
         self.assertAlmostEqual(progress.simp_fraction(50, 100, [10.0, 5.0]), 0.5)  # the cap's share
 
