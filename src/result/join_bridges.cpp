@@ -159,8 +159,8 @@ double fill_notches(const TetMesh& mesh, const std::vector<char>& inner, double 
   return added;
 }
 
-/// The nodes (#V flags) within `radius` of node v, among `nodes` bucketed in `grid` (cells of
-/// `radius`, keyed by integer cell coordinates).
+/// Some of the mesh's nodes bucketed in cubes of side `cell` (keyed by integer cube
+/// coordinates), to find those within `cell` of a point.
 struct NodeGrid {
   double cell = 1;
   std::map<std::array<long, 3>, std::vector<long>> buckets;
@@ -280,11 +280,11 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
     std::vector<Point> points;
     for (long t : path) points.push_back(centre[t]);
     for (size_t i = 0; i + 1 < points.size(); ++i) bridge.length += (points[i + 1] - points[i]).norm();
-    // the path's own nodes too: a chain of nodes inside the level from the piece to the
-    // load-carrying one, whatever the size against the elements
     // the tube runs on a radius into both pieces, so that it ends inside them
     const std::vector<Point> axis = extended_ends(points, 0.5 * size);
     std::vector<char> near = nodes_near(mesh, axis, 0.5 * size);
+    // the path's own nodes too: a chain of nodes inside the level from the piece to the
+    // load-carrying one, whatever the size against the elements
     for (long t : path)
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     for (long t = 0; t < nt; ++t) {
