@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <queue>
 #include <set>
 #include <sstream>
@@ -13,6 +14,8 @@
 namespace topopt::result {
 
 namespace {
+
+constexpr int kNotchRounds = 8;  // fill_notches: rounds at most
 
 using Point = Eigen::Vector3d;
 
@@ -119,6 +122,117 @@ std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& poin
   return near;
 }
 
+/// The path's polyline (tet centres) with each end carried on by `length` along its last step:
+/// the tube then ends inside the pieces it joins, not at their first tet's centre.
+std::vector<Point> extended_ends(std::vector<Point> points, double length) {
+  if (points.size() < 2) return points;
+  const Point head = points[0] - points[1], tail = points.back() - points[points.size() - 2];
+  if (head.norm() > 0) points.insert(points.begin(), points[0] + length * head.normalized());
+  if (tail.norm() > 0) points.push_back(points.back() + length * tail.normalized());
+  return points;
+}
+
+/// Fills the notches left at the tet level: round after round, every design tet with a node
+/// flagged in `inner` (#V) whose four nodes all touch the solid (a node of a non-design tet or
+/// of a crisp tet of the densities at `threshold`) is set to density 1, until a round sets none
+/// or after `rounds`: the one-element crevices and notches the closing's node sampling leaves,
+/// filled from their narrow end. Returns the material added (Σ volume × the density gained).
+double fill_notches(const TetMesh& mesh, const std::vector<char>& inner, double threshold, int rounds, VecXd& density) {
+  double added = 0;
+  const auto& T = mesh.T;
+  for (int round = 0; round < rounds; ++round) {
+    const std::vector<char> solid = crisp_tets(mesh, node_densities(mesh, density), threshold);
+    std::vector<char> touch(mesh.V.rows(), 0);
+    for (long t = 0; t < T.rows(); ++t)
+      if (solid[t])
+        for (int k = 0; k < 4; ++k) touch[T(t, k)] = 1;
+    long filled = 0;
+    for (long t = 0; t < T.rows(); ++t) {
+      if (mesh.domain[t] != 0 || density[t] >= 1) continue;
+      if (!(inner[T(t, 0)] || inner[T(t, 1)] || inner[T(t, 2)] || inner[T(t, 3)])) continue;
+      if (!(touch[T(t, 0)] && touch[T(t, 1)] && touch[T(t, 2)] && touch[T(t, 3)])) continue;
+      added += tet_volume(mesh, t) * (1 - std::max(density[t], 0.0));
+      density[t] = 1, ++filled;
+    }
+    if (filled == 0) break;
+  }
+  return added;
+}
+
+/// Some of the mesh's nodes bucketed in cubes of side `cell` (keyed by integer cube
+/// coordinates), to find those within `cell` of a point.
+struct NodeGrid {
+  double cell = 1;
+  std::map<std::array<long, 3>, std::vector<long>> buckets;
+  std::array<long, 3> key(const Point& x) const {
+    return {static_cast<long>(std::floor(x[0] / cell)), static_cast<long>(std::floor(x[1] / cell)),
+            static_cast<long>(std::floor(x[2] / cell))};
+  }
+  /// Calls f(u) for every bucketed node u within `cell` of x.
+  template <class F>
+  void around(const TetMesh& mesh, const Point& x, F&& f) const {
+    const std::array<long, 3> k = key(x);
+    for (long i = -1; i <= 1; ++i)
+      for (long j = -1; j <= 1; ++j)
+        for (long l = -1; l <= 1; ++l) {
+          const auto it = buckets.find({k[0] + i, k[1] + j, k[2] + l});
+          if (it == buckets.end()) continue;
+          for (long u : it->second)
+            if ((mesh.V.row(u).transpose() - x).norm() <= cell) f(u);
+        }
+  }
+};
+
+/// Closes the junctions of a bridge: the morphological closing, by a ball of `radius`, of the
+/// solid nodes (on a non-design tet, or at or above `threshold` of the node densities) near the
+/// bridge's axis (the polyline `axis`): a node within `reach` of the axis is closed when every
+/// node within `radius` of it lies within `radius` of a solid node (dilation, then erosion).
+/// Every design tet whose four nodes are closed or solid is set to density 1: the crevices and
+/// knife-edge shelves a tube of whole tets leaves where it meets a piece's side, gaps narrower
+/// than 2 × radius, fill as fillets of that radius; flat and convex sides stay as they were.
+/// Returns the material added (Σ volume × the density gained).
+double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, double reach, double radius,
+                       double threshold, VecXd& density) {
+  const long nv = mesh.V.rows();
+  const VecXd nd = node_densities(mesh, density);
+  std::vector<char> solid(nv, 0);
+  for (long v = 0; v < nv; ++v) solid[v] = nd[v] >= threshold;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain[t] != 0)
+      for (int k = 0; k < 4; ++k) solid[mesh.T(t, k)] = 1;
+  const std::vector<char> inner = nodes_near(mesh, axis, reach);               // may close
+  const std::vector<char> outer = nodes_near(mesh, axis, reach + 2 * radius);  // what decides
+  NodeGrid grid;
+  grid.cell = radius;
+  for (long v = 0; v < nv; ++v)
+    if (outer[v]) grid.buckets[grid.key(mesh.V.row(v).transpose())].push_back(v);
+  std::vector<char> dilated(nv, 0);
+  for (long v = 0; v < nv; ++v) {
+    if (!outer[v]) continue;
+    grid.around(mesh, mesh.V.row(v).transpose(), [&](long u) { dilated[v] |= solid[u]; });
+  }
+  std::vector<char> closed(nv, 0);
+  for (long v = 0; v < nv; ++v) {
+    if (!inner[v] || solid[v]) {
+      closed[v] = solid[v];
+      continue;
+    }
+    bool all = true;
+    grid.around(mesh, mesh.V.row(v).transpose(), [&](long u) { all = all && dilated[u]; });
+    closed[v] = all;
+  }
+  double added = 0;
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    if (mesh.domain[t] != 0 || density[t] >= 1) continue;
+    const auto& T = mesh.T;
+    if (!(inner[T(t, 0)] || inner[T(t, 1)] || inner[T(t, 2)] || inner[T(t, 3)])) continue;
+    if (!(closed[T(t, 0)] && closed[T(t, 1)] && closed[T(t, 2)] && closed[T(t, 3)])) continue;
+    added += tet_volume(mesh, t) * (1 - std::max(density[t], 0.0));
+    density[t] = 1;
+  }
+  return added + fill_notches(mesh, inner, threshold, kNotchRounds, density);
+}
+
 std::string mm(double v, const char* unit) {
   std::ostringstream s;
   s.precision(v < 10 ? 2 : 4);
@@ -166,9 +280,11 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
     std::vector<Point> points;
     for (long t : path) points.push_back(centre[t]);
     for (size_t i = 0; i + 1 < points.size(); ++i) bridge.length += (points[i + 1] - points[i]).norm();
+    // the tube runs on a radius into both pieces, so that it ends inside them
+    const std::vector<Point> axis = extended_ends(points, 0.5 * size);
+    std::vector<char> near = nodes_near(mesh, axis, 0.5 * size);
     // the path's own nodes too: a chain of nodes inside the level from the piece to the
     // load-carrying one, whatever the size against the elements
-    std::vector<char> near = nodes_near(mesh, points, 0.5 * size);
     for (long t : path)
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     for (long t = 0; t < nt; ++t) {
@@ -179,6 +295,10 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
       bridge.volume += tet_volume(mesh, t) * (1 - std::clamp(out[t], 0.0, 1.0));
       out[t] = 1, carrying[t] = 1;
     }
+    const VecXd tube = out;
+    bridge.volume += close_junctions(mesh, axis, size, 0.5 * size, threshold, out);
+    for (long t = 0; t < nt; ++t)
+      if (out[t] != tube[t]) carrying[t] = 1;
     bridges.push_back(bridge);
   }
   // joined: the piece now lies in a load-carrying piece of the result shape

@@ -24,9 +24,15 @@ double bridge_penalty(double rho);
 /// tets to the nearest load-carrying tet (or one joined before), a step costing the distance
 /// between the tets' centres times bridge_penalty of the density of the tet entered
 /// (non-design tets: 1); then every design tet with a node within size / 2 of the path (the
-/// polyline through the path's tet centres) or on a tet of the path is set to density 1, so
+/// polyline through the path's tet centres, carried on by size / 2 past both ends, so that the
+/// tube ends inside the pieces it joins) or on a tet of the path is set to density 1, so
 /// every such node has node density 1 (the path's nodes join the piece to the load-carrying
-/// one) and the result shape's member there is at least `size` across.
+/// one) and the result shape's member there is at least `size` across. Last the junctions
+/// are closed within `size` of the path: the solid nodes closed by a ball of size / 2 and the
+/// design tets whose nodes are all closed set to 1, then the one-element notches left filled
+/// (design tets whose four nodes all touch a crisp or non-design tet, a few rounds), so that
+/// the tube meets the pieces in fillets, not crevices: these left triangles below 10° where the
+/// cut crossed a non-design face next to its edge, and slivers the member measure saw.
 /// anchors: #V flags (kAnchorSupport | kAnchorLoad; empty: the largest piece carries). size:
 /// the bridges' diameter (mm; <= 0: 3 × the mean edge length of the design tets). Appends one
 /// Bridge per piece to `bridges` (joined: the piece is one with a load-carrying piece in the

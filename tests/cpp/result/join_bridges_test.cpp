@@ -15,6 +15,7 @@
 #include "mesh/core/structured_box.h"
 #include "pipeline/optimize_job.h"
 #include "result/iso_surface.h"
+#include "result/result_check.h"
 #include "result/verification.h"
 #include "simp/density_filter.h"
 
@@ -157,6 +158,25 @@ TEST(JoinBridges, ADetachedPadIsJoinedByABridgeOfTheSetSizeThatAddsLittle) {
   clean_design(f.mesh, clean, 0.5, f.anchors, joining(true), again);
   EXPECT_TRUE(again.bridges.empty());
   EXPECT_TRUE(again.warnings.empty());
+}
+
+TEST(JoinBridges, TheJunctionsKeepEveryTriangleOfTheResultAt10DegreesOrMore) {
+  // issue 19: no triangle below 10°, also where the bridge meets the pad's and the beam's
+  // faces (the pad's faces are non-design faces of the result), in void and in a grey background
+  for (const double background : {0.02, 0.3}) {
+    const PadFixture f = pad_fixture(background);
+    HygieneReport rep;
+    const TriSurface s =
+        pipeline::result_surface(f.mesh, f.density, 0.5, -1, SmoothParams{}, nullptr, f.anchors, joining(true), &rep);
+    ASSERT_EQ(rep.bridges.size(), 1u) << background;
+    EXPECT_TRUE(rep.bridges[0].joined) << background;
+    const ResultCheck c = check_result(s);
+    EXPECT_TRUE(c.valid()) << background;
+    EXPECT_GE(c.min_angle_free, 10.0) << background;
+    EXPECT_GE(c.min_angle_faces, 10.0) << background;
+    EXPECT_GE(c.min_angle_nondesign, 10.0) << background;
+    EXPECT_LT(c.min_angle_nondesign, 180.0) << background;  // the pad's faces are there
+  }
 }
 
 TEST(JoinBridges, WithTheOptionOffThePadStaysApartAndNamed) {
