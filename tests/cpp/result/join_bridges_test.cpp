@@ -18,6 +18,7 @@
 #include "result/result_check.h"
 #include "result/verification.h"
 #include "simp/density_filter.h"
+#include "testing/bar_field.h"
 
 namespace topopt::result {
 namespace {
@@ -62,13 +63,7 @@ PadFixture pad_fixture(double background = 0.02, double grey = -1) {
     if (x[0] < 1e-9) f.anchors[v] |= kAnchorSupport;
     if (x[0] > 24 - 1e-9 && x[1] > 3 - 1e-9 && x[1] < 9 + 1e-9 && x[2] < 6 + 1e-9) f.anchors[v] |= kAnchorLoad;
   }
-  fem::SupportSpec fixed;
-  fixed.faces = {1};
-  fem::LoadSpec down;
-  down.vector = {0, 0, -100};
-  down.nd_faces = {8};
-  f.problem.supports = {fixed};
-  f.problem.load_cases = {{"down", {down}, 1.0}};
+  f.problem = testing::fixed_at_face1_pulled_down_on(8);
   return f;
 }
 

@@ -42,6 +42,24 @@ TriSurface finished(TriSurface s, bool with_build, DesignSurfaceReport* report =
   return s;
 }
 
+/// One rippled surface finished without the build and with it (+z, 45°), with the area too flat on each.
+struct Finished {
+  TriSurface plain, lifted;
+  DesignSurfaceReport report;  // of the lifted one
+  double too_flat_before = 0, too_flat_after = 0;
+};
+
+Finished finished_both_ways(const TriSurface& rippled) {
+  Finished f;
+  f.plain = finished(rippled, false);
+  f.lifted = finished(rippled, true, &f.report);
+  BuildDirection build;
+  build.direction = Eigen::Vector3d::UnitZ();
+  f.too_flat_before = too_flat_area(f.plain, build, 45);
+  f.too_flat_after = too_flat_area(f.lifted, build, 45);
+  return f;
+}
+
 /// The mean length of the edges at each point of s (#P).
 VecXd mean_edge(const TriSurface& s) {
   VecXd sum = VecXd::Zero(s.V.rows()), count = VecXd::Zero(s.V.rows());
@@ -59,12 +77,10 @@ TEST(OverhangLift, LiftsTheFacetsOfAPrintableSlopeBackAboveTheAngle) {
   // 52°, printable; the ripple and the smoothing scatter its facets, some below 45°
   const double slope = std::tan(52 * M_PI / 180), c = std::cos(52 * M_PI / 180);
   const TriSurface rippled = rippled_surface([&](double x, double z) { return (z - slope * (x - 2)) * c; }, 0.02);
-  const TriSurface plain = finished(rippled, false);
-  DesignSurfaceReport report;
-  const TriSurface lifted = finished(rippled, true, &report);
-  BuildDirection build;
-  build.direction = Eigen::Vector3d::UnitZ();
-  const double before = too_flat_area(plain, build, 45), after = too_flat_area(lifted, build, 45);
+  const Finished both = finished_both_ways(rippled);
+  const TriSurface &plain = both.plain, &lifted = both.lifted;
+  const DesignSurfaceReport& report = both.report;
+  const double before = both.too_flat_before, after = both.too_flat_after;
   std::cout << "too flat: " << before << " mm2 -> " << after << " mm2, " << report.lift.moves << " moves, keels "
             << report.lift.keels_before << " -> " << report.lift.keels_after << " mm\n";
   ASSERT_GT(before, 0.5) << "the ripple should tilt some facets below 45 degrees";
@@ -90,12 +106,10 @@ TEST(OverhangLift, CannotMakeAFlatCeilingPrint) {
   // move makes it steep without a keel or a lowest point, so it stays too flat but for small
   // triangles on the ripple's bumps (measured: 105.1 -> 95.4 mm², the lifted 9 % scattered over it)
   const TriSurface rippled = rippled_surface([](double, double z) { return z - 5; }, 0.02);
-  const TriSurface plain = finished(rippled, false);
-  DesignSurfaceReport report;
-  const TriSurface lifted = finished(rippled, true, &report);
-  BuildDirection build;
-  build.direction = Eigen::Vector3d::UnitZ();
-  const double before = too_flat_area(plain, build, 45), after = too_flat_area(lifted, build, 45);
+  const Finished both = finished_both_ways(rippled);
+  const TriSurface &plain = both.plain, &lifted = both.lifted;
+  const DesignSurfaceReport& report = both.report;
+  const double before = both.too_flat_before, after = both.too_flat_after;
   std::cout << "ceiling too flat: " << before << " mm2 -> " << after << " mm2, " << report.lift.moves << " moves\n";
   EXPECT_GT(before, 90);  // the 100 mm² ceiling, less what the ripple tilts
   EXPECT_GE(after, 0.9 * before);

@@ -38,13 +38,7 @@ Fixture bar_fixture() {
   f.mesh = std::move(bar.mesh);
   f.density = std::move(bar.density);
   f.surface = extract_iso_surface(f.mesh, node_densities(f.mesh, f.density), 0.5);
-  fem::SupportSpec fixed;
-  fixed.faces = {1};
-  fem::LoadSpec down;
-  down.vector = {0, 0, -100};
-  down.nd_faces = {8};
-  f.problem.supports = {fixed};
-  f.problem.load_cases = {{"down", {down}, 1.0}};
+  f.problem = testing::fixed_at_face1_pulled_down_on(8);
   return f;
 }
 

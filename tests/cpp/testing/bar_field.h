@@ -6,6 +6,7 @@
 
 #include "common/types.h"
 #include "mesh/core/structured_box.h"
+#include "result/verification.h"
 #include "simp/density_filter.h"
 
 namespace topopt::testing {
@@ -37,5 +38,19 @@ inline BarField bar_field(double first_block_end, const std::function<double(dou
 
 /// The varying radius 3.5 + 1.5 sin(x / 6) mm the iso-surface tests use.
 inline double wavy_radius(double x) { return 3.5 + 1.5 * std::sin(x / 6); }
+
+/// The result tests' load case: Ω's Face1 (x = 0) fixed, 100 N down (−z) on non-design face
+/// `nd_face` (the far block's end face).
+inline result::VerificationProblem fixed_at_face1_pulled_down_on(int nd_face) {
+  fem::SupportSpec fixed;
+  fixed.faces = {1};
+  fem::LoadSpec down;
+  down.vector = {0, 0, -100};
+  down.nd_faces = {nd_face};
+  result::VerificationProblem problem;
+  problem.supports = {fixed};
+  problem.load_cases = {{"down", {down}, 1.0}};
+  return problem;
+}
 
 }  // namespace topopt::testing
