@@ -27,7 +27,7 @@ void bind_extract_surface(pyb::module_& m) {
       "extract_surface",
       [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
          const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fraction_arg,
-         const pyb::object& smoothing_arg) {
+         const pyb::object& smoothing_arg, const std::string& optimization) {
         const TetMesh mesh = tet_mesh_arg(nodes_arg, tets_arg, domain_arg);
         const double any = std::numeric_limits<double>::max();  // densities stored by FreeCAD may pass 1 by rounding
         const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
@@ -39,7 +39,10 @@ void bind_extract_surface(pyb::module_& m) {
         result::TriSurface s;
         {
           pyb::gil_scoped_release release;
-          result::SmoothParams sp;
+          // the run's surface settings from the study's optimization section (its overhang lift)
+          std::string lift_warning;
+          result::SmoothParams sp = pipeline::extraction_settings(optimization, mesh, &lift_warning);
+          if (!lift_warning.empty()) throw Error(ErrorCode::InvalidParameter, lift_warning);
           sp.iterations = smoothing_iterations;
           s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
                                        sp);
@@ -47,9 +50,11 @@ void bind_extract_surface(pyb::module_& m) {
         return pyb::make_tuple(s.V, s.F);
       },
       pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold") = -1.0,
-      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20,
+      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20, pyb::arg("optimization") = "",
       R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
-volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
+volume_fraction of the design domain). optimization: the job's "optimization" section as JSON text
+("" for the defaults); with an overhang control the too-flat downward facets are lifted as in the
+run. Returns (points #P x 3, triangles #Q x 3), closed and
 oriented outwards.)doc");
 }
 
