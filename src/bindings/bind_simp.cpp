@@ -27,29 +27,35 @@ void bind_extract_surface(pyb::module_& m) {
       "extract_surface",
       [](const pyb::object& nodes_arg, const pyb::object& tets_arg, const pyb::object& domain_arg,
          const pyb::object& density_arg, const pyb::object& threshold_arg, const pyb::object& fraction_arg,
-         const pyb::object& smoothing_arg) {
+         const pyb::object& smoothing_arg, const pyb::object& optimization_arg) {
         const TetMesh mesh = tet_mesh_arg(nodes_arg, tets_arg, domain_arg);
         const double any = std::numeric_limits<double>::max();  // densities stored by FreeCAD may pass 1 by rounding
         const VecXd density = values_arg(density_arg, "densities", mesh.T.rows(), "tet", -any, any);
         const double threshold = number_arg(threshold_arg, "threshold", -any, any);
         const double volume_fraction = number_arg(fraction_arg, "volume_fraction", -any, any);
-        const int smoothing_iterations = int_arg(smoothing_arg, "smoothing_iterations", 0, 10000);
+        const int smoothing_iterations = int_arg(smoothing_arg, "smoothing_iterations", -1, 10000);
+        const std::string optimization = text_arg(optimization_arg, "optimization");
         if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
           throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
         result::TriSurface s;
         {
           pyb::gil_scoped_release release;
-          result::SmoothParams sp;
-          sp.iterations = smoothing_iterations;
+          // the run's surface settings from the study's optimization section (its overhang lift)
+          std::string lift_warning;
+          result::SmoothParams sp = pipeline::extraction_settings(optimization, mesh, &lift_warning);
+          if (!lift_warning.empty()) throw Error(ErrorCode::InvalidParameter, lift_warning);
+          if (smoothing_iterations >= 0) sp.iterations = smoothing_iterations;
           s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
                                        sp);
         }
         return pyb::make_tuple(s.V, s.F);
       },
       pyb::arg("nodes"), pyb::arg("tets"), pyb::arg("domain"), pyb::arg("densities"), pyb::arg("threshold") = -1.0,
-      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = 20,
+      pyb::arg("volume_fraction") = -1.0, pyb::arg("smoothing_iterations") = -1, pyb::arg("optimization") = "",
       R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
-volume_fraction of the design domain). Returns (points #P x 3, triangles #Q x 3), closed and
+volume_fraction of the design domain). optimization: the job's "optimization" section as JSON text
+("" for the defaults); with an overhang control the too-flat downward facets are lifted as in the
+run. smoothing_iterations: -1 for the section's (20 by default). Returns (points #P x 3, triangles #Q x 3), closed and
 oriented outwards.)doc");
 }
 

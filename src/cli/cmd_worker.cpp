@@ -45,7 +45,9 @@ const char* kUsage =
     "    {\"operation\": \"optimize\" | \"mesh\" | \"info\" | \"surface_mesh\" | \"extract_surface\",\n"
     "     \"job\": {...} (the job, inline: optimize, mesh), \"part\", \"nondesign\": shape files\n"
     "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
-    "     domain, densities), \"params\": {...} (info: tolerance; surface_mesh: size, wall_layers;\n"
+    "     domain, densities; its \"job\", optional, gives the study's \"optimization\" section: the\n"
+    "     run's surface settings, its overhang control's lift), \"params\": {...} (info: tolerance;\n"
+    "     surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
     "     DIR/result.step, the shape as one CAD solid, its curved faces analytic when \"part\"\n"
     "     is given, join_non_design: 0 leaves the non-design solids apart;\n"
@@ -358,12 +360,18 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   const double threshold = param(r, "threshold", -1), volume_fraction = param(r, "volume_fraction", -1);
   if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
-  result::SmoothParams smooth;
-  smooth.iterations = static_cast<int>(param(r, "smoothing_iterations", 20));
-  if (smooth.iterations < 0 || smooth.iterations > 1000)
-    throw Error(ErrorCode::InvalidParameter, "smoothing_iterations must lie in [0, 1000]");
+  if (!r.job.is_null() && !(r.job.is_object() && (!r.job.contains("optimization") || r.job["optimization"].is_object())))
+    throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object, its \"optimization\" too");
   ch.progress("read", 0, "reading the densities");
   auto [mesh, density] = checked_densities(r);
+  // the run's surface settings (its overhang control's lift) from the study's job, before the
+  // part's curved faces number the stored mesh's boundary
+  std::string lift_warning;
+  result::SmoothParams smooth = pipeline::extraction_settings(
+      r.job.is_object() && r.job.contains("optimization") ? r.job["optimization"].dump() : "", mesh, &lift_warning);
+  smooth.iterations = static_cast<int>(param(r, "smoothing_iterations", smooth.iterations));
+  if (smooth.iterations < 0 || smooth.iterations > 1000)
+    throw Error(ErrorCode::InvalidParameter, "smoothing_iterations must lie in [0, 1000]");
   const result::SourceFaces source = source_faces_for(r, mesh, ch);
   ch.progress("surface", -1, "extracting the result shape");
   double used = 0;
@@ -372,6 +380,7 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   clean.join_non_design = param(r, "join_non_design", 1) != 0;
   const result::TriSurface s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
                                                         volume_fraction, smooth, &used, {}, clean, &hygiene);
+  if (!lift_warning.empty()) hygiene.warnings.push_back(lift_warning);
   json result = {{"threshold", used}, {"warnings", hygiene.warnings}, {"min_feature", hygiene.min_feature}};
   ch.progress("write", -1, "writing the results");
   put_result_surface(result, r.output, s);

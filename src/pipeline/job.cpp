@@ -188,6 +188,10 @@ void parse_face_name(const std::string& name, std::vector<int>& faces, std::vect
                                            "\"Face7\" (or \"NonDesign:Face2\" for a face of the non-design solids)");
 }
 
+OptimizeSettings parse_optimization_text(const std::string& text) {
+  return parse_optimization(text.empty() ? json::object() : io::parse_json_text(text, "the job's optimization section"));
+}
+
 Job parse_job(const std::string& text, const std::string& base_dir) {
   const json doc = io::parse_json_text(text, "job file");
   const Fields top(

@@ -85,6 +85,11 @@ Job read_job(const std::string& path);
 /// current folder).
 Job parse_job(const std::string& text, const std::string& base_dir);
 
+/// A job's "optimization" section alone, from JSON text (an object; "" for the defaults), read
+/// and checked as parse_job reads it (keys named under "optimization."): what an extraction of a
+/// stored result takes from its study's job (pipeline::extraction_settings). Throws as parse_job.
+OptimizeSettings parse_optimization_text(const std::string& text);
+
 /// Throws Error(FaceNotFound) if a support, load or the overhang's base face names a face above `num_faces` (the
 /// part's face count), or a non-design face above `num_nondesign_faces` (skipped if < 0).
 void check_faces(const Job& job, int num_faces, int num_nondesign_faces);

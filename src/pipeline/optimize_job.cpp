@@ -232,6 +232,21 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
   return smooth;
 }
 
+result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning) {
+  OptimizeSettings set = parse_optimization_text(optimization);
+  if (warning) warning->clear();
+  simp::OverhangControl& o = set.simp.controls.overhang;
+  if (o.enabled && o.base_face > 0 && mesh.face.size() == 0) {
+    if (warning)
+      *warning = "overhang: the stored mesh does not number the part's faces, so the base plate on Face" +
+                 std::to_string(o.base_face) +
+                 " is unknown here: this shape is extracted without the overhang lift (re-run the study for the "
+                 "lifted shape)";
+    o.enabled = false;
+  }
+  return surface_settings(set, mesh);
+}
+
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used,
                                   const std::vector<char>& anchors, const result::HygieneParams& hygiene,

@@ -81,6 +81,15 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 /// `topopt result`) takes its settings here.
 result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh& mesh);
 
+/// The surface settings of a re-extraction of a stored result (the worker's extract_surface,
+/// the workbench's threshold slider; the Python module's extract_surface): `optimization`, the
+/// study's job's "optimization" section as JSON text ("" for the defaults: no overhang control),
+/// read by parse_optimization_text, then surface_settings on `mesh`, so that the shape at a
+/// threshold is the run's (with an overhang control, its too-flat facets lifted). A stored mesh
+/// has no boundary face numbers (mesh.face empty): a control standing the part on a base face
+/// then extracts without the lift and says so in *warning (may be null; "" otherwise).
+result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning);
+
 /// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain, found on the densities as given), cleaned by
 /// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the

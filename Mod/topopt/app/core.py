@@ -58,10 +58,15 @@ def volume_mesh(nodes, triangles, size=0.0, delaunay_bulk=True):
 
 
 def extract_surface(nodes, tets, domain, densities, threshold=-1.0, volume_fraction=-1.0,
-                    smoothing_iterations=20):
+                    smoothing_iterations=None, optimization=None):
     """The smoothed result shape of element densities (the native `extract_surface`),
     arguments checked first: nodes #V x 3, tets #T x 4, domain #T (or empty), densities #T
     (finite); a threshold in (0, 1), or a volume_fraction in (0, 1) whose threshold is found.
+    optimization: the job's "optimization" section (dict or JSON text; job.study_optimization
+    gives a study's), None for the defaults: with an overhang control the shape's too-flat
+    downward facets are lifted as the run lifts them (a control standing the part on a base
+    face cannot be placed on these arrays and raises). smoothing_iterations: None for the
+    section's (20 by default).
     Returns (points #P x 3, triangles #Q x 3). Large meshes are better re-extracted through
     the worker (runner.reextract does)."""
     nodes, tets, domain = _tet_mesh(nodes, tets, domain)
@@ -71,8 +76,10 @@ def extract_surface(nodes, tets, domain, densities, threshold=-1.0, volume_fract
     volume_fraction = checks.number(volume_fraction, "volume_fraction")
     if not 0 < threshold < 1 and not 0 < volume_fraction < 1:
         raise TopOptError("give a threshold in (0, 1) or a volume_fraction in (0, 1)", "InvalidParameter")
-    smoothing = int(checks.in_range(smoothing_iterations, "smoothing_iterations", 0, 1000))
-    return _call("extract_surface", nodes, tets, domain, densities, threshold, volume_fraction, smoothing)
+    smoothing = -1 if smoothing_iterations is None else int(
+        checks.in_range(smoothing_iterations, "smoothing_iterations", 0, 1000))
+    settings = checks.job_text(optimization) if optimization is not None else ""
+    return _call("extract_surface", nodes, tets, domain, densities, threshold, volume_fraction, smoothing, settings)
 
 
 def check_job(job):

@@ -135,23 +135,33 @@ def study_to_job(study):
         "material": {"E": n["YoungsModulus"], "nu": n["PoissonRatio"], "density": n["Density"]},
         "supports": supports,
         "load_cases": [{"name": "loads", "weight": 1.0, "loads": loads}],
-        "optimization": {"volume_fraction": n["VolumeFraction"], "penalty": n["Penalty"], "filter": study.Filter,
-                         "update": study.Update, "max_iterations": n["MaxIterations"],
-                         "keep_loaded_faces": bool(getattr(study, "KeepLoadedFaces", True))},
+        "optimization": study_optimization(study, n),
     }
-    if n["FilterRadius"] > 0:
-        job["optimization"]["filter_radius"] = n["FilterRadius"]
     job["result"] = {"join_non_design": bool(getattr(study, "JoinNonDesign", True))}
     job["output"] = {"step": bool(getattr(study, "WriteStep", True)), "verification": bool(getattr(study, "Verify", False))}
     if "StepMaxTriangles" in n:
         job["output"]["step_max_triangles"] = n["StepMaxTriangles"]
-    job["optimization"].update(study_responses(study))
-    controls = study_controls(study)
-    if controls:
-        job["optimization"]["controls"] = controls
     # no threshold: a run always extracts the shape that keeps the volume fraction; the study's
     # Threshold is the shown result's (the slider's), never an input of the next run
     return job
+
+
+def study_optimization(study, numbers=None):
+    """The job's "optimization" section of a study: what a run optimises with, and where a
+    re-extraction of its result (runner.extract_at, the threshold slider) takes the run's surface
+    settings from, its overhang control's lift among them. numbers: study_numbers(study) when
+    the caller has them. Raises TopOptError naming a property out of range or malformed."""
+    n = numbers if numbers is not None else study_numbers(study)
+    optimization = {"volume_fraction": n["VolumeFraction"], "penalty": n["Penalty"], "filter": study.Filter,
+                    "update": study.Update, "max_iterations": n["MaxIterations"],
+                    "keep_loaded_faces": bool(getattr(study, "KeepLoadedFaces", True))}
+    if n["FilterRadius"] > 0:
+        optimization["filter_radius"] = n["FilterRadius"]
+    optimization.update(study_responses(study))
+    controls = study_controls(study)
+    if controls:
+        optimization["controls"] = controls
+    return optimization
 
 
 def _json_property(study, name, example):

@@ -234,7 +234,8 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]),
     within the study's StepMaxTriangles, with the study's part and non-design shapes so that
     their cylinders, cones, spheres and tori come back as analytic faces, as in the run's
-    result.step.
+    result.step. The request carries the study's job's optimization section, so that the shape
+    has the run's surface settings (with an overhang control, its too-flat facets lifted).
     Returns the worker's answer (surface_points #P×3, surface_triangles #Q×3, surface_tags #Q,
     files). cancel(): polled, True cancels. Raises TopOptError if the study has no result, if
     what it stored is damaged, or if the worker fails or runs past REEXTRACT_TIMEOUT seconds."""
@@ -247,7 +248,7 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     if step:  # the study's STEP budget, as its job's output.step_max_triangles gives it to a run
         params.update(_step_budget(study), step=1)
     try:
-        return worker.run("extract_surface", arrays={"nodes": nodes, "tets": tets, "domain": domain,
+        return worker.run("extract_surface", job={"optimization": jobmod.study_optimization(study)}, arrays={"nodes": nodes, "tets": tets, "domain": domain,
                                                      "densities": densities},
                           params=params, cancel=cancel, timeout=REEXTRACT_TIMEOUT, **shapes)
     except TopOptError as e:

@@ -24,6 +24,9 @@
 
 #include "brep/shape_io.h"
 #include "io/npy.h"
+#include "pipeline/job.h"
+#include "pipeline/optimize_job.h"
+#include "result/overhang_lift.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -311,6 +314,73 @@ TEST_F(CliWorker, ExtractSurfaceStepWithThePartHasItsBoreAsCylinders) {
   const std::vector<double> radii = cylinder_radii(dir_ / "analytic" / "result.step");
   ASSERT_FALSE(radii.empty());
   for (double radius : radii) EXPECT_NEAR(radius, 4.0, 1e-6);
+}
+
+/// The surface a worker extract_surface wrote into DIR/`out`.
+topopt::result::TriSurface extracted(const fs::path& out) {
+  using namespace topopt::io;
+  topopt::result::TriSurface s;
+  s.V = npy_real(read_npy((out / "surface_points.npy").string()), 3, "points");
+  s.F = npy_integer(read_npy((out / "surface_triangles.npy").string()), 3, "triangles").cast<int>();
+  return s;
+}
+
+TEST_F(CliWorker, ExtractSurfaceTakesTheJobsOverhangLiftAsTheRunDoes) {
+  // issue 22: the threshold slider's shape is the run's. The beam (60 x 10 x 10, meshed at 2 by
+  // the worker) full above the plane z = 2 + x/4: a wedge whose underside rises 14 deg from the
+  // plate z = 0, too flat for a 45 deg overhang control
+  json job = beam_job({{"controls", {{"overhang", {{"direction", {0, 0, 1}}, {"angle", 45}}}}}});
+  job["mesh"]["size"] = 2.0;
+  WorkerRun r = run_worker(request({{"operation", "mesh"}, {"job", job}, {"part", "beam.brep"}, {"output", "mesh"}}));
+  ASSERT_EQ(r.status, 0);
+  using namespace topopt;
+  TetMesh mesh;  // the stored mesh, as the workbench keeps it: no boundary face numbers
+  mesh.V = io::npy_real(io::read_npy((dir_ / "mesh" / "nodes.npy").string()), 3, "nodes");
+  mesh.T = io::npy_integer(io::read_npy((dir_ / "mesh" / "tets.npy").string()), 4, "tets").cast<int>();
+  mesh.domain = VecXi::Zero(mesh.T.rows());
+  VecXd density(mesh.T.rows());
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(t, k)).transpose() / 4;
+    density[t] = c.z() > 2 + c.x() / 4 ? 1.0 : 1e-3;
+  }
+  io::write_npy((dir_ / "densities.npy").string(), density);
+  json extract = {{"operation", "extract_surface"},
+                  {"arrays", {{"nodes", "mesh/nodes.npy"}, {"tets", "mesh/tets.npy"}, {"densities", "densities.npy"}}},
+                  {"params", {{"threshold", 0.5}}},
+                  {"output", "plain"}};
+  r = run_worker(request(extract));  // no job: no control, the shape as before
+  ASSERT_EQ(r.status, 0);
+  extract["job"] = {{"optimization", job["optimization"]}}, extract["output"] = "lifted";
+  r = run_worker(request(extract));
+  ASSERT_EQ(r.status, 0);
+  // the run's surface: its settings as optimize takes them from the job file
+  const result::SmoothParams run_settings = pipeline::surface_settings(pipeline::parse_job(job.dump(), "").optimization, mesh);
+  ASSERT_TRUE(run_settings.build.active());
+  const result::TriSurface run = pipeline::result_surface(mesh, density, 0.5, -1, run_settings);
+  const result::TriSurface plain = extracted(dir_ / "plain"), lifted = extracted(dir_ / "lifted");
+  ASSERT_EQ(lifted.F, run.F);
+  EXPECT_LE((lifted.V - run.V).cwiseAbs().maxCoeff(), 1e-12);
+  const double flat_plain = result::too_flat_area(plain, run_settings.build, 45);
+  const double flat_lifted = result::too_flat_area(lifted, run_settings.build, 45);
+  EXPECT_NEAR(flat_lifted, result::too_flat_area(run, run_settings.build, 45), 1e-9);
+  EXPECT_GT(flat_plain, 100);  // the wedge's underside, about 33 x 10 mm
+  EXPECT_LT(flat_lifted, flat_plain - 1);
+  // without the control: the surface of the default settings, not lifted
+  const result::TriSurface before = pipeline::result_surface(mesh, density, 0.5, -1, result::SmoothParams());
+  ASSERT_EQ(plain.F, before.F);
+  EXPECT_LE((plain.V - before.V).cwiseAbs().maxCoeff(), 1e-12);
+  std::cout << "too-flat area (mm2): without the control " << flat_plain << ", with it " << flat_lifted << "\n";
+  // a control standing the part on a face: the stored mesh cannot place that plate, the shape
+  // comes without the lift and the answer says so
+  extract["job"]["optimization"]["controls"]["overhang"]["base_face"] = "Face5", extract["output"] = "based";
+  r = run_worker(request(extract));
+  ASSERT_EQ(r.status, 0);
+  std::ifstream answer(dir_ / "based" / "result.json");
+  const json based = json::parse(answer);
+  const auto says_so = [](const json& w) { return w.get<std::string>().find("without the overhang lift") != std::string::npos; };
+  EXPECT_EQ(std::count_if(based["warnings"].begin(), based["warnings"].end(), says_so), 1) << based.dump();
+  EXPECT_EQ(extracted(dir_ / "based").V, plain.V);
 }
 
 TEST_F(CliWorker, ErrorsAreALastLineNamingCodeAndStage) {

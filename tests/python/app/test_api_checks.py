@@ -202,6 +202,19 @@ class InProcessCalls(Fails, unittest.TestCase):
         self.assertEqual(len(points), 8)
         self.assertEqual(len(triangles), 12)
 
+    def test_extract_surface_takes_the_jobs_optimization(self):
+        # the run's surface settings: the section is read as the job parser reads it
+        points, triangles = core.extract_surface(CUBE_NODES, CUBE_TETS, [], np.ones(6), threshold=0.5,
+                                                 optimization={"smoothing_iterations": 0})
+        self.assertEqual((len(points), len(triangles)), (8, 12))
+        e = self.error_of(lambda: core.extract_surface(CUBE_NODES, CUBE_TETS, [], np.ones(6), threshold=0.5,
+                                                       optimization={"smoothing_iterationz": 0}))
+        self.assertIn("smoothing_iterationz", str(e))
+        base = {"controls": {"overhang": {"direction": [0, 0, 1], "base_face": "Face5"}}}
+        e = self.error_of(lambda: core.extract_surface(CUBE_NODES, CUBE_TETS, [], np.ones(6), threshold=0.5,
+                                                       optimization=base))
+        self.assertIn("without the overhang lift", str(e))
+
     def test_extract_surface_bad_arguments(self):
         dens = np.ones(6)
         past_the_end = CUBE_TETS.copy()

@@ -6,9 +6,14 @@ plate face that does not face against the build direction."""
 import unittest
 
 import FreeCAD
+import numpy as np
 
-from topopt.app import api
+from topopt.app import api, runner
 from helpers import box_study
+
+# a unit cube in 6 tets: a stored result the threshold slider re-extracts
+CUBE_NODES = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], dtype=float)
+CUBE_TETS = np.array([[0, 1, 3, 7], [0, 1, 7, 5], [0, 5, 7, 4], [0, 3, 2, 7], [0, 2, 6, 7], [0, 6, 4, 7]])
 
 
 class Controls(unittest.TestCase):
@@ -83,6 +88,33 @@ class Controls(unittest.TestCase):
         with self.assertRaises(api.TopOptError) as ctx:
             api.job_of(self.study)
         self.assertIn("GeometryControls", str(ctx.exception))
+
+    def test_the_slider_request_carries_the_build(self):
+        # issue 22: the threshold slider re-extracts in the worker with the run's surface settings,
+        # the study's job's optimization section (its overhang control: the lift)
+        api.set_controls(self.study, build_direction=(0, 0, 1), overhang_angle=50)
+        self.study.Densities = [1.0] * 6
+        stored = (CUBE_NODES, CUBE_TETS, np.zeros(6, dtype=np.int32), np.ones(6))
+        sent = {}
+
+        def record(operation, **kwargs):
+            sent.update(kwargs, operation=operation)
+            return {}
+
+        real = runner.worker.run
+        runner.worker.run = record
+        try:
+            runner.extract_at(self.study, 0.5, stored=stored)
+        finally:
+            runner.worker.run = real
+        self.assertEqual(sent["operation"], "extract_surface")
+        self.assertEqual(sent["job"], {"optimization": api.job_of(self.study)["optimization"]})
+        self.assertEqual(sent["job"]["optimization"]["controls"]["overhang"], {"direction": [0, 0, 1], "angle": 50})
+        # through the worker: the core reads it; a base face the stored mesh cannot place is said
+        api.set_controls(self.study, build_direction=(0, 0, 1), base_face="Face5")
+        answer = runner.extract_at(self.study, 0.5, stored=stored)
+        self.assertEqual(len(answer["surface_triangles"]), 12)
+        self.assertEqual(len([w for w in answer["warnings"] if "without the overhang lift" in w]), 1)
 
     def test_the_core_uses_the_controls(self):
         api.set_controls(self.study, symmetry_planes=[((0, 40, 5), (0, 1, 0))])  # y = 40: off the part

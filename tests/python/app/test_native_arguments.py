@@ -162,6 +162,8 @@ class Arguments(unittest.TestCase):
         self.refused("tets must be an array of #n by 4 indices into the nodes, not an array of bool",
                      native.extract_surface, self.nodes, self.tets > 3, self.domain, self.dens, 0.5)
         self.refused("callback must be a function taking a dict, or None", native.run_job, JOB, "", "", 5)
+        self.refused("optimization must be a str, not a dict", native.extract_surface,
+                     self.nodes, self.tets, self.domain, self.dens, 0.5, -1.0, -1, {})
 
     def test_job_json_of_the_wrong_kind_is_named(self):
         job = json.loads(JOB)
