@@ -45,8 +45,11 @@ const char* kUsage =
     "    {\"operation\": \"optimize\" | \"mesh\" | \"info\" | \"surface_mesh\" | \"extract_surface\",\n"
     "     \"job\": {...} (the job, inline: optimize, mesh), \"part\", \"nondesign\": shape files\n"
     "     (BREP/STEP), \"arrays\": {\"nodes\": \"nodes.npy\", ...} (extract_surface: nodes, tets,\n"
-    "     domain, densities; its \"job\", optional, gives the study's \"optimization\" section: the\n"
-    "     run's surface settings, its overhang control's lift), \"params\": {...} (info: tolerance;\n"
+    "     domain, densities, and the run's boundary_triangles, boundary_faces,\n"
+    "     boundary_nondesign_faces; its \"job\", optional: the study's job, cleaned and finished as\n"
+    "     its run was: supports and loads (with the boundary: the pieces kept), the optimization\n"
+    "     section's surface settings and hygiene; or that section alone),\n"
+    "     \"params\": {...} (info: tolerance;\n"
     "     surface_mesh: size, wall_layers;\n"
     "     extract_surface: threshold, volume_fraction, smoothing_iterations, step: 1 also writes\n"
     "     DIR/result.step, the shape as one CAD solid, its curved faces analytic when \"part\"\n"
@@ -340,17 +343,51 @@ std::pair<TetMesh, VecXd> checked_densities(const Request& r) {
   return {mesh, density};
 }
 
+/// The run's boundary when the request gives it (arrays boundary_triangles #F x 3 and
+/// boundary_faces #F, boundary_nondesign_faces #F optional: what the run's mesh answered), put
+/// into `mesh`, every index and length checked. Returns whether it was given.
+bool take_boundary(const Request& r, TetMesh& mesh) {
+  if (!r.arrays.count("boundary_triangles") && !r.arrays.count("boundary_faces")) return false;
+  const long nv = mesh.V.rows();
+  mesh.F = indices<MatX3i>(array_of(r, "boundary_triangles"), 3, "boundary_triangles", nv,
+                           "the node numbers 0.." + std::to_string(nv - 1));
+  const auto numbers = [&](const std::string& name) {
+    VecXi v = indices<VecXi>(array_of(r, name), 1, name, 1LL << 30, "0 and above");
+    if (v.size() != mesh.F.rows())
+      throw Error(ErrorCode::InvalidParameter, name + ": " + std::to_string(v.size()) + " numbers for " +
+                                                   std::to_string(mesh.F.rows()) + " boundary triangles");
+    return v;
+  };
+  mesh.face = numbers("boundary_faces");
+  if (r.arrays.count("boundary_nondesign_faces")) mesh.nd_face = numbers("boundary_nondesign_faces");
+  return true;
+}
+
 /// The study's part and non-design shapes when the request gives them (op_optimize's files):
-/// their curved faces for the STEP, and `mesh`'s boundary triangles (the stored mesh has none)
-/// numbered by the curved face of the part they lie on, so that the result surface's triangles
-/// there carry the tags SourceFaces::classify reads. None without a part.
-result::SourceFaces source_faces_for(const Request& r, TetMesh& mesh, WorkerChannel& ch) {
+/// their curved faces for the STEP, and, unless the request gave the run's boundary
+/// (take_boundary), `mesh`'s boundary triangles numbered by the curved face of the part they lie
+/// on, so that the result surface's triangles there carry the tags SourceFaces::classify reads.
+/// None without a part.
+result::SourceFaces source_faces_for(const Request& r, TetMesh& mesh, bool numbered, WorkerChannel& ch) {
   auto [part, nd] = read_shapes(r, ch);
   if (part.IsNull()) return {};
   result::SourceFaces source(part, nd);
+  if (numbered) return source;
   mesh.F = boundary_triangles(mesh.T);
   mesh.face = source.part_face_numbers(mesh.V, mesh.F);
   return source;
+}
+
+/// The study's job of an extract_surface request: the whole job the run had (with its supports
+/// and loads: the result is then cleaned as the run cleaned it) or its optimization section alone.
+pipeline::Job study_job(const Request& r) {
+  if (!r.job.is_null() && !(r.job.is_object() && (!r.job.contains("optimization") || r.job["optimization"].is_object())))
+    throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object, its \"optimization\" too");
+  if (r.job.is_object() && (r.job.contains("supports") || r.job.contains("load_cases"))) return job_of(r);
+  pipeline::Job job;
+  job.optimization = pipeline::parse_optimization_text(
+      r.job.is_object() && r.job.contains("optimization") ? r.job["optimization"].dump() : "");
+  return job;
 }
 
 /// extract_surface: the result shape of given densities at a threshold (or volume fraction);
@@ -360,27 +397,28 @@ json op_extract_surface(const Request& r, WorkerChannel& ch) {
   const double threshold = param(r, "threshold", -1), volume_fraction = param(r, "volume_fraction", -1);
   if (!(threshold > 0 && threshold < 1) && !(volume_fraction > 0 && volume_fraction < 1))
     throw Error(ErrorCode::InvalidParameter, "give a threshold in (0, 1) or a volume fraction in (0, 1)");
-  if (!r.job.is_null() && !(r.job.is_object() && (!r.job.contains("optimization") || r.job["optimization"].is_object())))
-    throw Error(ErrorCode::InvalidParameter, "worker request: \"job\" must be a JSON object, its \"optimization\" too");
+  const pipeline::Job job = study_job(r);
   ch.progress("read", 0, "reading the densities");
   auto [mesh, density] = checked_densities(r);
-  // the run's surface settings (its overhang control's lift) from the study's job, before the
-  // part's curved faces number the stored mesh's boundary
-  std::string lift_warning;
-  result::SmoothParams smooth = pipeline::extraction_settings(
-      r.job.is_object() && r.job.contains("optimization") ? r.job["optimization"].dump() : "", mesh, &lift_warning);
+  const bool numbered = take_boundary(r, mesh);
+  // the run's surface settings, hygiene and anchors from the study's job, before the part's
+  // curved faces number a stored mesh without its boundary
+  pipeline::Reextraction run = pipeline::reextraction(job, mesh);
+  result::SmoothParams& smooth = run.smooth;
   smooth.iterations = static_cast<int>(param(r, "smoothing_iterations", smooth.iterations));
   if (smooth.iterations < 0 || smooth.iterations > 1000)
     throw Error(ErrorCode::InvalidParameter, "smoothing_iterations must lie in [0, 1000]");
-  const result::SourceFaces source = source_faces_for(r, mesh, ch);
+  const result::SourceFaces source = source_faces_for(r, mesh, numbered, ch);
   ch.progress("surface", -1, "extracting the result shape");
   double used = 0;
-  result::HygieneReport hygiene;  // without supports and loads: the largest piece is kept
-  result::HygieneParams clean;    // the study's JoinNonDesign (1, the default: join)
-  clean.join_non_design = param(r, "join_non_design", 1) != 0;
-  const result::TriSurface s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1,
-                                                        volume_fraction, smooth, &used, {}, clean, &hygiene);
-  if (!lift_warning.empty()) hygiene.warnings.push_back(lift_warning);
+  result::HygieneReport hygiene;
+  // the study's JoinNonDesign when given (1: join), else the job's
+  run.hygiene.join_non_design = param(r, "join_non_design", run.hygiene.join_non_design ? 1 : 0) != 0;
+  const result::TriSurface s =
+      pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
+                               smooth, &used, run.anchors, run.hygiene, &hygiene, nullptr, {}, nullptr,
+                               source.size() > 0 ? &source : nullptr);
+  hygiene.warnings.insert(hygiene.warnings.end(), run.warnings.begin(), run.warnings.end());
   json result = {{"threshold", used}, {"warnings", hygiene.warnings}, {"min_feature", hygiene.min_feature}};
   ch.progress("write", -1, "writing the results");
   put_result_surface(result, r.output, s);

@@ -232,8 +232,10 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
   return smooth;
 }
 
-result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning) {
-  OptimizeSettings set = parse_optimization_text(optimization);
+namespace {
+
+/// extraction_settings' rule on parsed settings.
+result::SmoothParams stored_surface_settings(OptimizeSettings set, const TetMesh& mesh, std::string* warning) {
   if (warning) warning->clear();
   simp::OverhangControl& o = set.simp.controls.overhang;
   if (o.enabled && o.base_face > 0 && mesh.face.size() == 0) {
@@ -245,6 +247,35 @@ result::SmoothParams extraction_settings(const std::string& optimization, const 
     o.enabled = false;
   }
   return surface_settings(set, mesh);
+}
+
+}  // namespace
+
+result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning) {
+  return stored_surface_settings(parse_optimization_text(optimization), mesh, warning);
+}
+
+Reextraction reextraction(const Job& job, const TetMesh& mesh) {
+  Reextraction x;
+  std::string warning;
+  x.smooth = stored_surface_settings(job.optimization, mesh, &warning);
+  if (!warning.empty()) x.warnings.push_back(warning);
+  x.hygiene = hygiene_params(mesh, job.optimization);
+  if (job.supports.empty() && job.load_cases.empty()) return x;  // no anchors asked: the largest piece
+  const std::string differ =
+      "the result's pieces are cleaned keeping the largest one, not those joined to the supports and loads as "
+      "the run did, so this shape may differ from the run's (re-run the study to store its boundary faces)";
+  if (mesh.face.size() == 0 || mesh.face.size() != mesh.F.rows()) {
+    x.warnings.push_back("the stored mesh does not number the part's faces: " + differ);
+    return x;
+  }
+  try {
+    x.anchors = anchor_nodes(mesh, job);
+  } catch (const Error& e) {
+    x.warnings.push_back(std::string("the supports and loads cannot be placed on the stored mesh (") + e.what() +
+                         "): " + differ);
+  }
+  return x;
 }
 
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,

@@ -90,6 +90,24 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
 /// then extracts without the lift and says so in *warning (may be null; "" otherwise).
 result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning);
 
+/// How a re-extraction of a stored result is made as its run made it (the worker's
+/// extract_surface, the threshold slider): the surface settings (extraction_settings' rule), the
+/// hygiene (hygiene_params: fill_voids, the bridges' size) and the anchors (anchor_nodes), all
+/// from the study's job.
+struct Reextraction {
+  result::SmoothParams smooth;
+  result::HygieneParams hygiene;
+  std::vector<char> anchors;          ///< #V, or empty: the largest piece is kept
+  std::vector<std::string> warnings;  ///< where the stored mesh cannot give what the run had
+};
+
+/// The Reextraction of `job` (its supports and loads may be empty: only its optimization section
+/// is then known) on the stored `mesh`. The anchors need the run's boundary triangles and their
+/// face numbers (mesh.F, mesh.face; mesh.nd_face for a non-design face): without them, or when
+/// they do not hold a support's or load's face, a job with supports and loads is cleaned keeping
+/// the largest piece, and a warning says the shape may differ from the run's.
+Reextraction reextraction(const Job& job, const TetMesh& mesh);
+
 /// The result shape of element densities (#T) at a threshold (< 0: the one that keeps
 /// `volume_fraction` of the design domain, found on the densities as given), cleaned by
 /// result::clean_design at that threshold (anchors: #V, see anchor_nodes; empty: keep the

@@ -138,6 +138,28 @@ def stored_mesh(study):
     return nodes, tets, domain, densities
 
 
+def stored_boundary(study, node_count):
+    """The boundary of the analysis mesh a study stored at its last run, as the worker's arrays
+    ({"boundary_triangles" #F x 3, "boundary_faces" #F, "boundary_nondesign_faces" #F}), every
+    index and length checked; {} when the study holds none (a document saved before it kept
+    them): the threshold slider then cannot place the supports and loads, and says so."""
+    if not getattr(study, "MeshBoundary", None):
+        return {}
+    try:
+        flat = np.asarray(study.MeshBoundary, dtype=np.int64)
+        if len(flat) % 3:
+            _fail("MeshBoundary holds %d numbers, not three per triangle" % len(flat))
+        triangles = index_array(flat.reshape(-1, 3), "MeshBoundary", node_count, 3, "nodes")
+        faces = index_array(study.MeshBoundaryFaces, "MeshBoundaryFaces", 1 << 30)
+        same_length(faces, len(triangles), "MeshBoundaryFaces", "triangle")
+        nondesign = index_array(study.MeshBoundaryNonDesignFaces, "MeshBoundaryNonDesignFaces", 1 << 30)
+        same_length(nondesign, len(triangles), "MeshBoundaryNonDesignFaces", "triangle")
+    except TopOptError as e:
+        raise TopOptError("the result stored in %s is damaged (%s): run the study again"
+                          % (study.Label, e), "InvalidParameter") from None
+    return {"boundary_triangles": triangles, "boundary_faces": faces, "boundary_nondesign_faces": nondesign}
+
+
 def _stored_tets(study):
     nodes = real_array([[v.x, v.y, v.z] for v in study.MeshNodes], "MeshNodes", 3)
     flat = np.asarray(study.MeshTets, dtype=np.int64)

@@ -84,11 +84,24 @@ def execute(prepared, on_progress=None, cancel=None, on_result=None):
                       on_result=on_result if first else None)
 
 
-def store_mesh(study, nodes, tets, domain):
-    """Keeps the analysis mesh in the study (for re-extraction and the domain view)."""
+def store_mesh(study, nodes, tets, domain, answer=None):
+    """Keeps the analysis mesh in the study (for re-extraction and the domain view), and from the
+    worker's `answer` its boundary numbered by the part's faces (boundary_triangles,
+    boundary_faces, boundary_nondesign_faces), so that a re-extraction places the supports and
+    loads as the run did."""
     study.MeshNodes = [FreeCAD.Vector(*map(float, p)) for p in nodes]
     study.MeshTets = [int(i) for i in np.asarray(tets).reshape(-1)]
     study.MeshDomains = [int(i) for i in domain]
+    answer = answer or {}
+    triangles = np.asarray(answer.get("boundary_triangles", []), dtype=np.int64).reshape(-1)
+    faces = np.asarray(answer.get("boundary_faces", []), dtype=np.int64).reshape(-1)
+    nondesign = np.asarray(answer.get("boundary_nondesign_faces", []), dtype=np.int64).reshape(-1)
+    if len(nondesign) != len(faces):  # a mesh without non-design faces
+        nondesign = np.zeros(len(faces), dtype=np.int64)
+    if hasattr(study, "MeshBoundary"):  # a study made before it kept them gets them on restore
+        study.MeshBoundary = [int(i) for i in triangles]
+        study.MeshBoundaryFaces = [int(i) for i in faces]
+        study.MeshBoundaryNonDesignFaces = [int(i) for i in nondesign]
 
 
 def mesh_only(study, on_progress=None, cancel=None):
@@ -101,7 +114,7 @@ def mesh_only(study, on_progress=None, cancel=None):
     result = worker.run("mesh", job=prepared.job, part=prepared.part_brep, nondesign=prepared.nondesign_brep,
                         on_progress=on_progress, cancel=cancel)
     with transaction(study.Document, "TopOpt mesh"):
-        store_mesh(study, result["nodes"], result["tets"], result["domain"])
+        store_mesh(study, result["nodes"], result["tets"], result["domain"], result)
         study.Densities = []
         results.show_domains(study, result["nodes"], result["tets"], result["domain"])
         quiet.recompute(study.Document)
@@ -149,7 +162,7 @@ def apply(study, result):
     nodes = np.asarray(result["nodes"], dtype=np.float64)
     tets = np.asarray(result["tets"], dtype=np.int64)
     domain = np.asarray(result["domain"], dtype=np.int64)
-    store_mesh(study, nodes, tets, domain)
+    store_mesh(study, nodes, tets, domain, result)
     study.Densities = [float(x) for x in result["densities"]]
     study.ComplianceHistory = [float(h["compliance"]) for h in result["history"]]
     study.VolumeHistory = [float(h["volume"]) for h in result["history"]]
@@ -234,8 +247,11 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     the caller has it; step: also write it as a STEP solid (the answer's files["result.step"]),
     within the study's StepMaxTriangles, with the study's part and non-design shapes so that
     their cylinders, cones, spheres and tori come back as analytic faces, as in the run's
-    result.step. The request carries the study's job's optimization section, so that the shape
-    has the run's surface settings (with an overhang control, its too-flat facets lifted).
+    result.step. The request carries the study's job and the stored mesh's boundary numbered by
+    the part's faces, so that the shape is made as the run made it: its surface settings (with an
+    overhang control, its too-flat facets lifted), its hygiene (fill_voids, the bridges' size) and
+    its pieces (those joined to the supports and loads kept). A study whose job cannot be made
+    any more, or a document that kept no boundary: the worker keeps the largest piece and warns.
     Returns the worker's answer (surface_points #P×3, surface_triangles #Q×3, surface_tags #Q,
     files). cancel(): polled, True cancels. Raises TopOptError if the study has no result, if
     what it stored is damaged, or if the worker fails or runs past REEXTRACT_TIMEOUT seconds."""
@@ -248,14 +264,28 @@ def extract_at(study, threshold, cancel=None, stored=None, step=False):
     if step:  # the study's STEP budget, as its job's output.step_max_triangles gives it to a run
         params.update(_step_budget(study), step=1)
     try:
-        return worker.run("extract_surface", job={"optimization": jobmod.study_optimization(study)}, arrays={"nodes": nodes, "tets": tets, "domain": domain,
-                                                     "densities": densities},
-                          params=params, cancel=cancel, timeout=REEXTRACT_TIMEOUT, **shapes)
+        arrays = dict({"nodes": nodes, "tets": tets, "domain": domain, "densities": densities},
+                      **checks.stored_boundary(study, len(nodes)))
+        return worker.run("extract_surface", job=_extraction_job(study), arrays=arrays, params=params, cancel=cancel,
+                          timeout=REEXTRACT_TIMEOUT, **shapes)
     except TopOptError as e:
         if e.code == "TooLarge" and "step_max_triangles" in str(e):  # the core names the job's key
             raise TopOptError("%s (in the workbench: the study's StepMaxTriangles, under Output)" % e,
                               e.code) from e
         raise
+
+
+def _extraction_job(study):
+    """The study's job for a re-extraction: the whole job (its supports and loads place the
+    anchors the run cleaned the result by), or, when the study no longer makes one (a support
+    or load removed since the run), its optimization section alone, with a warning: the result
+    is then cleaned keeping its largest piece."""
+    try:
+        return jobmod.study_to_job(study)
+    except TopOptError as e:
+        FreeCAD.Console.PrintWarning("TopOpt: %s: the re-extracted shape keeps the largest piece, not the pieces "
+                                     "joined to the supports and loads, and may differ from the run's\n" % e)
+        return {"optimization": jobmod.study_optimization(study)}
 
 
 def _step_budget(study):

@@ -212,10 +212,18 @@ class Study:
         _add(obj, "App::PropertyIntegerList", "MeshTets", "Result", "Analysis mesh tets, 4 per tet")
         _add(obj, "App::PropertyIntegerList", "MeshDomains", "Result", "0 design, i non-design solid i")
         _add(obj, "App::PropertyFloatList", "Densities", "Result", "Element densities of the last run")
+        # its boundary numbered by the part's faces: the supports and loads the threshold slider
+        # cleans the result by, as the run did (empty in documents saved before)
+        _add(obj, "App::PropertyIntegerList", "MeshBoundary", "Result", "Boundary triangles of the mesh, 3 per triangle")
+        _add(obj, "App::PropertyIntegerList", "MeshBoundaryFaces", "Result",
+             "Per boundary triangle, the part's face it lies on (N of FaceN; 0 none)")
+        _add(obj, "App::PropertyIntegerList", "MeshBoundaryNonDesignFaces", "Result",
+             "Per boundary triangle, the non-design compound's face it also lies on (0 none)")
         for name in ("Status", "MeshNodes", "MeshTets", "MeshDomains", "Densities", "ComplianceHistory",
                      "VolumeHistory", "Threshold", "DomainMeshes") + tuple(n for n, _ in RESULT_LINKS + ASBUILT_LINKS):
             obj.setEditorMode(name, 1)  # read-only in the property editor
-        for name in ("MeshNodes", "MeshTets", "MeshDomains", "Densities"):
+        for name in ("MeshNodes", "MeshTets", "MeshDomains", "Densities", "MeshBoundary", "MeshBoundaryFaces",
+                     "MeshBoundaryNonDesignFaces"):
             obj.setEditorMode(name, 2)  # and hidden: they are large
 
     def _asbuilt(self, obj):

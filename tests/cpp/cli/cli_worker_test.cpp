@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -381,6 +382,93 @@ TEST_F(CliWorker, ExtractSurfaceTakesTheJobsOverhangLiftAsTheRunDoes) {
   const auto says_so = [](const json& w) { return w.get<std::string>().find("without the overhang lift") != std::string::npos; };
   EXPECT_EQ(std::count_if(based["warnings"].begin(), based["warnings"].end(), says_so), 1) << based.dump();
   EXPECT_EQ(extracted(dir_ / "based").V, plain.V);
+}
+
+/// The volume a closed, outward result surface encloses (mm3).
+double surface_volume(const topopt::result::TriSurface& s) {
+  double v = 0;
+  for (long t = 0; t < s.F.rows(); ++t) {
+    const Eigen::Vector3d a = s.V.row(s.F(t, 0)), b = s.V.row(s.F(t, 1)), c = s.V.row(s.F(t, 2));
+    v += a.dot(b.cross(c)) / 6.0;
+  }
+  return v;
+}
+
+TEST_F(CliWorker, ExtractSurfaceCleansTheResultAsTheRunDoes) {
+  // issue 19: at the run's threshold the slider's shape is the run's. The beam (60 x 10 x 10 at 2,
+  // Face1 x = 0 fixed, Face2 x = 60 loaded) solid in three pieces: x < 8 on the support, x > 52
+  // under the load, and a larger one between them touching neither. The run keeps the anchored
+  // pieces; cleaning without anchors keeps the largest, the loose middle one.
+  json job = beam_job({{"fill_voids", false}});
+  job["mesh"]["size"] = 2.0;
+  WorkerRun r = run_worker(request({{"operation", "mesh"}, {"job", job}, {"part", "beam.brep"}, {"output", "mesh"}}));
+  ASSERT_EQ(r.status, 0);
+  using namespace topopt;
+  const auto npy = [&](const char* name) { return io::read_npy((dir_ / "mesh" / name).string()); };
+  TetMesh mesh;  // the run's mesh, its boundary numbered by the part's faces
+  mesh.V = io::npy_real(npy("nodes.npy"), 3, "nodes");
+  mesh.T = io::npy_integer(npy("tets.npy"), 4, "tets").cast<int>();
+  mesh.domain = VecXi::Zero(mesh.T.rows());
+  mesh.F = io::npy_integer(npy("boundary_triangles.npy"), 3, "triangles").cast<int>();
+  mesh.face = io::npy_integer(npy("boundary_faces.npy"), 1, "faces").col(0).cast<int>();
+  VecXd density(mesh.T.rows());
+  const auto write_densities = [&](const std::function<bool(const Eigen::Vector3d&)>& solid) {
+    for (long t = 0; t < mesh.T.rows(); ++t) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(t, k)).transpose() / 4;
+      density[t] = solid(c) ? 1.0 : 1e-3;
+    }
+    io::write_npy((dir_ / "densities.npy").string(), density);
+  };
+  const pipeline::Job parsed = pipeline::parse_job(job.dump(), "");
+  const auto run_shape = [&] {  // optimize_job's own call: its anchors and hygiene from the job
+    return pipeline::result_surface(mesh, density, 0.5, -1, pipeline::surface_settings(parsed.optimization, mesh),
+                                    nullptr, pipeline::anchor_nodes(mesh, parsed),
+                                    pipeline::hygiene_params(mesh, parsed.optimization));
+  };
+  json extract = {{"operation", "extract_surface"},
+                  {"job", job},
+                  {"arrays",
+                   {{"nodes", "mesh/nodes.npy"},
+                    {"tets", "mesh/tets.npy"},
+                    {"densities", "densities.npy"},
+                    {"boundary_triangles", "mesh/boundary_triangles.npy"},
+                    {"boundary_faces", "mesh/boundary_faces.npy"}}},
+                  {"params", {{"threshold", 0.5}}},
+                  {"output", "anchored"}};
+  const auto same = [](const result::TriSurface& a, const result::TriSurface& b) {
+    ASSERT_EQ(a.F, b.F);
+    EXPECT_LE((a.V - b.V).cwiseAbs().maxCoeff(), 1e-12);
+  };
+  write_densities([](const Eigen::Vector3d& c) { return c.x() < 8 || c.x() > 52 || (c.x() > 18 && c.x() < 44); });
+  ASSERT_EQ(run_worker(request(extract)).status, 0);
+  const result::TriSurface run = run_shape(), anchored = extracted(dir_ / "anchored");
+  same(anchored, run);
+  // without the run's boundary the anchors cannot be rebuilt: the largest piece, and a warning
+  extract["arrays"].erase("boundary_triangles"), extract["arrays"].erase("boundary_faces");
+  extract["output"] = "unanchored";
+  ASSERT_EQ(run_worker(request(extract)).status, 0);
+  const json answer = json::parse(std::ifstream(dir_ / "unanchored" / "result.json"));
+  const auto says_so = [](const json& w) { return w.get<std::string>().find("may differ from the run's") != std::string::npos; };
+  EXPECT_EQ(std::count_if(answer["warnings"].begin(), answer["warnings"].end(), says_so), 1) << answer.dump();
+  const double v_run = surface_volume(run), v_largest = surface_volume(extracted(dir_ / "unanchored"));
+  std::cout << "anchored (the run's) " << v_run << " mm3, largest piece " << v_largest << " mm3\n";
+  EXPECT_NEAR(v_run, 1600, 200);      // the two end pieces, 8 x 10 x 10 each
+  EXPECT_NEAR(v_largest, 2600, 300);  // the middle one, 26 x 10 x 10
+  // fill_voids false: a closed void in a solid beam stays, as in the run
+  write_densities([](const Eigen::Vector3d& c) {
+    return !(c.x() > 20 && c.x() < 40 && c.y() > 2.5 && c.y() < 7.5 && c.z() > 2.5 && c.z() < 7.5);
+  });
+  extract = {{"operation", "extract_surface"}, {"job", job}, {"arrays", extract["arrays"]}, {"params", {{"threshold", 0.5}}}, {"output", "voided"}};
+  extract["arrays"]["boundary_triangles"] = "mesh/boundary_triangles.npy";
+  extract["arrays"]["boundary_faces"] = "mesh/boundary_faces.npy";
+  ASSERT_EQ(run_worker(request(extract)).status, 0);
+  const result::TriSurface voided_run = run_shape(), voided = extracted(dir_ / "voided");
+  same(voided, voided_run);
+  const double v_void = surface_volume(voided_run);
+  std::cout << "fill_voids false: " << v_void << " mm3 of the beam's 6000\n";
+  EXPECT_LT(v_void, 6000 - 100);  // the void (20 x 5 x 5 between the tets' centres) is there, as the run left it
+  EXPECT_GT(v_void, 6000 - 1000);
 }
 
 TEST_F(CliWorker, ErrorsAreALastLineNamingCodeAndStage) {

@@ -73,6 +73,19 @@ class ResultAsBuilt(unittest.TestCase):
             api.export_step(self.study, os.path.join(self.folder, "no", "such", "beam.step"))
         self.assertIn("does not exist", str(e.exception))
 
+    def test_re_extraction_at_the_run_threshold_is_the_run_shape(self):
+        # issue 19: the study keeps the run's boundary numbered by the part's faces, so the slider
+        # cleans the result by the run's supports and loads: the same surface, without a warning
+        from topopt.app import runner
+        self.assertEqual(len(self.study.MeshBoundary), 3 * len(self.study.MeshBoundaryFaces))
+        self.assertGreater(max(self.study.MeshBoundaryFaces), 0)
+        answer = runner.extract_at(self.study, self.study.RunThreshold)
+        self.assertEqual([w for w in answer["warnings"] if "may differ from the run's" in w], [])
+        run = self.study.Result.Mesh
+        self.assertEqual(len(answer["surface_triangles"]), run.CountFacets)
+        shown = runner.result_mesh(answer["surface_points"], answer["surface_triangles"])
+        self.assertAlmostEqual(shown.Volume, run.Volume, delta=1e-9 * run.Volume)
+
     def test_step_and_solid_follow_the_threshold_slider(self):
         from topopt.app import runner
         run_threshold = self.study.Threshold

@@ -108,13 +108,17 @@ class Controls(unittest.TestCase):
         finally:
             runner.worker.run = real
         self.assertEqual(sent["operation"], "extract_surface")
-        self.assertEqual(sent["job"], {"optimization": api.job_of(self.study)["optimization"]})
+        # the whole job (issue 19: its supports and loads place the anchors the run cleaned by)
+        self.assertEqual(sent["job"], api.job_of(self.study))
         self.assertEqual(sent["job"]["optimization"]["controls"]["overhang"], {"direction": [0, 0, 1], "angle": 50})
         # through the worker: the core reads it; a base face the stored mesh cannot place is said
         api.set_controls(self.study, build_direction=(0, 0, 1), base_face="Face5")
         answer = runner.extract_at(self.study, 0.5, stored=stored)
         self.assertEqual(len(answer["surface_triangles"]), 12)
         self.assertEqual(len([w for w in answer["warnings"] if "without the overhang lift" in w]), 1)
+        # a stored mesh without its boundary (as here, or a document saved before it kept one):
+        # the supports and loads cannot be placed, the largest piece is kept, and that is said
+        self.assertEqual(len([w for w in answer["warnings"] if "may differ from the run's" in w]), 1)
 
     def test_the_core_uses_the_controls(self):
         api.set_controls(self.study, symmetry_planes=[((0, 40, 5), (0, 1, 0))])  # y = 40: off the part
