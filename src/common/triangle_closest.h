@@ -1,9 +1,25 @@
-// The point of a triangle nearest to a point: the distance transforms of the design (hygiene's
-// thinnest member, the member-size measure) and the STEP coarsening's tolerance use it.
+// The point of a triangle (or of a segment) nearest to a point: the distance transforms of the
+// design (hygiene's thinnest member, the member-size measure), the STEP coarsening's tolerance,
+// the planar faces' straight runs and the bridges' tubes use them.
 #pragma once
 #include <Eigen/Core>
+#include <algorithm>
 
 namespace topopt {
+
+/// The point of segment a-b nearest to p (a for a degenerate segment).
+inline Eigen::Vector3d closest_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return a + t * ab;
+}
+
+/// The distance from p to segment a-b.
+inline double distance_to_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return (p - closest_on_segment(p, a, b)).norm();
+}
 
 /// The point of triangle (a, b, c) nearest to p (all in mm), by the Voronoi region of p: a
 /// corner, an edge or the inside (Ericson, Real-Time Collision Detection, 5.1.5). A degenerate

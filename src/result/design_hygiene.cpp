@@ -36,18 +36,6 @@ struct Groups {
 
 Point node(const TetMesh& mesh, int v) { return mesh.V.row(v).transpose(); }
 
-Point tet_centre(const TetMesh& mesh, long t) {
-  return 0.25 *
-         (node(mesh, mesh.T(t, 0)) + node(mesh, mesh.T(t, 1)) + node(mesh, mesh.T(t, 2)) + node(mesh, mesh.T(t, 3)));
-}
-
-double tet_volume(const TetMesh& mesh, long t) {
-  const Point a = node(mesh, mesh.T(t, 0));
-  return std::abs(
-             (node(mesh, mesh.T(t, 1)) - a).cross(node(mesh, mesh.T(t, 2)) - a).dot(node(mesh, mesh.T(t, 3)) - a)) /
-         6;
-}
-
 std::string mm3(double v) {
   std::ostringstream s;
   s.precision(v < 10 ? 2 : 4);
@@ -295,6 +283,18 @@ bool changed_design(const HygieneReport& round) {
 }
 
 }  // namespace
+
+Point tet_centre(const TetMesh& mesh, long t) {
+  return 0.25 *
+         (node(mesh, mesh.T(t, 0)) + node(mesh, mesh.T(t, 1)) + node(mesh, mesh.T(t, 2)) + node(mesh, mesh.T(t, 3)));
+}
+
+double tet_volume(const TetMesh& mesh, long t) {
+  const Point a = node(mesh, mesh.T(t, 0));
+  return std::abs(
+             (node(mesh, mesh.T(t, 1)) - a).cross(node(mesh, mesh.T(t, 2)) - a).dot(node(mesh, mesh.T(t, 3)) - a)) /
+         6;
+}
 
 std::string solids_named(const std::vector<int>& tags) {
   std::ostringstream s;

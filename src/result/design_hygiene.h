@@ -90,6 +90,11 @@ using mesh::tet_components;
 /// of one piece), -1 for design tets with none inside; `count` gets the number of pieces.
 VecXi level_components(const TetMesh& mesh, const VecXd& node_density, double threshold, int& count);
 
+/// The centroid of tet t of `mesh`, and its (unsigned) volume in mm³: the hygiene's and the
+/// bridges' measures of a tet.
+Eigen::Vector3d tet_centre(const TetMesh& mesh, long t);
+double tet_volume(const TetMesh& mesh, long t);
+
 /// What the rule looks at of a piece.
 struct PieceFacts {
   char touch = 0;          ///< kAnchorSupport | kAnchorLoad of the anchors it reaches

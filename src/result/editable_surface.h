@@ -77,4 +77,10 @@ class EditableSurface {
   std::vector<std::vector<int>> star_;
 };
 
+/// Twice the area times the unit normal of triangle t of points V (by its corners' order).
+inline Eigen::Vector3d normal_of(const MatX3d& V, const EditableSurface::Tri& t) {
+  const Eigen::Vector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]);
+  return (b - a).cross(c - a);
+}
+
 }  // namespace topopt::result

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "common/triangle_closest.h"
 #include "result/iso_surface.h"
 
 namespace topopt::result {
@@ -18,19 +19,6 @@ namespace {
 constexpr int kNotchRounds = 8;  // fill_notches: rounds at most
 
 using Point = Eigen::Vector3d;
-
-Point tet_centre(const TetMesh& mesh, long t) {
-  Point c = Point::Zero();
-  for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(t, k)).transpose();
-  return 0.25 * c;
-}
-
-double tet_volume(const TetMesh& mesh, long t) {
-  const Point a = mesh.V.row(mesh.T(t, 0)).transpose();
-  const Point b = mesh.V.row(mesh.T(t, 1)).transpose(), c = mesh.V.row(mesh.T(t, 2)).transpose(),
-              d = mesh.V.row(mesh.T(t, 3)).transpose();
-  return std::abs((b - a).cross(c - a).dot(d - a)) / 6;
-}
 
 /// 3 × the mean edge length of the design tets (of all tets when there is no design tet).
 double default_size(const TetMesh& mesh) {
@@ -99,13 +87,6 @@ std::vector<long> cheapest_path(const TetMesh& mesh, const MatX4i& nb, const std
 }
 
 /// Distance from x to the segment a-b.
-double to_segment(const Point& x, const Point& a, const Point& b) {
-  const Point d = b - a;
-  const double len2 = d.squaredNorm();
-  const double s = len2 > 0 ? std::clamp((x - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (x - (a + s * d)).norm();
-}
-
 /// Per node (#V): within `radius` of the polyline through `points`.
 std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& points, double radius) {
   Point lo = points[0], hi = points[0];
@@ -116,7 +97,7 @@ std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& poin
     const Point x = mesh.V.row(v).transpose();
     if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
     for (size_t i = 0; i + 1 < points.size() && !near[v]; ++i)
-      near[v] = to_segment(x, points[i], points[i + 1]) <= radius;
+      near[v] = distance_to_segment(x, points[i], points[i + 1]) <= radius;
     if (points.size() == 1) near[v] = (x - points[0]).norm() <= radius;
   }
   return near;

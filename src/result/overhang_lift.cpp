@@ -20,11 +20,6 @@ using Tri = EditableSurface::Tri;
 
 constexpr double kDegree = M_PI / 180;
 
-Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
-  const Eigen::Vector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]);
-  return (b - a).cross(c - a);
-}
-
 /// Whether triangle t of V rests on the plate: every corner within the plate's tolerance.
 bool on_plate(const MatX3d& V, const Tri& t, const BuildDirection& build) {
   for (int v : t)

@@ -18,16 +18,15 @@ using Tri = std::array<int, 3>;
 /// (about 1.4e-6 rad apart): the pieces of one mesh triangle cut at level crossings, rounding aside.
 constexpr double kCoplanar = 1e-12;
 
-Eigen::Vector3d normal_of(const MatX3d& V, const Tri& t) {
-  const Eigen::Vector3d a = V.row(t[0]), b = V.row(t[1]), c = V.row(t[2]);
-  return (b - a).cross(c - a);
-}
-
 /// The surface as editable triangles with each point's triangles.
 class Remesher {
  public:
   Remesher(TriSurface& s, const RemeshParams& p, const FaceProjector& onto)
-      : s_(s), p_(p), onto_(onto), m_(s.F, s.tag, s.V.rows()), guard_(s_.V, m_),
+      : s_(s),
+        p_(p),
+        onto_(onto),
+        m_(s.F, s.tag, s.V.rows()),
+        guard_(s_.V, m_),
         given_points_(static_cast<int>(s.V.rows())) {
     if (s_.point_face.size() != s_.V.rows()) s_.point_face = VecXi::Zero(s_.V.rows());
     if (onto_.nondesign_faces && onto_.onto_nondesign) nd_face_ = onto_.nondesign_faces(s_);
@@ -463,9 +462,9 @@ class Remesher {
   }
 
   /// Whether point v may go into its neighbour u: v free, inside a planar Ω face, removable from
-  /// inside a face (removable_inside) or from a non-design face's crease (crease_removable), or on the cut line of an Ω face with uv along that line
-  /// (one triangle of the face and one of the free-form on it; on a curved face no point moves,
-  /// the line keeps its other points).
+  /// inside a face (removable_inside) or from a non-design face's crease (crease_removable), or on the cut line of an Ω
+  /// face with uv along that line (one triangle of the face and one of the free-form on it; on a curved face no point
+  /// moves, the line keeps its other points).
   bool may_go(int v, int u) const {
     if (s_.lock[v] == 0 || face_interior(v) != 0 || removable_inside(v) || crease_removable(v, u)) return true;
     if (s_.lock[v] != 1 || !p_.planar_faces) return false;
@@ -508,8 +507,8 @@ class Remesher {
   const RemeshParams& p_;
   const FaceProjector& onto_;
   EditableSurface m_;
-  CrossingGuard guard_;  ///< every edit is refused when its triangles would cross the surface
-  int given_points_;  ///< the points s had; split_needle adds points after them
+  CrossingGuard guard_;       ///< every edit is refused when its triangles would cross the surface
+  int given_points_;          ///< the points s had; split_needle adds points after them
   std::vector<int> nd_face_;  ///< per triangle (index of m_): its curved non-design face (nondesign_faces) or -1
   RemeshReport report_;
 };

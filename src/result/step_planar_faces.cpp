@@ -9,6 +9,8 @@
 #include <map>
 #include <unordered_map>
 
+#include "common/triangle_closest.h"
+
 namespace topopt::result {
 namespace {
 
@@ -164,13 +166,6 @@ std::vector<PlanarFace> coplanar_groups(const TriSurface& s, const std::vector<c
   return out;
 }
 
-/// Distance from p to the segment a-b.
-double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
-}
-
 /// Per point: true when it may be dropped from the loops (see planar_faces).
 std::vector<char> droppable_points(const TriSurface& s, const std::vector<char>& mergeable,
                                    const std::vector<PlanarFace>& faces, const HalfEdges& half,
@@ -200,7 +195,7 @@ std::vector<char> droppable_points(const TriSurface& s, const std::vector<char>&
     const Vec3 x = point(s, static_cast<int>(p)), a = point(s, ends[p][0]), b = point(s, ends[p][1]);
     const Vec3 da = a - x, db = b - x;
     out[p] = da.dot(db) < 0 && da.cross(db).norm() <= sine * da.norm() * db.norm() &&
-             segment_distance(x, a, b) <= params.linear_tolerance;
+             distance_to_segment(x, a, b) <= params.linear_tolerance;
   }
   return out;
 }
@@ -224,7 +219,7 @@ std::vector<int> corners(const TriSurface& s, const std::vector<int>& loop, cons
     const Vec3 lo = point(s, std::min(a, c)), hi = point(s, std::max(a, c));
     bool straight = true;
     for (size_t k = i + 1; k < j && straight; ++k)
-      straight = segment_distance(point(s, loop[(start + k) % n]), lo, hi) <= tolerance;
+      straight = distance_to_segment(point(s, loop[(start + k) % n]), lo, hi) <= tolerance;
     out.push_back(a);
     if (!straight)
       for (size_t k = i + 1; k < j; ++k) out.push_back(loop[(start + k) % n]);
