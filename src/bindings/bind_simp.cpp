@@ -14,6 +14,7 @@
 #include "pipeline/job.h"
 #include "pipeline/optimize_job.h"
 #include "pipeline/run_job.h"
+#include "result/step_export.h"
 #include "simp/controls/member_measure.h"
 
 namespace topopt::py {
@@ -40,13 +41,16 @@ void bind_extract_surface(pyb::module_& m) {
         result::TriSurface s;
         {
           pyb::gil_scoped_release release;
-          // the run's surface settings from the study's optimization section (its overhang lift)
-          std::string lift_warning;
-          result::SmoothParams sp = pipeline::extraction_settings(optimization, mesh, &lift_warning);
-          if (!lift_warning.empty()) throw Error(ErrorCode::InvalidParameter, lift_warning);
-          if (smoothing_iterations >= 0) sp.iterations = smoothing_iterations;
+          // made as the worker's re-extraction makes it (pipeline::reextraction): the surface
+          // settings (its overhang lift) and the hygiene (fill_voids, the bridges' size) from the
+          // study's optimization section; no boundary faces here, so the largest piece is kept
+          pipeline::Job job;
+          job.optimization = pipeline::parse_optimization_text(optimization);
+          pipeline::Reextraction run = pipeline::reextraction(job, mesh);
+          if (!run.warnings.empty()) throw Error(ErrorCode::InvalidParameter, run.warnings.front());
+          if (smoothing_iterations >= 0) run.smooth.iterations = smoothing_iterations;
           s = pipeline::result_surface(mesh, density, threshold > 0 && threshold < 1 ? threshold : -1, volume_fraction,
-                                       sp);
+                                       run.smooth, nullptr, {}, run.hygiene);
         }
         return pyb::make_tuple(s.V, s.F);
       },
@@ -55,7 +59,8 @@ void bind_extract_surface(pyb::module_& m) {
       R"doc(The smoothed result shape of element densities at a threshold (or at the threshold that keeps
 volume_fraction of the design domain). optimization: the job's "optimization" section as JSON text
 ("" for the defaults); with an overhang control the too-flat downward facets are lifted as in the
-run. smoothing_iterations: -1 for the section's (20 by default). Returns (points #P x 3, triangles #Q x 3), closed and
+run, and its hygiene settings (fill_voids) are honoured as the run honours them; the largest piece
+is kept (no supports and loads are known here). smoothing_iterations: -1 for the section's (20 by default). Returns (points #P x 3, triangles #Q x 3), closed and
 oriented outwards.)doc");
 }
 
@@ -230,6 +235,9 @@ surface_points #P x 3, surface_triangles #Q x 3, surface_tags #Q, status, second
 surface), warnings (list of strings).)doc");
   bind_extract_surface(m);
   bind_design_report(m);
+  // the STEP export's own triangle budget (a job without output.step_max_triangles gets it): the
+  // workbench's new studies start from it (topopt.app.study.STEP_MAX_TRIANGLES, tested equal)
+  m.attr("STEP_MAX_TRIANGLES") = result::StepExportParams{}.max_triangles;
   bind_member_measure(m);
 }
 

@@ -87,7 +87,7 @@ Job parse_job(const std::string& text, const std::string& base_dir);
 
 /// A job's "optimization" section alone, from JSON text (an object; "" for the defaults), read
 /// and checked as parse_job reads it (keys named under "optimization."): what an extraction of a
-/// stored result takes from its study's job (pipeline::extraction_settings). Throws as parse_job.
+/// stored result takes from its study's job (pipeline::reextraction). Throws as parse_job.
 OptimizeSettings parse_optimization_text(const std::string& text);
 
 /// Throws Error(FaceNotFound) if a support, load or the overhang's base face names a face above `num_faces` (the

@@ -234,7 +234,8 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
 
 namespace {
 
-/// extraction_settings' rule on parsed settings.
+/// The surface settings of a re-extraction of a stored result (reextraction): surface_settings on
+/// `mesh`, without an overhang control's base plate the stored mesh cannot place (said in *warning).
 result::SmoothParams stored_surface_settings(OptimizeSettings set, const TetMesh& mesh, std::string* warning) {
   if (warning) warning->clear();
   simp::OverhangControl& o = set.simp.controls.overhang;
@@ -250,10 +251,6 @@ result::SmoothParams stored_surface_settings(OptimizeSettings set, const TetMesh
 }
 
 }  // namespace
-
-result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning) {
-  return stored_surface_settings(parse_optimization_text(optimization), mesh, warning);
-}
 
 Reextraction reextraction(const Job& job, const TetMesh& mesh) {
   Reextraction x;

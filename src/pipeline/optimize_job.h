@@ -81,17 +81,10 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job);
 /// `topopt result`) takes its settings here.
 result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh& mesh);
 
-/// The surface settings of a re-extraction of a stored result (the worker's extract_surface,
-/// the workbench's threshold slider; the Python module's extract_surface): `optimization`, the
-/// study's job's "optimization" section as JSON text ("" for the defaults: no overhang control),
-/// read by parse_optimization_text, then surface_settings on `mesh`, so that the shape at a
-/// threshold is the run's (with an overhang control, its too-flat facets lifted). A stored mesh
-/// has no boundary face numbers (mesh.face empty): a control standing the part on a base face
-/// then extracts without the lift and says so in *warning (may be null; "" otherwise).
-result::SmoothParams extraction_settings(const std::string& optimization, const TetMesh& mesh, std::string* warning);
-
 /// How a re-extraction of a stored result is made as its run made it (the worker's
-/// extract_surface, the threshold slider): the surface settings (extraction_settings' rule), the
+/// extract_surface, the threshold slider, the Python module's extract_surface): the surface
+/// settings (surface_settings; a control standing the part on a base face that a stored mesh
+/// without face numbers cannot place extracts without the overhang lift, with a warning), the
 /// hygiene (hygiene_params: fill_voids, the bridges' size) and the anchors (anchor_nodes), all
 /// from the study's job.
 struct Reextraction {

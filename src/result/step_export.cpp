@@ -274,13 +274,13 @@ std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pi
 
 /// `body` with the faces on one input surface that touch each other joined into one face (a
 /// full bore's two halves become one face with a seam: ShapeUpgrade_UnifySameDomain, faces only,
-/// whose edge merge re-orients the whole shell at a cost growing as its square); `body` itself
-/// when the joined shape fails OCCT's check.
+/// whose edge merge re-orients the whole shell at a cost growing as its square); not checked
+/// (the caller keeps it only when it passes OCCT's check).
 TopoDS_Shape halves_joined(const TopoDS_Shape& body, double angular_tolerance) {
   ShapeUpgrade_UnifySameDomain unify(body, false, true, false);
   unify.SetAngularTolerance(angular_tolerance);
   unify.Build();
-  return BRepCheck_Analyzer(unify.Shape()).IsValid() ? unify.Shape() : body;
+  return unify.Shape();
 }
 
 /// The refusal of a surface that coarsen_to_budget could not bring within `budget` triangles,
@@ -344,7 +344,7 @@ int result_bodies(const TriSurface& s) {
 }
 
 TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& params, CoarsenReport* coarsened,
-                          const SourceFaces* source, int* analytic_refused) {
+                          const SourceFaces* source, int* analytic_refused, bool* checked_valid) {
   const SurfaceCheck check = check_surface(given.V, given.F);
   if (!check.closed_manifold() || check.volume <= 0)
     throw Error(
@@ -364,16 +364,28 @@ TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& param
   std::vector<TopoDS_Shape> bodies;
   for (const TopoDS_Solid& body : solids_of(s, pieces, source, merge, analytic, &split)) bodies.push_back(body);
   if (analytic_refused) *analytic_refused = analytic;
-  // a body whose merged faces OCCT's check refuses while its facets pass is written as facets
+  // a body whose merged faces OCCT's check refuses while its facets pass is written as facets;
+  // each body is checked once in the form kept (BRepCheck is a fifth of the export's time)
   std::vector<TopoDS_Solid> facets;
+  bool all_valid = merge.has_value();
   for (size_t b = 0; merge && b < bodies.size(); ++b) {
-    if (split[b]) bodies[b] = halves_joined(bodies[b], params.angular_tolerance);
+    if (split[b]) {
+      const TopoDS_Shape joined = halves_joined(bodies[b], params.angular_tolerance);
+      if (BRepCheck_Analyzer(joined).IsValid()) {
+        bodies[b] = joined;
+        continue;
+      }
+    }
     if (BRepCheck_Analyzer(bodies[b]).IsValid()) continue;
     int ignored = 0;
     if (facets.empty()) facets = solids_of(s, pieces, source, std::nullopt, ignored);
-    if (BRepCheck_Analyzer(facets[b]).IsValid()) bodies[b] = facets[b], ++refused;
+    if (BRepCheck_Analyzer(facets[b]).IsValid())
+      bodies[b] = facets[b], ++refused;
+    else
+      all_valid = false;
   }
   if (coarsened) coarsened->unmerged_bodies = refused;
+  if (checked_valid) *checked_valid = all_valid;
   if (bodies.size() == 1) return bodies[0];
   BRep_Builder builder;
   TopoDS_Compound all;
@@ -420,7 +432,7 @@ std::string solid_faults(const TopoDS_Shape& shape, int limit) {
   return text;
 }
 
-StepExportReport describe_solid(const TopoDS_Shape& shape) {
+StepExportReport describe_solid(const TopoDS_Shape& shape, bool known_valid) {
   StepExportReport r;
   for (TopExp_Explorer e(shape, TopAbs_SOLID); e.More(); e.Next()) ++r.solids;
   for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) {
@@ -431,7 +443,7 @@ StepExportReport describe_solid(const TopoDS_Shape& shape) {
     if (surface->IsKind(STANDARD_TYPE(Geom_ElementarySurface)) && !surface->IsKind(STANDARD_TYPE(Geom_Plane)))
       ++r.analytic_faces;
   }
-  r.valid = BRepCheck_Analyzer(shape).IsValid();
+  r.valid = known_valid || BRepCheck_Analyzer(shape).IsValid();
   GProp_GProps props;
   BRepGProp::VolumeProperties(shape, props);
   r.volume = props.Mass();
@@ -466,8 +478,9 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
         return brep::guard_occt("building the result solid", [&]() {
           CoarsenReport coarsened;
           int analytic_refused = 0;
-          const TopoDS_Shape solid = result_solid(s, params, &coarsened, source, &analytic_refused);
-          StepExportReport r = describe_solid(solid);
+          bool checked_valid = false;  // every body passed OCCT's check in result_solid: not run again
+          const TopoDS_Shape solid = result_solid(s, params, &coarsened, source, &analytic_refused, &checked_valid);
+          StepExportReport r = describe_solid(solid, checked_valid);
           r.triangles = coarsened.triangles_after;
           r.unmerged_bodies = coarsened.unmerged_bodies;
           r.analytic_refused = analytic_refused;

@@ -81,10 +81,14 @@ struct StepExportReport {
 /// first triangle without area or an open surface (what to change: the smoothing settings).
 /// With `source` (the input's curved analytic faces), the triangles lying on one of them become
 /// faces on that original surface (step_export_analytic.h); `analytic_refused` (optional) counts
-/// the pieces that stayed facets. Runs OCCT in this process: callers with foreign or untrusted
-/// surfaces use write_result_step.
+/// the pieces that stayed facets. `checked_valid` (optional): true when every body passed OCCT's
+/// check (BRepCheck_Analyzer) here, as built (with params.unify each body is checked in the form
+/// kept; without it nothing is checked and it is false), so that describe_solid need not check the
+/// shape again. Runs OCCT in this process: callers with foreign or untrusted surfaces use
+/// write_result_step.
 TopoDS_Shape result_solid(const TriSurface& s, const StepExportParams& params = {}, CoarsenReport* coarsened = nullptr,
-                          const SourceFaces* source = nullptr, int* analytic_refused = nullptr);
+                          const SourceFaces* source = nullptr, int* analytic_refused = nullptr,
+                          bool* checked_valid = nullptr);
 
 /// The bodies of the result surface `s`: its pieces (triangles sharing points) that enclose a
 /// positive volume (a piece of negative volume is a closed void inside a body).
@@ -97,9 +101,10 @@ int result_bodies(const TriSurface& s);
 /// design does not join (a non-design solid held by its own support), in the user's terms.
 std::vector<std::string> body_descriptions(const TriSurface& s);
 
-/// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer) and
-/// measures its volume; seconds and bytes are left 0.
-StepExportReport describe_solid(const TopoDS_Shape& shape);
+/// Counts the shape's solids, faces and planar faces, checks it (BRepCheck_Analyzer; with
+/// `known_valid`, the caller's word that every solid of it passed that check already: not run
+/// again) and measures its volume; seconds and bytes are left 0.
+StepExportReport describe_solid(const TopoDS_Shape& shape, bool known_valid = false);
 
 /// What OCCT's BRepCheck_Analyzer refuses in `shape`: up to `limit` faults, each as the kind
 /// and index of the sub-shape (OCCT's TopExp order), where it lies (centre of its box, for

@@ -10,7 +10,8 @@ from . import units
 
 PROXY_TYPE = "TopOpt::Study"
 #: StepMaxTriangles of a new study: the core's own default budget (StepExportParams::max_triangles
-#: in src/result/step_export.h), which a job without "step_max_triangles" gets
+#: in src/result/step_export.h, the native module's STEP_MAX_TRIANGLES; test_study ties them), which a
+#: job without "step_max_triangles" gets
 STEP_MAX_TRIANGLES = 100000
 
 #: the study's links to what runs and the Mesh command made: (name, doc)

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <BRepCheck_Analyzer.hxx>
 #include <BRepGProp.hxx>
 #include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
@@ -95,6 +96,29 @@ TEST(StepExport, ABodyPerPieceAndVoidsAsInnerShells) {
   EXPECT_TRUE(r.valid);
   EXPECT_EQ(r.solids, 1);
   EXPECT_NEAR(r.volume, volume - 8, 1e-6 * volume);
+}
+
+TEST(StepExport, ASolidCheckedWhileBuiltIsWhatOcctsCheckOfTheWholeShapeSays) {
+  // write_result_step checks the solid once (each body as result_solid builds it), not again on
+  // the whole shape: the word "checked" must agree with OCCT's check of what is returned, for one
+  // body, two bodies in a compound and a body with a void; unmerged (params.unify off) nothing is
+  // checked and the word is "not checked"
+  const TriSurface bar = bar_surface();
+  for (const TriSurface& s :
+       {bar, testing::with_cube(bar, {20, 16, 1}, 3), testing::with_cube(bar, {2, 9, 4}, 2, true)}) {
+    bool checked = false;
+    const TopoDS_Shape shape = result_solid(s, {}, nullptr, nullptr, nullptr, &checked);
+    EXPECT_TRUE(checked);
+    EXPECT_TRUE(BRepCheck_Analyzer(shape).IsValid());
+    const StepExportReport r = describe_solid(shape, checked), again = describe_solid(shape);
+    EXPECT_EQ(r.valid, again.valid);
+    EXPECT_EQ(r.solids, result_bodies(s));
+    EXPECT_EQ(r.faces, again.faces);
+    EXPECT_NEAR(r.volume, again.volume, 1e-9 * again.volume);
+    checked = true;
+    result_solid(s, {.unify = false, .coarsen = {.tolerance = 0}}, nullptr, nullptr, nullptr, &checked);
+    EXPECT_FALSE(checked);
+  }
 }
 
 TEST(StepExport, SeparateBodiesAreOneCompoundOfSolidsWithAWarningNamingEach) {

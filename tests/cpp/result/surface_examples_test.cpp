@@ -6,12 +6,16 @@
 // measured floor, the volume of the kept design (smoothing does not shrink it), Ω's planar faces'
 // points in their planes, the points splits added inside Ω's curved faces on their true
 // surfaces, and the non-design points where marching tetrahedra put them (or, added by a split,
-// on the non-design triangles they put there).
+// on the non-design triangles they put there); at the volume's threshold, its result.step read
+// back by OCCT as one valid solid of one shell with the surface's volume.
 #include <gtest/gtest.h>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TopExp_Explorer.hxx>
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <set>
 #include <string>
 
@@ -20,6 +24,7 @@
 #include "pipeline/result_files.h"
 #include "pipeline/run_job.h"
 #include "result/result_check.h"
+#include "result/step_export.h"
 #include "testing/nondesign_distance.h"
 
 namespace topopt::result {
@@ -141,6 +146,29 @@ void check_design_surface(const TetMesh& mesh, const TriSurface& s, const VecXd&
   EXPECT_LE(off_surface, 1e-9 * scale);
 }
 
+/// The run's result as result.step, read back by OCCT: one valid solid of one shell (the result
+/// is one piece, the non-design solids no load needs joined by bridges, and holds no closed
+/// void) whose volume is the surface's within 0.5 %.
+void check_step(const TriSurface& s, const std::string& name, const SourceFaces& source) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("topopt_surface_examples_" + name + ".step")).string();
+  const StepExportReport written = write_result_step(path, s, {}, {}, &source);
+  EXPECT_TRUE(written.valid);
+  STEPControl_Reader reader;
+  ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
+  reader.TransferRoots();
+  const TopoDS_Shape back = reader.OneShape();
+  const StepExportReport r = describe_solid(back);
+  EXPECT_TRUE(r.valid) << solid_faults(back);
+  EXPECT_EQ(r.solids, 1);
+  int shells = 0;
+  for (TopExp_Explorer x(back, TopAbs_SHELL); x.More(); x.Next()) ++shells;
+  EXPECT_EQ(shells, 1);
+  const double volume = check_surface(s.V, s.F).volume;
+  EXPECT_NEAR(r.volume, volume, 0.005 * volume);
+  std::filesystem::remove(path);
+}
+
 void check_example(const Example& e) {
   const pipeline::Job job = example_job(e);
   const pipeline::RunResult run = pipeline::run_job(job);
@@ -149,6 +177,7 @@ void check_example(const Example& e) {
   {
     SCOPED_TRACE(e.name + ": the volume's threshold, 20 smoothing pairs");
     check_design_surface(run.mesh, r.surface, r.design, r.threshold, e, source);
+    check_step(r.surface, e.name, source);
   }
   SCOPED_TRACE(e.name + ": threshold 0.4, 60 smoothing pairs");
   SmoothParams smooth;

@@ -6,6 +6,7 @@ import unittest
 import FreeCAD
 import Part
 
+import topopt
 from topopt.app import api, units
 from topopt.app.study import STEP_MAX_TRIANGLES, is_study
 from helpers import bundled
@@ -77,6 +78,9 @@ class StudyFromScript(unittest.TestCase):
         self.assertIn("WallLayers is 7, outside [0, 4]", str(ctx.exception))
 
     def test_step_budget_reaches_the_job_and_is_checked(self):
+        # a new study's budget is the core's own default (StepExportParams::max_triangles), not a
+        # copy that may drift from it
+        self.assertEqual(STEP_MAX_TRIANGLES, topopt.native().STEP_MAX_TRIANGLES)
         study = self.make()
         self.assertEqual(api.job_of(study)["output"]["step_max_triangles"], STEP_MAX_TRIANGLES)
         study.StepMaxTriangles = 0  # no budget
