@@ -171,8 +171,14 @@ def member_columns(build, out, size, mesh_size, stdout):
     c = re.search(r"crisp design ([0-9.eE+-]+) N\*mm", stdout)
     apart = "came apart" if "eroded design came apart" in stdout else \
         "not joined" if "does not join the supports" in stdout else "no"
+    # the crisp design's share of the design domain, and what the minimum size's pass added (mm³)
+    vol = np.abs(np.einsum("ij,ij->i", np.cross(points[tets[:, 1]] - points[tets[:, 0]], points[tets[:, 2]] - points[tets[:, 0]]),
+                           points[tets[:, 3]] - points[tets[:, 0]])) / 6
+    share = vol[design_solid].sum() / vol[domain == 0].sum()
+    added = h.get("design", {}).get("min_member", {}).get("volume_added", 0.0)
     return (m["smallest_member"], beyond.min() if beyond.size else float("nan"),
-            beyond2.min() if beyond2.size else float("nan"), thin, float(c.group(1)) if c else float("nan"), apart)
+            beyond2.min() if beyond2.size else float("nan"), thin, float(c.group(1)) if c else float("nan"), apart,
+            share, added)
 
 
 def run(cmd):
@@ -252,10 +258,11 @@ def main():
                 shares += " (%.1f mm²: %.1f on bared non-design faces, %.1f on non-design faces on Ω's boundary; " \
                           "without those: **%.1f %%**)" % (over, bared, given, 100 * share)
             if controls and "min_member_size" in controls:
-                small, beyond, beyond2, thin, crisp_c, apart = member_columns(
+                small, beyond, beyond2, thin, crisp_c, apart, share, added = member_columns(
                     a.build, out, controls["min_member_size"], size, p.stdout + p.stderr)
-                members.append("| %s | %s | %g | %.2f mm | %.2f / %.2f mm | %.1f %% | %.4g | %.4g | %s |" % (
-                    name, label, a.volume, small, beyond, beyond2, 100 * thin, c, crisp_c, apart))
+                members.append("| %s | %s | %g | %.2f mm | %.2f / %.2f mm | %.1f %% | %.4g | %.4g | %.4f | %.0f | %s | %d | %.1f |" % (
+                    name, label, a.volume, small, beyond, beyond2, 100 * thin, c, crisp_c, share, added, apart,
+                    len(h["history"]), cpu))
             print("| %s | %s | %s | %s | %d | %.4g | %s | %.1f | %.1f / %.1f | %s | %s |" % (
                 name, label, tets.group(1) if tets else "?", nvar.group(1) if nvar else "all", len(h["history"]), c,
                 "%.2f" % (c / free_c) if free_c else "-", simp_s, wall, cpu, shares, os.path.basename(png)))
@@ -263,8 +270,8 @@ def main():
     if members:
         print("\n| example | control | volume | smallest member (reach 1 mesh size) | beyond one / two mesh sizes of the non-design tets | "
               "solid design tets thinner than size − mesh size | SIMP compliance (eroded) | crisp design's compliance (N·mm) | "
-              "eroded design warned |")
-        print("|---|---|---|---|---|---|---|---|---|")
+              "crisp volume (of the design domain) | added by the size (mm³) | eroded design warned | iterations | CPU (s) |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         print("\n".join(members))
 
 

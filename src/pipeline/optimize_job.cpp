@@ -67,7 +67,19 @@ void write_history_json(const std::string& path, const OptimizeResult& r) {
                        {"length", b.length},
                        {"size", b.size},
                        {"joined", b.joined}});
+  const result::MemberEnforcement& m = h.members;
+  const json members = {{"size", m.size},
+                        {"cell", m.cell},
+                        {"smallest_before", m.smallest_before},
+                        {"smallest_after", m.smallest_after},
+                        {"thinnest_at", m.thinnest_at},
+                        {"volume_added", m.volume_added},
+                        {"design_volume", m.design_volume},
+                        {"tets_added", m.tets_added},
+                        {"rounds", m.rounds},
+                        {"met", m.met()}};
   j["design"] = {{"pieces", h.pieces},
+                 {"min_member", members},
                  {"anchored_pieces", h.anchored_pieces},
                  {"apart", apart},
                  {"bridges", bridges},
@@ -170,6 +182,7 @@ result::HygieneParams hygiene_params(const TetMesh& mesh, const OptimizeSettings
   result::HygieneParams h = settings.hygiene;
   const double min_size = settings.simp.controls.member.min_size;
   h.bridge_size = min_size > 0 ? min_size : 2 * simp::filter_radius(mesh, settings.simp.filter);
+  h.min_member_size = min_size;
   return h;
 }
 

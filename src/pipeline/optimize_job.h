@@ -55,7 +55,8 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
 /// The hygiene of a job's result on `mesh`: settings.hygiene with the bridges' diameter (the
 /// non-design solids joined, result::HygieneParams::bridge_size) the minimum member size when
 /// set (controls.member.min_size), else the density filter's diameter (twice the radius SIMP
-/// uses on this mesh, simp::filter_radius).
+/// uses on this mesh, simp::filter_radius); and that minimum member size held on the crisp
+/// design (result::HygieneParams::min_member_size, result/member_enforce.h).
 result::HygieneParams hygiene_params(const TetMesh& mesh, const OptimizeSettings& settings);
 
 /// The faces of Ω a support or a force or pressure of `job` acts on (1-based, ascending;

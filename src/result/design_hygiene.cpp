@@ -438,23 +438,20 @@ double min_feature_size(const TetMesh& mesh, const MatX4i& neighbours, const std
   return std::isfinite(best) ? best : 0;
 }
 
-VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
-                   const HygieneParams& params, HygieneReport& report) {
-  report = HygieneReport{};
-  const MatX4i nb = tet_neighbours(mesh.T);
-  std::vector<Bridge> bridges;
-  VecXd out = params.join_non_design
-                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges)
-                  : density;
+namespace {
+
+/// The cleaning rounds of clean_design on `out` (#T, changed in place): `report` gets the first
+/// round's findings and what later rounds removed or filled.
+void clean_rounds(const TetMesh& mesh, const MatX4i& nb, double threshold, const std::vector<char>& anchors,
+                  const HygieneParams& params, VecXd& out, HygieneReport& report) {
   // Taking a piece out lowers the node densities of the tets around it, filling a void raises
   // them, so the crisp design of the cleaned densities can hold a piece or a void the first
   // round did not see: clean again until a round changes nothing, so that the design handed
   // over is clean by the same test (at most kRounds rounds).
   constexpr int kRounds = 4;
-  std::vector<char> solid;
   for (int round = 0; round < kRounds; ++round) {
     const VecXd nd = node_densities(mesh, out);
-    solid = crisp_tets(mesh, nd, threshold);
+    std::vector<char> solid = crisp_tets(mesh, nd, threshold);
     HygieneReport found;
     remove_pieces(mesh, nd, threshold, anchors, solid, out, found);
     // the voids of what the removals left: the crisp design's, then the cut's that it misses
@@ -468,11 +465,35 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
       add_round(found, report);
     if (!changed_design(round == 0 ? report : found)) break;
   }
+}
+
+}  // namespace
+
+VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, const std::vector<char>& anchors,
+                   const HygieneParams& params, HygieneReport& report) {
+  report = HygieneReport{};
+  const MatX4i nb = tet_neighbours(mesh.T);
+  std::vector<Bridge> bridges;
+  VecXd out = params.join_non_design
+                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges)
+                  : density;
+  clean_rounds(mesh, nb, threshold, anchors, params, out, report);
+  if (params.min_member_size > 0) {  // the minimum member size held on the clean design, then its voids closed
+    MemberEnforcement members;
+    out = enforce_min_member(mesh, out, threshold, anchors, {params.min_member_size}, members);
+    if (members.tets_added > 0) {
+      HygieneReport again;
+      clean_rounds(mesh, nb, threshold, anchors, params, out, again);
+      add_round(again, report);
+    }
+    report.members = members;
+  }
   warn_voids(report);
   for (const Bridge& b : bridges)
     if (b.joined) report.warnings.push_back(bridge_warning(b));
   report.bridges = std::move(bridges);
-  solid = crisp_tets(mesh, node_densities(mesh, out), threshold);
+  if (const std::string w = member_warning(report.members); !w.empty()) report.warnings.push_back(w);
+  const std::vector<char> solid = crisp_tets(mesh, node_densities(mesh, out), threshold);
   report.min_feature = min_feature_size(mesh, nb, solid, report.min_feature_at);
   return out;
 }

@@ -16,6 +16,7 @@
 #include "common/types.h"
 #include "mesh/core/tet_components.h"
 #include "result/iso_surface.h"
+#include "result/member_enforce.h"
 
 namespace topopt::result {
 
@@ -32,6 +33,10 @@ struct HygieneParams {
   /// diameter (pipeline::hygiene_params); <= 0: 3 × the mean edge length of the design tets
   /// (the diameter of the automatic filter).
   double bridge_size = 0;
+  /// The job's minimum member size (mm, controls.min_member_size; pipeline::hygiene_params): after
+  /// the cleaning, the crisp design's members thinner than it are thickened (member_enforce.h).
+  /// <= 0: not.
+  double min_member_size = 0;
 };
 
 /// A bridge that joins a non-design solid apart to the load-carrying piece (join_bridges.h).
@@ -60,6 +65,7 @@ struct HygieneReport {
   int voids_kept = 0;              ///< closed internal voids kept (fill_voids false)
   double void_volume_kept = 0;     ///< mm³
   std::vector<Bridge> bridges;     ///< bridges made (join_non_design), before the rest of the cleaning
+  MemberEnforcement members;       ///< the minimum member size held (params.min_member_size)
   double min_feature = 0;          ///< thinnest member of the design (mm), 0 if none measured
   std::array<double, 3> min_feature_at{0, 0, 0};  ///< where (the centre of a design tet)
   std::vector<std::string> warnings;              ///< one sentence each, in the user's terms
