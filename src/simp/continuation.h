@@ -18,12 +18,13 @@ struct ProjectionParams {
   double beta_max = 32;              ///< the final sharpness; >= beta_start
   double beta_factor = 2;            ///< β ← min(beta_max, beta_factor β) when settled, > 1
   int max_iterations_per_beta = 40;  ///< raise β after this many iterations at one β anyway
-  /// Relative compliance change that counts as settled. 1e-2 (the job's "settle") would save
-  /// the rocker 6 of its 25 iterations at β = 1 (19) and the cantilever 11 for final designs no
-  /// worse, but the tests' 40-iteration runs then end at β 32 instead of β 2, where
-  /// Controls.CyclicAndPatternDesignsRepeat and DrawDirectionHoldsOnATurnedDirection miss their
-  /// bounds (BENCHMARKS.md, branches speed3 and speed6): not the default until they are looked at.
-  double settle_tolerance = 2e-3;
+  /// Relative compliance change that counts as settled (the job's "settle"). 1e-2 against the
+  /// earlier 2e-3: the rocker 61 → 53 iterations (compliance −1.5e-4), the bracket 50 → 45, the
+  /// lever 98 → 73 (its compliance +0.38 %) (BENCHMARKS.md, branch speed8). The two Controls tests
+  /// it broke measured their property unfairly on the sharper designs (a quarter turn that does
+  /// not carry the mesh's tets onto tets; a threshold inside the cast's smoothing slack), not a
+  /// loss of symmetry or castability: their measures were corrected, their bounds kept.
+  double settle_tolerance = 1e-2;
   int settle_iterations = 3;         ///< ... for this many iterations running
 };
 
