@@ -16,7 +16,7 @@ using nlohmann::json;
 namespace {
 
 /// "heaviside": true/null (on, the defaults), false (off) or {"beta_start": 1, "beta_max": 32,
-/// "factor": 2, "every": 40, "settle": 1e-2} (on, with those settings).
+/// "factor": 2, "every": 40, "settle": 2e-3} (on, with those settings).
 void parse_heaviside(const Fields& f, simp::ProjectionParams& p) {
   if (!f.has("heaviside")) return;
   const json& h = f.at("heaviside");

@@ -18,13 +18,13 @@ struct ProjectionParams {
   double beta_max = 32;              ///< the final sharpness; >= beta_start
   double beta_factor = 2;            ///< β ← min(beta_max, beta_factor β) when settled, > 1
   int max_iterations_per_beta = 40;  ///< raise β after this many iterations at one β anyway
-  /// Relative compliance change that counts as settled (the job's "settle"). 1e-2 against the
-  /// earlier 2e-3: the rocker 61 → 53 iterations (compliance −1.5e-4), the bracket 50 → 45, the
-  /// lever 98 → 73 (its compliance +0.38 %) (BENCHMARKS.md, branch speed8). The two Controls tests
-  /// it broke measured their property unfairly on the sharper designs (a quarter turn that does
-  /// not carry the mesh's tets onto tets; a threshold inside the cast's smoothing slack), not a
-  /// loss of symmetry or castability: their measures were corrected, their bounds kept.
-  double settle_tolerance = 1e-2;
+  /// Relative compliance change that counts as settled (the job's "settle"). 1e-2 would save the
+  /// rocker 8 of its 61 iterations (compliance −1.5e-4), the cantilever 8 of 69, the bracket 5 of
+  /// 50 and the lever 25 of 98 (its compliance +0.38 %), and the two Controls tests it broke were
+  /// measuring unfairly (corrected, branch speed8); but Overhang.BeamHasLessOverhangWithTheControl
+  /// then ends on a design whose crisp iso-surface overhangs 2.4 % (bound 1 %; 0.81 % at 2e-3),
+  /// not looked into yet (BENCHMARKS.md, branches speed6 and speed8): not the default.
+  double settle_tolerance = 2e-3;
   int settle_iterations = 3;         ///< ... for this many iterations running
 };
 

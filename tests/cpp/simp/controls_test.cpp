@@ -82,7 +82,7 @@ std::vector<Eigen::Vector3d> within_one_cell(const Beam& b) {
 /// crisp design's boundary is a staircase of tets, and a map that does not carry the mesh's
 /// tets onto tets (the quarter turn about the beam's axis maps the diagonal that splits each
 /// cube into six tets onto another diagonal) shifts that staircase by up to one cell in a
-/// diagonal direction (measured with the continuation ending at β = 32: every point missed
+/// diagonal direction (measured with settle 1e-2, the continuation ending at β = 32: every point missed
 /// by the axis neighbours alone found its state within one cell; the free design's mismatch is
 /// far above the bounds either way).
 double mismatch(const Beam& b, const VecXd& rho, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& image,
@@ -369,11 +369,11 @@ TEST(Controls, TetCastNeverRisesAlongATurnedDirection) {
 /// drawn along d could not release: one-sided, solid above void; split, solid → void → solid (a
 /// cavity between the two dies' reach). A ray turns solid where rho rises above 0.5 + band and
 /// void where it falls below 0.5 − band (in between it keeps its state). The band is the cast's
-/// own slack on a grey design: each smooth maximum may fall short of the maximum by √ε/2 (ε = the
-/// draw direction's smoothness, 1e-6 below), so
-/// the cast field may rise by that much per tet along a ray, and a stretch of values hovering
-/// at the threshold then reads as void under solid (the 40-iteration runs below end at β 8 and
-/// 2 with 22 % grey; their wrong-way rises measured 0.003–0.017, the free design's 0.58–0.99).
+/// own slack on a grey design: each smooth maximum may fall short of the maximum by √ε/2 (ε, the
+/// draw direction's smoothness, is 1e-6 below), so the cast field may rise by that much per tet
+/// along a ray, and a stretch of values hovering at the threshold then reads as void under solid
+/// (with the job's settle 1e-2 the 40-iteration runs below ended at β 8 and 2 with 22 % grey:
+/// their wrong-way rises measured 0.003–0.017, the free design's 0.58–0.99).
 double share_not_castable(const Beam& b, const VecXd& rho, const Eigen::Vector3d& d, bool split, double band = 0.02) {
   long rays = 0, bad = 0;
   along_rays(b, rho, d.normalized(), 0.5, [&](const std::vector<double>& values) {
