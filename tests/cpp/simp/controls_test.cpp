@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -61,23 +62,42 @@ SimpParams run_params() {
   return p;
 }
 
+/// Offsets (mm) to the points within one cell of a point: a ball of one cell's edge along each
+/// axis, sampled every quarter cell, nearest first (the point itself first).
+std::vector<Eigen::Vector3d> within_one_cell(const Beam& b) {
+  std::vector<Eigen::Vector3d> offsets;
+  for (int i = -4; i <= 4; ++i)
+    for (int j = -4; j <= 4; ++j)
+      for (int k = -4; k <= 4; ++k)
+        if (i * i + j * j + k * k <= 16) offsets.emplace_back(i / 4.0, j / 4.0, k / 4.0);
+  std::stable_sort(offsets.begin(), offsets.end(),
+                   [](const Eigen::Vector3d& a, const Eigen::Vector3d& c) { return a.squaredNorm() < c.squaredNorm(); });
+  for (Eigen::Vector3d& o : offsets) o = o.cwiseProduct(Eigen::Vector3d(b.cell(0), b.cell(1), b.cell(2)));
+  return offsets;
+}
+
 /// Share of sample points p inside the box (x below x_max) whose crisp density differs from
-/// that at every point within one cell of image(p) (the image itself and ± one cell along
-/// each axis): 0 for a design that the map carries onto itself, to the mesh size.
+/// that at every point within one cell of image(p) (in any direction): 0 for a design that the
+/// map carries onto itself, to the mesh size. Any direction, not only along the axes: the
+/// crisp design's boundary is a staircase of tets, and a map that does not carry the mesh's
+/// tets onto tets (the quarter turn about the beam's axis maps the diagonal that splits each
+/// cube into six tets onto another diagonal) shifts that staircase by up to one cell in a
+/// diagonal direction (measured with settle 1e-2, the continuation ending at β = 32: every point missed
+/// by the axis neighbours alone found its state within one cell; the free design's mismatch is
+/// far above the bounds either way).
 double mismatch(const Beam& b, const VecXd& rho, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& image,
                 double x_max = 28) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> ux(0, x_max), uyz(-5, 5);
+  const std::vector<Eigen::Vector3d> near = within_one_cell(b);
   int bad = 0, n = 4000;
   for (int s = 0; s < n; ++s) {
     const Eigen::Vector3d p(ux(rng), uyz(rng), uyz(rng));
     const Eigen::Vector3d q = image(p);
     if (std::isnan(q.x())) continue;  // p is not in the map's range
     const bool mine = b.solid(rho, p);
-    bool found = b.solid(rho, q) == mine;
-    for (int a = 0; a < 3 && !found; ++a)
-      for (double sign : {-1.0, 1.0})
-        found = found || b.solid(rho, q + sign * b.cell(a) * Eigen::Vector3d::Unit(a)) == mine;
+    bool found = false;
+    for (size_t k = 0; k < near.size() && !found; ++k) found = b.solid(rho, q + near[k]) == mine;
     bad += !found;
   }
   return static_cast<double>(bad) / n;
@@ -345,22 +365,29 @@ TEST(Controls, TetCastNeverRisesAlongATurnedDirection) {
       EXPECT_EQ(cast.num_dropped(), 0) << "a cycle on the structured mesh";
     }
 }
-/// Share of the rays along d (along_rays, 0.5 mm apart) through the crisp design (rho > 0.5,
-/// #T) that a die drawn along d could not release: one-sided, solid above void; split, solid
-/// → void → solid (a cavity between the two dies' reach). Such a ray crosses the boundary
-/// more than once (one-sided) or twice (split) or in the wrong order.
-double share_not_castable(const Beam& b, const VecXd& rho, const Eigen::Vector3d& d, bool split) {
+/// Share of the rays along d (along_rays, 0.5 mm apart) through the design (rho, #T) that a die
+/// drawn along d could not release: one-sided, solid above void; split, solid → void → solid (a
+/// cavity between the two dies' reach). A ray turns solid where rho rises above 0.5 + band and
+/// void where it falls below 0.5 − band (in between it keeps its state). The band is the cast's
+/// own slack on a grey design: each smooth maximum may fall short of the maximum by √ε/2 (ε, the
+/// draw direction's smoothness, is 1e-6 below), so the cast field may rise by that much per tet
+/// along a ray, and a stretch of values hovering at the threshold then reads as void under solid
+/// (with the job's settle 1e-2 the 40-iteration runs below ended at β 8 and 2 with 22 % grey:
+/// their wrong-way rises measured 0.003–0.017, the free design's 0.58–0.99).
+double share_not_castable(const Beam& b, const VecXd& rho, const Eigen::Vector3d& d, bool split, double band = 0.02) {
   long rays = 0, bad = 0;
   along_rays(b, rho, d.normalized(), 0.5, [&](const std::vector<double>& values) {
     ++rays;
     bool left = !split;  // one-sided: the ray starts in the lower die's solid; any void → solid is wrong
-    for (size_t k = 0; k + 1 < values.size(); ++k) {
-      const bool now = values[k] > 0.5, next = values[k + 1] > 0.5;
-      if (!now && next && left) {
+    bool solid = values[0] > 0.5;
+    for (size_t k = 1; k < values.size(); ++k) {
+      const bool next = solid ? values[k] >= 0.5 - band : values[k] > 0.5 + band;
+      if (!solid && next && left) {
         ++bad;
         return;
       }
-      left = left || (now && !next);
+      left = left || (solid && !next);
+      solid = next;
     }
   });
   return rays ? static_cast<double>(bad) / rays : 1.0;
@@ -421,7 +448,12 @@ TEST(Controls, CyclicAndPatternDesignsRepeat) {
   p.controls.cyclic = {CyclicRepetition{{0, 0, 0}, {1, 0, 0}, 4}};  // 90° about the beam's axis
   const SimpResult cyc = optimize(b.mesh, b.mat, b.supports, b.loads, {}, p);
   const auto quarter = [](const Eigen::Vector3d& q) { return Eigen::Vector3d(q.x(), -q.z(), q.y()); };
-  EXPECT_LE(mismatch(b, cyc.density, quarter), 0.01);
+  const SimpResult free_b = optimize(b.mesh, b.mat, b.supports, b.loads, {}, run_params());
+  const double m_cyc = mismatch(b, cyc.density, quarter), m_free_b = mismatch(b, free_b.density, quarter);
+  std::cout << "quarter turn mismatch: cyclic " << m_cyc << " (beta " << cyc.history.back().beta << ", grey "
+            << cyc.history.back().grey << "), free " << m_free_b << "\n";
+  EXPECT_LE(m_cyc, 0.01);
+  EXPECT_GE(m_free_b, 0.03) << "the free design should not repeat under the quarter turn";
   // three copies across the beam's height (y in [-5, -5/3), [-5/3, 5/3), [5/3, 5)), where the
   // free design puts its flanges at the top and bottom only
   Beam fine({18, 9, 6});
