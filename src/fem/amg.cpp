@@ -25,8 +25,7 @@ struct Level {
   double lambda = 1;           // estimate of λmax(D⁻¹A)
   std::vector<double> eigvec;  // its eigenvector estimate (restarts the power iteration)
   CsrMatrix P, R;              // to/from the next coarser level
-  // single-precision copies of A, P, R's values, interleaved by row block: what the V-cycle
-  // reads (see interleaved_product)
+  // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
   // residual, Chebyshev correction, scratch product
@@ -251,8 +250,7 @@ struct SmoothedAggregationAmg::Impl {
   /// A does not coarsen any more (the next level would keep 80 % of the unknowns or more).
   bool coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
-  /// The single-precision copy of M's values the V-cycle reads, interleaved by row block.
-  static void to_single(const CsrMatrix& M, std::vector<float>& out) { interleaved_values(M, out); }
+  static void to_single(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
   void cycle(size_t l) const;
 };
@@ -385,12 +383,12 @@ void SmoothedAggregationAmg::Impl::smooth(const Level& L, const double* b, doubl
   if (zero_start) {
     for (int i = 0; i < n; ++i) r[i] = b[i], x[i] = 0;
   } else {
-    interleaved_product(*L.A, L.Af.data(), x, q, threads);
+    sparse_product(*L.A, L.Af.data(), x, q, threads);
     for (int i = 0; i < n; ++i) r[i] = b[i] - q[i];
   }
   for (int i = 0; i < n; ++i) d[i] = dinv[i] * r[i] / theta, x[i] += d[i];
   for (int k = 1; k < params.smoother_degree; ++k) {
-    interleaved_product(*L.A, L.Af.data(), d, q, threads);  // r -= A d keeps r = b - A x
+    sparse_product(*L.A, L.Af.data(), d, q, threads);  // r -= A d keeps r = b - A x
     const double rho_new = 1 / (2 * sigma - rho);
     const double c1 = rho_new * rho, c2 = 2 * rho_new / delta;
     for (int i = 0; i < n; ++i) {
@@ -413,12 +411,12 @@ void SmoothedAggregationAmg::Impl::cycle(size_t l) const {
     return;
   }
   smooth(L, L.b.data(), L.x.data(), true);
-  interleaved_product(*L.A, L.Af.data(), L.x.data(), L.q.data(), threads);
+  sparse_product(*L.A, L.Af.data(), L.x.data(), L.q.data(), threads);
   for (int i = 0; i < n; ++i) L.r[i] = L.b[i] - L.q[i];
   const Level& C = levels[l + 1];
-  interleaved_product(L.R, L.Rf.data(), L.r.data(), C.b.data(), threads);
+  sparse_product(L.R, L.Rf.data(), L.r.data(), C.b.data(), threads);
   cycle(l + 1);
-  interleaved_product(L.P, L.Pf.data(), C.x.data(), L.q.data(), threads);
+  sparse_product(L.P, L.Pf.data(), C.x.data(), L.q.data(), threads);
   for (int i = 0; i < n; ++i) L.x[i] += L.q[i];
   smooth(L, L.b.data(), L.x.data(), false);
 }

@@ -4,7 +4,6 @@
 // carries values, a column count and row blocks, and what is done with it is matrix algebra.
 #pragma once
 #include <Eigen/Core>
-#include <algorithm>
 #include <vector>
 
 #include "common/parallel.h"
@@ -31,63 +30,15 @@ struct CsrMatrix {
   bool blocks_consistent() const;
 };
 
-namespace detail {
-
-/// Rows r0 .. r0 + NR − 1 of y = M x for one row block of M (its `len` columns c, shared by its
-/// rows): each row's terms added in column order, as a row at a time would add them, while each
-/// column index and x value is read once for all the block's rows. The value of row r, entry k
-/// is v[k·NR + r] if Interleaved (interleaved_values), else v[r·len + k] (M's own order).
-template <int NR, bool Interleaved, class Value>
-inline void block_rows(const Value* v, const int* c, int len, const double* x, double* y) {
-  double acc[NR] = {};
-  for (int k = 0; k < len; ++k) {
-    const double xk = x[c[k]];
-    for (int r = 0; r < NR; ++r) acc[r] += v[Interleaved ? k * NR + r : r * len + k] * xk;
-  }
-  for (int r = 0; r < NR; ++r) y[r] = acc[r];
-}
-
-/// block_rows for a block of nr rows (1 .. CsrMatrix::kMaxBlock), the count known at compile time.
-template <bool Interleaved, class Value>
-inline void block_rows(int nr, const Value* v, const int* c, int len, const double* x, double* y) {
-  switch (nr) {
-    case 1: return block_rows<1, Interleaved>(v, c, len, x, y);
-    case 2: return block_rows<2, Interleaved>(v, c, len, x, y);
-    case 3: return block_rows<3, Interleaved>(v, c, len, x, y);
-    case 4: return block_rows<4, Interleaved>(v, c, len, x, y);
-    case 5: return block_rows<5, Interleaved>(v, c, len, x, y);
-    case 6: return block_rows<6, Interleaved>(v, c, len, x, y);
-    case 7: return block_rows<7, Interleaved>(v, c, len, x, y);
-    default: return block_rows<8, Interleaved>(v, c, len, x, y);
-  }
-}
-
-/// y = M x over M's row blocks, the values in M's order or interleaved (block_rows).
-template <bool Interleaved, class Value>
-void blocked_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
-  const long nb = static_cast<long>(M.blocks.size()) - 1;
-  parallel_for(
-      nb, threads,
-      [&](long bb, long be) {
-        for (long blk = bb; blk < be; ++blk) {
-          const int r0 = M.blocks[blk], base = M.ptr[r0];
-          block_rows<Interleaved>(M.blocks[blk + 1] - r0, val + base, &M.col[base], M.ptr[r0 + 1] - base, x, y + r0);
-        }
-      },
-      1024);
-}
-
-}  // namespace detail
-
 /// y = M x with M's pattern and the values `val` (M.nonzeros() of them: M.val itself, or a
 /// single-precision copy: the products are memory-bound, and 4-byte values cut the bytes read
-/// by a third). x: M.cols, y: M.rows. The rows of a row block are summed together (one read
-/// of each column index and x value for the block), each in the order of a row alone.
+/// by a third). x: M.cols, y: M.rows. Row by row even where M has row blocks: a walk by blocks
+/// (each column index read once for a block's rows) measured 2-3 times slower on the elasticity
+/// matrix here (speed7 in BENCHMARKS.md); the sums are the same either way.
 template <class Value>
 void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
-  if (!M.blocks.empty()) return detail::blocked_product<false>(M, val, x, y, threads);
-  const std::vector<int>& ptr = M.ptr;
-  const std::vector<int>& col = M.col;
+  const int* ptr = M.ptr.data();
+  const int* col = M.col.data();
   parallel_for(
       M.rows, threads,
       [&](long b, long e) {
@@ -98,33 +49,6 @@ void sparse_product(const CsrMatrix& M, const Value* val, const double* x, doubl
         }
       },
       4096);
-}
-
-/// M's values converted to Value and rearranged for interleaved_product: within each row block
-/// (r0, nr rows, len entries each) entry k of row r0 + r goes to ptr[r0] + k·nr + r, so that a
-/// block's values are one stream (3×3 node blocks side by side for elasticity, the layout of a
-/// block-sparse matrix without its padding). Without row blocks: the values in M's order.
-template <class Value>
-void interleaved_values(const CsrMatrix& M, std::vector<Value>& out) {
-  out.resize(M.val.size());
-  if (M.blocks.empty()) {
-    std::copy(M.val.begin(), M.val.end(), out.begin());
-    return;
-  }
-  for (size_t blk = 0; blk + 1 < M.blocks.size(); ++blk) {
-    const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, base = M.ptr[r0], len = M.ptr[r0 + 1] - base;
-    for (int r = 0; r < nr; ++r)
-      for (int k = 0; k < len; ++k) out[base + k * nr + r] = static_cast<Value>(M.val[base + r * len + k]);
-  }
-}
-
-/// y = M x with M's pattern and values `ival` from interleaved_values: the same terms added in
-/// the same order as sparse_product with the values in M's order (the same y to the bit), the
-/// values of a row block read as one stream. x: M.cols, y: M.rows.
-template <class Value>
-void interleaved_product(const CsrMatrix& M, const Value* ival, const double* x, double* y, int threads) {
-  if (M.blocks.empty()) return sparse_product(M, ival, x, y, threads);
-  detail::blocked_product<true>(M, ival, x, y, threads);
 }
 
 /// C = A B (A.cols == B.rows), on `threads` threads. With row blocks in A, the rows of a block
