@@ -19,8 +19,9 @@ struct CsrMatrix {
   std::vector<int> col;     ///< column of each entry (any order within a row)
   std::vector<double> val;  ///< value of each entry
   /// Optional row blocks (offsets, first 0, last rows): the rows of a block have the same
-  /// columns in the same order (a mesh node's dofs, an aggregate's coarse dofs), so products
-  /// read each column index once per block. At most kMaxBlock rows a block. Empty: none.
+  /// columns in the same order (a mesh node's dofs, an aggregate's coarse dofs), so the matrix
+  /// products (multiply, multiply_rows, add_product_rows) read each column index once per block;
+  /// sparse_product ignores them. At most kMaxBlock rows a block. Empty: none.
   std::vector<int> blocks;
   static constexpr int kMaxBlock = 8;
   long nonzeros() const { return static_cast<long>(col.size()); }
@@ -33,8 +34,8 @@ struct CsrMatrix {
 /// y = M x with M's pattern and the values `val` (M.nonzeros() of them: M.val itself, or a
 /// single-precision copy: the products are memory-bound, and 4-byte values cut the bytes read
 /// by a third). x: M.cols, y: M.rows. Row by row even where M has row blocks: a walk by blocks
-/// (each column index read once for a block's rows) measured 2-3 times slower on the elasticity
-/// matrix here (speed7 in BENCHMARKS.md); the sums are the same either way.
+/// (each column index read once for a block's rows) measured 2-3 times slower on a matrix shaped
+/// like the elasticity one (branch speed7 in BENCHMARKS.md); the sums are the same either way.
 template <class Value>
 void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
   const int* ptr = M.ptr.data();
