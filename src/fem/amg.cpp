@@ -21,6 +21,7 @@ struct Level {
   CsrMatrix own;                 // this level's matrix (unused on level 0)
   const CsrMatrix* A = nullptr;  // the matrix of this level
   std::vector<double> inv_diag;
+  std::vector<long> diag_at;   // position of each row's diagonal entry in A (found at the first use)
   double lambda = 1;           // estimate of λmax(D⁻¹A)
   std::vector<double> eigvec;  // its eigenvector estimate (restarts the power iteration)
   CsrMatrix P, R;              // to/from the next coarser level
@@ -233,6 +234,8 @@ struct SmoothedAggregationAmg::Impl {
   int modes_count = 6;       // near-null modes per row: 6 rigid-body modes, 1 for a scalar problem
   std::deque<Level> levels;  // a deque: levels point at their own matrices
   Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> coarse;
+  SpMat coarse_lower;             // the lower triangle of the coarsest matrix, as factorised
+  std::vector<long> coarse_from;  // the entry of the coarsest CsrMatrix behind each value of coarse_lower
   mutable Eigen::VectorXd coarse_b, coarse_x;
 
   /// Power iteration for λmax(D⁻¹A): `steps` steps from L.eigvec if it is set (a refresh:
@@ -247,7 +250,7 @@ struct SmoothedAggregationAmg::Impl {
   /// A does not coarsen any more (the next level would keep 80 % of the unknowns or more).
   bool coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
-  static void to_float(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
+  static void to_single(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
   void cycle(size_t l) const;
 };
@@ -285,15 +288,29 @@ void SmoothedAggregationAmg::Impl::estimate_lambda(Level& L, int steps) const {
 }
 
 void SmoothedAggregationAmg::Impl::factor_coarsest(bool numeric_only) {
-  // Sparse Cholesky of the coarsest matrix (its lower triangle).
+  // Sparse Cholesky of the coarsest matrix (its lower triangle). Its pattern and where each of
+  // its values comes from are made once per setup; a refresh only copies the values over.
   const CsrMatrix& Ac = *levels.back().A;
-  std::vector<Eigen::Triplet<double, int>> trip;
-  trip.reserve(Ac.nonzeros() / 2 + Ac.rows);
-  for (int i = 0; i < Ac.rows; ++i)
-    for (int k = Ac.ptr[i]; k < Ac.ptr[i + 1]; ++k)
-      if (Ac.col[k] >= i) trip.emplace_back(Ac.col[k], i, Ac.val[k]);  // lower triangle
-  SpMat S(Ac.rows, Ac.rows);
-  S.setFromTriplets(trip.begin(), trip.end());
+  SpMat& S = coarse_lower;
+  if (!numeric_only || static_cast<long>(coarse_from.size()) != S.nonZeros() || S.rows() != Ac.rows) {
+    std::vector<Eigen::Triplet<double, int>> trip;
+    trip.reserve(Ac.nonzeros() / 2 + Ac.rows);
+    for (int i = 0; i < Ac.rows; ++i)
+      for (int k = Ac.ptr[i]; k < Ac.ptr[i + 1]; ++k)
+        if (Ac.col[k] >= i) trip.emplace_back(Ac.col[k], i, Ac.val[k]);  // lower triangle
+    S.resize(Ac.rows, Ac.rows);
+    S.setFromTriplets(trip.begin(), trip.end());
+    // column i of S is row i of Ac from its diagonal on (Ac holds each entry once)
+    coarse_from.assign(S.nonZeros(), 0);
+    std::vector<long> at(Ac.rows, -1);
+    for (int i = 0; i < Ac.rows; ++i) {
+      for (int k = Ac.ptr[i]; k < Ac.ptr[i + 1]; ++k) at[Ac.col[k]] = k;
+      for (int p = S.outerIndexPtr()[i]; p < S.outerIndexPtr()[i + 1]; ++p) coarse_from[p] = at[S.innerIndexPtr()[p]];
+    }
+  } else {
+    double* v = S.valuePtr();
+    for (size_t p = 0; p < coarse_from.size(); ++p) v[p] = Ac.val[coarse_from[p]];
+  }
   // AMD only: the coarse matrix is small and dense-ish; CHOLMOD's default of trying several
   // orderings costs more than the fill it saves (measured on the rocker's 8.7 k coarse level).
   coarse.cholmod().nmethods = 1;
@@ -309,17 +326,30 @@ void SmoothedAggregationAmg::Impl::factor_coarsest(bool numeric_only) {
 }
 
 void SmoothedAggregationAmg::Impl::inverse_diagonal(Level& L) const {
+  // The diagonal's positions are found once per pattern: a refresh (SIMP's every iteration)
+  // then reads n values instead of scanning every entry of A. A row holding its diagonal more
+  // than once (kDiagonalScan) has it summed by a scan of the row, as a row without one reads 0.
+  constexpr long kNoDiagonal = -1, kDiagonalScan = -2;
   const CsrMatrix& A = *L.A;
+  if (static_cast<int>(L.diag_at.size()) != A.rows) {
+    L.diag_at.assign(A.rows, kNoDiagonal);
+    for (int i = 0; i < A.rows; ++i)
+      for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k)
+        if (A.col[k] == i) L.diag_at[i] = L.diag_at[i] == kNoDiagonal ? k : kDiagonalScan;
+  }
   L.inv_diag.assign(A.rows, 0.0);
-  for (int i = 0; i < A.rows; ++i)
-    for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k)
-      if (A.col[k] == i) L.inv_diag[i] += A.val[k];
   for (int i = 0; i < A.rows; ++i) {
-    if (!(L.inv_diag[i] > 0))
+    double d = 0;
+    if (L.diag_at[i] >= 0)
+      d = A.val[L.diag_at[i]];
+    else if (L.diag_at[i] == kDiagonalScan)
+      for (int k = A.ptr[i]; k < A.ptr[i + 1]; ++k)
+        if (A.col[k] == i) d += A.val[k];
+    if (!(d > 0))
       throw Error(ErrorCode::NoSupport,
                   "the stiffness matrix has a zero or negative diagonal entry: "
                   "an unknown is not held by any element; check the mesh and supports");
-    L.inv_diag[i] = 1 / L.inv_diag[i];
+    L.inv_diag[i] = 1 / d;
   }
 }
 
@@ -427,9 +457,9 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
     // A P only for as long as the product needs it (a refresh forms it again slice by slice)
     CsrMatrix coarse = multiply(L.R, multiply(Al, L.P, m.threads), m.threads);
-    Impl::to_float(L.P, L.Pf);
-    Impl::to_float(L.R, L.Rf);
-    Impl::to_float(Al, L.Af);
+    Impl::to_single(L.P, L.Pf);
+    Impl::to_single(L.R, L.Rf);
+    Impl::to_single(Al, L.Af);
     nodes.swap(coarse_nodes);
     modes.swap(coarse_modes);
     m.levels.emplace_back();
@@ -445,7 +475,7 @@ void SmoothedAggregationAmg::refresh_finest() {
   m.inverse_diagonal(m.levels[0]);
   if (m.levels.size() > 1) {
     m.estimate_lambda(m.levels[0], 5);
-    Impl::to_float(*m.levels[0].A, m.levels[0].Af);
+    Impl::to_single(*m.levels[0].A, m.levels[0].Af);
   } else
     m.factor_coarsest();
 }
@@ -457,7 +487,7 @@ void SmoothedAggregationAmg::refresh_galerkin() {
     Level& L = m.levels[l];
     m.inverse_diagonal(L);
     m.estimate_lambda(L, 5);
-    Impl::to_float(*L.A, L.Af);
+    Impl::to_single(*L.A, L.Af);
     // the setup's pattern: the next level's values rewritten in place (its A points at its `own`)
     galerkin_values(*L.A, L.P, L.R, m.levels[l + 1].own, m.threads);
   }

@@ -19,8 +19,9 @@ struct CsrMatrix {
   std::vector<int> col;     ///< column of each entry (any order within a row)
   std::vector<double> val;  ///< value of each entry
   /// Optional row blocks (offsets, first 0, last rows): the rows of a block have the same
-  /// columns in the same order (a mesh node's dofs, an aggregate's coarse dofs), so products
-  /// read each column index once per block. At most kMaxBlock rows a block. Empty: none.
+  /// columns in the same order (a mesh node's dofs, an aggregate's coarse dofs), so the matrix
+  /// products (multiply, multiply_rows, add_product_rows) read each column index once per block;
+  /// sparse_product ignores them. At most kMaxBlock rows a block. Empty: none.
   std::vector<int> blocks;
   static constexpr int kMaxBlock = 8;
   long nonzeros() const { return static_cast<long>(col.size()); }
@@ -32,40 +33,23 @@ struct CsrMatrix {
 
 /// y = M x with M's pattern and the values `val` (M.nonzeros() of them: M.val itself, or a
 /// single-precision copy: the products are memory-bound, and 4-byte values cut the bytes read
-/// by a third). x: M.cols, y: M.rows.
+/// by a third). x: M.cols, y: M.rows. Row by row even where M has row blocks: a walk by blocks
+/// (each column index read once for a block's rows) measured 2-3 times slower on a matrix shaped
+/// like the elasticity one (branch speed7 in BENCHMARKS.md); the sums are the same either way.
 template <class Value>
 void sparse_product(const CsrMatrix& M, const Value* val, const double* x, double* y, int threads) {
-  const std::vector<int>& ptr = M.ptr;
-  const std::vector<int>& col = M.col;
-  if (M.blocks.empty()) {
-    parallel_for(
-        M.rows, threads,
-        [&](long b, long e) {
-          for (long i = b; i < e; ++i) {
-            double s = 0;
-            for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
-            y[i] = s;
-          }
-        },
-        4096);
-    return;
-  }
-  const long nb = static_cast<long>(M.blocks.size()) - 1;
+  const int* ptr = M.ptr.data();
+  const int* col = M.col.data();
   parallel_for(
-      nb, threads,
-      [&](long bb, long be) {
-        for (long blk = bb; blk < be; ++blk) {
-          const int r0 = M.blocks[blk], nr = M.blocks[blk + 1] - r0, len = ptr[r0 + 1] - ptr[r0];
-          const int* c = &col[ptr[r0]];
-          for (int r = 0; r < nr; ++r) {
-            const Value* v = &val[ptr[r0 + r]];
-            double acc = 0;
-            for (int k = 0; k < len; ++k) acc += v[k] * x[c[k]];
-            y[r0 + r] = acc;
-          }
+      M.rows, threads,
+      [&](long b, long e) {
+        for (long i = b; i < e; ++i) {
+          double s = 0;
+          for (int k = ptr[i]; k < ptr[i + 1]; ++k) s += val[k] * x[col[k]];
+          y[i] = s;
         }
       },
-      1024);
+      4096);
 }
 
 /// C = A B (A.cols == B.rows), on `threads` threads. With row blocks in A, the rows of a block

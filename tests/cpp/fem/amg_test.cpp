@@ -1,6 +1,7 @@
 // Smoothed-aggregation multigrid: the preconditioner is symmetric positive definite, the
-// iteration count does not grow with the mesh (multigrid's defining property), and the
-// multigrid-CG solve equals the Cholesky solve, also with SIMP's 1e-9 void contrast.
+// iteration count does not grow with the mesh (multigrid's defining property), a Galerkin
+// refresh equals a fresh hierarchy, and the multigrid-CG solve equals the Cholesky solve, also
+// with SIMP's 1e-9 void contrast.
 #include "fem/amg.h"
 
 #include <gtest/gtest.h>
@@ -62,6 +63,45 @@ TEST(Amg, IterationsDoNotGrowWithTheMesh) {
   }
   EXPECT_LT(iterations[0], 60);
   EXPECT_LE(iterations[1], iterations[0] * 1.4 + 2) << iterations[0] << " then " << iterations[1];
+}
+
+TEST(Amg, GalerkinRefreshEqualsAFreshHierarchyToTheBit) {
+  // K doubled: the strength graph, the aggregates, D⁻¹K and so the prolongators are those of K
+  // (a power of two scales every product exactly), and every coarse matrix doubles. A hierarchy
+  // of K refreshed for 2K (R A P refilled on its kept pattern, the coarse factor's values copied
+  // into its kept pattern) must then equal a hierarchy set up on 2K and refreshed alike (the
+  // same power-iteration steps): the same V-cycle to the bit. One refreshed on the finest level
+  // only keeps K's coarse levels and must not.
+  TetMesh m = beam({24, 6, 6});
+  System s = clamped_beam_system(m, VecXd::Ones(m.T.rows()));
+  AmgParams p;
+  p.coarse_dofs = 200;  // three levels or more: a refill of a middle level and of the coarsest
+  CsrMatrix kept = s.A, stale = s.A, doubled = s.A;
+  for (double& v : doubled.val) v *= 2;
+  SmoothedAggregationAmg refreshed, finest_only, fresh;
+  refreshed.setup(kept, s.node_ptr, s.modes, p);
+  finest_only.setup(stale, s.node_ptr, s.modes, p);
+  fresh.setup(doubled, s.node_ptr, s.modes, p);
+  ASSERT_GE(fresh.levels(), 3);
+  ASSERT_EQ(refreshed.level_sizes(), fresh.level_sizes());
+  kept.val = doubled.val;
+  stale.val = doubled.val;
+  for (int twice = 0; twice < 2; ++twice) {  // the second refill takes the kept patterns only
+    refreshed.refresh_galerkin();
+    fresh.refresh_galerkin();
+  }
+  finest_only.refresh_finest();
+  finest_only.refresh_finest();
+  const int n = s.A.rows;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> N;
+  Eigen::VectorXd r(n), z_fresh(n), z_refreshed(n), z_stale(n);
+  for (int i = 0; i < n; ++i) r[i] = N(rng);
+  fresh.apply(r.data(), z_fresh.data());
+  refreshed.apply(r.data(), z_refreshed.data());
+  finest_only.apply(r.data(), z_stale.data());
+  EXPECT_EQ(z_refreshed, z_fresh);
+  EXPECT_GT((z_stale - z_fresh).norm(), 1e-3 * z_fresh.norm());  // the coarse levels matter
 }
 
 TEST(Amg, MultigridSolveEqualsCholeskyWithVoidContrast) {

@@ -60,6 +60,9 @@ TEST(CsrMatrix, ProductsEqualDenseArithmetic) {
   sparse_product(A, single.data(), x.data(), w.data(), 2);
   EXPECT_LT((w - ref).norm(), 1e-6 * ref.norm());
   EXPECT_GT((w - ref).norm(), 0.0);  // it did use the float values
+  Eigen::VectorXd w1(30);  // the V-cycle's single-precision product, one thread and two alike
+  sparse_product(plain, single.data(), x.data(), w1.data(), 1);
+  EXPECT_EQ(w1, w);
 }
 
 TEST(CsrMatrix, MatrixProductAndTransposeEqualDenseArithmetic) {
