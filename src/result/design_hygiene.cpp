@@ -444,7 +444,8 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
   const MatX4i nb = tet_neighbours(mesh.T);
   std::vector<Bridge> bridges;
   VecXd out = params.join_non_design
-                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges)
+                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges,
+                                           params.build_direction)
                   : density;
   // Taking a piece out lowers the node densities of the tets around it, filling a void raises
   // them, so the crisp design of the cleaned densities can hold a piece or a void the first
