@@ -183,6 +183,8 @@ result::HygieneParams hygiene_params(const TetMesh& mesh, const OptimizeSettings
   const double min_size = settings.simp.controls.member.min_size;
   h.bridge_size = min_size > 0 ? min_size : 2 * simp::filter_radius(mesh, settings.simp.filter);
   h.min_member_size = min_size;
+  const simp::OverhangControl& o = settings.simp.controls.overhang;
+  if (o.enabled) h.build_direction = o.direction.normalized();
   return h;
 }
 

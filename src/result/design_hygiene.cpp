@@ -475,7 +475,8 @@ VecXd clean_design(const TetMesh& mesh, const VecXd& density, double threshold, 
   const MatX4i nb = tet_neighbours(mesh.T);
   std::vector<Bridge> bridges;
   VecXd out = params.join_non_design
-                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges)
+                  ? join_non_design_solids(mesh, nb, density, threshold, anchors, params.bridge_size, bridges,
+                                           params.build_direction)
                   : density;
   clean_rounds(mesh, nb, threshold, anchors, params, out, report);
   if (params.min_member_size > 0) {  // the minimum member size held on the clean design, then its voids closed

@@ -37,6 +37,10 @@ struct HygieneParams {
   /// the cleaning, the crisp design's members thinner than it are thickened (member_enforce.h).
   /// <= 0: not.
   double min_member_size = 0;
+  /// The build direction of an overhang control (unit, from the plate up; zero: none): a bridge
+  /// is then carried down by a wall along the build to where Ω ends below (join_bridges.h), so that its
+  /// underside is not a ceiling the overhang pass cannot lift.
+  Eigen::Vector3d build_direction = Eigen::Vector3d::Zero();
 };
 
 /// A bridge that joins a non-design solid apart to the load-carrying piece (join_bridges.h).

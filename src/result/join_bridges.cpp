@@ -103,6 +103,28 @@ std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& poin
   return near;
 }
 
+/// Per node (#V): under the polyline `points` along −build (unit) and within `radius` of it across
+/// build, i.e. in the shadow the polyline's tube of that radius casts down the build direction —
+/// the node's height along build below the axis's height at the nearest point across build.
+std::vector<char> nodes_under(const TetMesh& mesh, const std::vector<Point>& points, double radius,
+                              const Eigen::Vector3d& build) {
+  const auto across = [&](const Point& x) -> Point { return x - x.dot(build) * build; };
+  std::vector<char> under(mesh.V.rows(), 0);
+  for (long v = 0; v < mesh.V.rows(); ++v) {
+    const Point x = mesh.V.row(v).transpose(), xa = across(x);
+    for (size_t i = 0; i + 1 < points.size() && !under[v]; ++i) {
+      const Point a = across(points[i]), b = across(points[i + 1]);
+      const Point c = closest_on_segment(xa, a, b);
+      if ((xa - c).norm() > radius) continue;
+      const double ab2 = (b - a).squaredNorm();
+      const double s = ab2 > 0 ? std::clamp((c - a).dot(b - a) / ab2, 0.0, 1.0) : 0.0;
+      const double height = (1 - s) * points[i].dot(build) + s * points[i + 1].dot(build);
+      under[v] = x.dot(build) <= height;
+    }
+  }
+  return under;
+}
+
 /// The path's polyline (tet centres) with each end carried on by `length` along its last step:
 /// the tube then ends inside the pieces it joins, not at their first tet's centre.
 std::vector<Point> extended_ends(std::vector<Point> points, double length) {
@@ -226,7 +248,8 @@ std::string mm(double v, const char* unit) {
 double bridge_penalty(double rho) { return 1 + (kVoidPenalty - 1) * (1 - std::clamp(rho, 0.0, 1.0)); }
 
 VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
-                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges) {
+                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges,
+                             const Eigen::Vector3d& build) {
   const long nt = mesh.T.rows();
   const Shape before = shape_of(mesh, density, threshold, anchors);
   std::vector<char> carrying(nt, 0);  // the load-carrying pieces' tets, and those joined to them
@@ -268,6 +291,10 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
     // load-carrying one, whatever the size against the elements
     for (long t : path)
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
+    if (build.squaredNorm() > 0) {  // a wall under the tube: no ceiling to print it on
+      const std::vector<char> under = nodes_under(mesh, axis, 0.5 * size, build);
+      for (size_t v = 0; v < near.size(); ++v) near[v] |= under[v];
+    }
     for (long t = 0; t < nt; ++t) {
       if (piece[t]) carrying[t] = 1;
       if (mesh.domain[t] != 0 ||

@@ -37,8 +37,15 @@ double bridge_penalty(double rho);
 /// the bridges' diameter (mm; <= 0: 3 × the mean edge length of the design tets). Appends one
 /// Bridge per piece to `bridges` (joined: the piece is one with a load-carrying piece in the
 /// returned densities; false when no path exists) and returns the densities (#T).
+/// build: an overhang control's build direction (unit; zero: none). With one, the tube is
+/// carried down along −build before the junctions close: every design tet with a node below the
+/// axis and within size / 2 of it across the build direction is set solid too, all the way down
+/// (to the plate, or where Ω ends below), so the bridge stands on a wall with sides along the build instead
+/// of hanging as a horizontal tube, whose underside faces straight down (on the bracket lying,
+/// 95 mm² too flat that the overhang pass, which only restores slopes, could not lift).
 VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
-                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges);
+                             const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges,
+                             const Eigen::Vector3d& build = Eigen::Vector3d::Zero());
 
 /// The warning for a bridge made: the solids it joins, the material it adds, its length and
 /// diameter, and the job key that leaves them apart instead.

@@ -15,6 +15,7 @@
 #include "mesh/core/structured_box.h"
 #include "pipeline/optimize_job.h"
 #include "result/iso_surface.h"
+#include "result/overhang_lift.h"
 #include "result/result_check.h"
 #include "result/verification.h"
 #include "simp/density_filter.h"
@@ -206,6 +207,55 @@ TEST(JoinBridges, TheBridgeFollowsGreyMaterialWhereThereIsSome) {
   ASSERT_GT(v_sum, 0);
   EXPECT_GT(x_sum / v_sum, 15.0);  // the column's x 16..18, not the pad's middle (14)
   EXPECT_LT(x_sum / v_sum, 19.0);
+}
+
+/// mm²: the area of s's triangles with centroid z in (lo, hi) and x in (3.5, 20.5) (apart from
+/// the end blocks, whose given faces at y = 3 face down) that face against `up`, do not rest on
+/// the plate (up · x = 0) and rise less than 45° from it.
+double too_flat_between(const TriSurface& s, const Eigen::Vector3d& up, double lo, double hi) {
+  double area = 0;
+  for (long f = 0; f < s.F.rows(); ++f) {
+    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
+    const double z = (a[2] + b[2] + c[2]) / 3;
+    const double x = (a[0] + b[0] + c[0]) / 3;
+    if (z <= lo || z >= hi || x <= 3.5 || x >= 20.5) continue;
+    if (std::max({a.dot(up), b.dot(up), c.dot(up)}) < 1e-6) continue;  // on the plate
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (-n.dot(up) > std::cos(M_PI / 4) * n.norm()) area += n.norm() / 2;
+  }
+  return area;
+}
+
+TEST(JoinBridges, UnderAnOverhangControlTheBridgeStandsOnAWallInsteadOfHanging) {
+  // issue 22: built along +y, the bridge from the pad down to the beam (along z) lies flat; its
+  // underside faced straight down, a ceiling the overhang pass (which only restores slopes)
+  // cannot lift — on the bracket lying, 95 mm² of 2700 facing down. With the build direction
+  // the tube is carried down to the plate (y = 0) by a wall along y: in the gap (z 5.5..8.5,
+  // only the bridge there, the end blocks apart) no facet is left too flat but the few the
+  // tet staircase tilts.
+  const PadFixture f = pad_fixture();
+  const Eigen::Vector3d up(0, 1, 0);
+  SmoothParams smooth;
+  smooth.build.direction = up;  // the overhang pass in both runs; the plate at y = 0
+  double flat[2], added[2];
+  for (const bool wall : {false, true}) {
+    HygieneParams h = joining(true);
+    if (wall) h.build_direction = up;
+    HygieneReport rep;
+    const TriSurface s = pipeline::result_surface(f.mesh, f.density, 0.5, -1, smooth, nullptr, f.anchors, h, &rep);
+    ASSERT_EQ(rep.bridges.size(), 1u) << wall;
+    EXPECT_TRUE(rep.bridges[0].joined) << wall;
+    EXPECT_TRUE(check_result(s).valid()) << wall;
+    flat[wall] = too_flat_between(s, up, 5.5, 8.5);
+    added[wall] = rep.bridges[0].volume;
+  }
+  EXPECT_GT(flat[0], 2.0);  // the hanging tube: a quarter of its 3 mm round over the 3 mm slice ~ 7 mm²
+  EXPECT_LT(flat[1], 0.1 * flat[0]) << flat[0] << " -> " << flat[1];
+  // the wall's material: at most the tube's reach across (size + 2 cells) from y = 0 to its top
+  // over the gap with a reach either end
+  const double reach = kSize / 2 + kCell * std::sqrt(3.0);
+  EXPECT_GT(added[1], added[0]);
+  EXPECT_LT(added[1], 2 * reach * (6 + reach) * (4 + 2 * reach) + added[0]);
 }
 
 TEST(JoinBridges, TheResultIsOneSolidAndItsAsBuiltComplianceDoesNotRise) {
