@@ -36,12 +36,16 @@ std::string occt_failure_kind(const Standard_Failure& f) {
   return "an internal failure of the geometry kernel";
 }
 
-Error occt_error(const Standard_Failure& failure, const std::string& doing) {
+Error occt_error(const Standard_Failure& failure, const std::string& doing, OcctBlame blame) {
   const bool signal = occt_failure_is_signal(failure);
+  const std::string what_to_do =
+      blame == OcctBlame::inputs
+          ? "check the part and the non-design solids with Part > Check geometry in FreeCAD and re-export them "
+            "from your CAD system; if they are sound, please report this with the files"
+          : "the fault is in the shape TopOpt made itself, not in your part or non-design solids; please report "
+            "this with the job file";
   return Error(signal ? ErrorCode::Crashed : ErrorCode::InvalidShape,
-               doing + " failed inside the geometry kernel, OCCT (" + occt_failure_kind(failure) +
-                   "): check the part and the non-design solids with Part > Check geometry in FreeCAD and "
-                   "re-export them from your CAD system; if they are sound, please report this with the files");
+               doing + " failed inside the geometry kernel, OCCT (" + occt_failure_kind(failure) + "): " + what_to_do);
 }
 
 }  // namespace topopt::brep

@@ -24,10 +24,15 @@ std::string occt_failure_kind(const Standard_Failure& failure);
 /// illegal instruction, floating-point trap): OCCT crashed rather than refused.
 bool occt_failure_is_signal(const Standard_Failure& failure);
 
+/// What an OCCT failure is put down to: the user's input shapes (check and re-export them), or
+/// a shape TopOpt made itself (the result surface as a solid: nothing the user's CAD can fix).
+enum class OcctBlame { inputs, own_shape };
+
 /// The Error for an OCCT failure while `doing` ("classifying the non-design solids against
 /// the part"): code Crashed for a signal, InvalidShape otherwise; the message names the
-/// stage and the kind of failure and says to check and re-export the inputs.
-Error occt_error(const Standard_Failure& failure, const std::string& doing);
+/// stage and the kind of failure and, by `blame`, says to check and re-export the inputs or
+/// that the fault is in TopOpt's own shape (to be reported with the job).
+Error occt_error(const Standard_Failure& failure, const std::string& doing, OcctBlame blame = OcctBlame::inputs);
 
 /// Runs `work()` and returns its result; an OCCT exception escaping it is rethrown as
 /// occt_error(failure, doing). Where OSD::SetSignal is active, an access violation on this
@@ -35,13 +40,14 @@ Error occt_error(const Standard_Failure& failure, const std::string& doing);
 /// objects `work` had on the stack are abandoned, not destroyed: use it around whole stages
 /// whose partial results are dropped on failure). Without OSD::SetSignal (FreeCAD) a fault
 /// still ends the process: keep foreign geometry in a child (brep/foreign.h).
+/// `blame`: as occt_error's.
 template <class Work>
-auto guard_occt(const std::string& doing, Work&& work) -> decltype(work()) {
+auto guard_occt(const std::string& doing, Work&& work, OcctBlame blame = OcctBlame::inputs) -> decltype(work()) {
   try {
     OCC_CATCH_SIGNALS
     return work();
   } catch (const Standard_Failure& failure) {
-    throw occt_error(failure, doing);
+    throw occt_error(failure, doing, blame);
   }
 }
 

@@ -105,7 +105,9 @@ int cmd_result(const Args& args) {
   std::cout << "surface: threshold " << threshold << ", " << s.F.rows() << " triangles, volume "
             << std::setprecision(10) << result::check_surface(s.V, s.F).volume << std::setprecision(6) << " mm^3\n"
             << "step: " << r.faces << " faces (" << r.planar_faces << " planar, " << r.analytic_faces
-            << " on the input's curved faces, " << r.analytic_refused << " of those left as facets) from "
+            << " on the input's curved faces, " << r.analytic_refused << " of those left as facets; "
+            << r.unmerged_bodies << " bodies rebuilt after OCCT's check refused them, " << r.facet_bodies
+            << " of those without the curved faces) from "
             << r.triangles << " triangles, " << r.bytes / 1e6 << " MB, volume " << r.volume << " mm^3 (" << r.seconds
             << " s, " << r.cpu_seconds << " s CPU)\n"
             << "wrote " << step << "\n";

@@ -39,6 +39,7 @@ json step_json(const result::StepExportReport& s) {
           {"cpu_seconds", s.cpu_seconds},
           {"triangles", s.triangles},
           {"unmerged_bodies", s.unmerged_bodies},
+          {"facet_bodies", s.facet_bodies},
           {"analytic_faces", s.analytic_faces},
           {"analytic_refused", s.analytic_refused}};
 }

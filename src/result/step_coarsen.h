@@ -30,6 +30,8 @@ struct CoarsenReport {
   bool reverted = false;      ///< the coarsened surface crossed itself: the one given was returned
   /// Set by result_solid: bodies whose merged faces OCCT's check refused, written as facets.
   int unmerged_bodies = 0;
+  /// Set by result_solid: of those, bodies written without the input's curved faces.
+  int facet_bodies = 0;
   int attempts = 1;          ///< coarsenings run by coarsen_to_budget (1: the tolerance given sufficed)
   double volume_change = 0;  ///< |volume returned - volume given| / volume given
   bool fits = true;          ///< coarsen_to_budget: triangles_after is within the budget

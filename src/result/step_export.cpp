@@ -123,7 +123,7 @@ std::string report_text(const StepExportReport& r) {
   std::ostringstream o;
   o.precision(17);
   o << r.valid << " " << r.solids << " " << r.faces << " " << r.planar_faces << " " << r.volume << " " << r.triangles
-    << " " << r.unmerged_bodies << " " << r.analytic_faces << " " << r.analytic_refused;
+    << " " << r.unmerged_bodies << " " << r.analytic_faces << " " << r.analytic_refused << " " << r.facet_bodies;
   return o.str();
 }
 
@@ -131,7 +131,7 @@ StepExportReport report_of(const std::string& text) {
   StepExportReport r;
   std::istringstream in(text);
   in >> r.valid >> r.solids >> r.faces >> r.planar_faces >> r.volume >> r.triangles >> r.unmerged_bodies >>
-      r.analytic_faces >> r.analytic_refused;
+      r.analytic_faces >> r.analytic_refused >> r.facet_bodies;
   if (!in) throw Error(ErrorCode::Internal, "the STEP export's child answered '" + text + "'");
   return r;
 }
@@ -275,13 +275,47 @@ std::vector<TopoDS_Solid> solids_of(const TriSurface& s, const SurfacePieces& pi
 /// `body` with the faces on one input surface that touch each other joined into one face (a
 /// full bore's two halves become one face with a seam: ShapeUpgrade_UnifySameDomain, faces only,
 /// whose edge merge re-orients the whole shell at a cost growing as its square); not checked
-/// (the caller keeps it only when it passes OCCT's check).
+/// (the caller keeps it only when it passes OCCT's check). Null when OCCT throws on the way
+/// (on a body that is not valid to begin with: the mount's, a vertex without a point).
 TopoDS_Shape halves_joined(const TopoDS_Shape& body, double angular_tolerance) {
-  ShapeUpgrade_UnifySameDomain unify(body, false, true, false);
-  unify.SetAngularTolerance(angular_tolerance);
-  unify.Build();
-  return unify.Shape();
+  try {
+    ShapeUpgrade_UnifySameDomain unify(body, false, true, false);
+    unify.SetAngularTolerance(angular_tolerance);
+    unify.Build();
+    return unify.Shape();
+  } catch (const Standard_Failure&) {
+    return {};
+  }
 }
+
+/// The forms a body of the result can be built in, richest first: the input's curved faces as
+/// analytic faces and coplanar triangles merged; the same unmerged; merged planar faces only;
+/// a planar face per triangle, which a closed, outward surface without self-intersection always
+/// makes valid. Each form is built for all bodies at once, when first needed, on its own
+/// vertices and edges.
+class BodyForms {
+ public:
+  BodyForms(const TriSurface& s, const SurfacePieces& pieces, const SourceFaces* source,
+            const std::optional<PlanarFacesParams>& merge)
+      : s_(s), pieces_(pieces), source_(source), merge_(merge) {}
+
+  /// Body b in form `form`: 0 the first form built again (on fresh vertices and edges, for a
+  /// body the halves' join damaged), 1, 2 or 3 the fallbacks after it.
+  const TopoDS_Solid& body(int form, size_t b) {
+    std::vector<TopoDS_Solid>& built = forms_[form];
+    int ignored = 0;
+    if (built.empty())
+      built = solids_of(s_, pieces_, form < 2 ? source_ : nullptr, form % 2 == 0 ? merge_ : std::nullopt, ignored);
+    return built[b];
+  }
+
+ private:
+  const TriSurface& s_;
+  const SurfacePieces& pieces_;
+  const SourceFaces* source_;
+  std::optional<PlanarFacesParams> merge_;
+  std::vector<TopoDS_Solid> forms_[4];
+};
 
 /// The refusal of a surface that coarsen_to_budget could not bring within `budget` triangles,
 /// naming the job key that raises the budget.
@@ -364,27 +398,39 @@ TopoDS_Shape result_solid(const TriSurface& given, const StepExportParams& param
   std::vector<TopoDS_Shape> bodies;
   for (const TopoDS_Solid& body : solids_of(s, pieces, source, merge, analytic, &split)) bodies.push_back(body);
   if (analytic_refused) *analytic_refused = analytic;
-  // a body whose merged faces OCCT's check refuses while its facets pass is written as facets;
-  // each body is checked once in the form kept (BRepCheck is a fifth of the export's time)
-  std::vector<TopoDS_Solid> facets;
+  // a body OCCT's check refuses is built again in the next form (BodyForms) until one passes:
+  // unmerged (counted in refused), then without the input's curved faces (in facet_bodies too),
+  // then a face per triangle; each body is checked once in each form tried (BRepCheck is a
+  // fifth of the export's time)
+  BodyForms forms(s, pieces, source, merge);
+  int facet_bodies = 0;
   bool all_valid = merge.has_value();
   for (size_t b = 0; merge && b < bodies.size(); ++b) {
+    // UnifySameDomain works on the body's own sub-shapes: when it throws or its result fails the
+    // check, the body may be left damaged (the mount at 5 mm: it threw "vertex without a
+    // point" and left wires open), so the first form is built again, its halves unjoined
+    int form = 0;
     if (split[b]) {
       const TopoDS_Shape joined = halves_joined(bodies[b], params.angular_tolerance);
-      if (BRepCheck_Analyzer(joined).IsValid()) {
+      if (!joined.IsNull() && BRepCheck_Analyzer(joined).IsValid()) {
         bodies[b] = joined;
         continue;
       }
+    } else if (BRepCheck_Analyzer(bodies[b]).IsValid()) {
+      continue;
+    } else {
+      form = 1;
     }
-    if (BRepCheck_Analyzer(bodies[b]).IsValid()) continue;
-    int ignored = 0;
-    if (facets.empty()) facets = solids_of(s, pieces, source, std::nullopt, ignored);
-    if (BRepCheck_Analyzer(facets[b]).IsValid())
-      bodies[b] = facets[b], ++refused;
-    else
+    while (form <= 3 && !BRepCheck_Analyzer(forms.body(form, b)).IsValid()) ++form;
+    if (form > 3) {
       all_valid = false;
+      continue;
+    }
+    bodies[b] = forms.body(form, b);
+    refused += form > 0;
+    facet_bodies += form > 1;
   }
-  if (coarsened) coarsened->unmerged_bodies = refused;
+  if (coarsened) coarsened->unmerged_bodies = refused, coarsened->facet_bodies = facet_bodies;
   if (checked_valid) *checked_valid = all_valid;
   if (bodies.size() == 1) return bodies[0];
   BRep_Builder builder;
@@ -475,7 +521,7 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
           const int null = open("/dev/null", O_WRONLY);
           if (null >= 0) dup2(null, 1), close(null);
         }
-        return brep::guard_occt("building the result solid", [&]() {
+        return brep::guard_occt("building result.step from the result surface", [&]() {
           CoarsenReport coarsened;
           int analytic_refused = 0;
           bool checked_valid = false;  // every body passed OCCT's check in result_solid: not run again
@@ -483,6 +529,7 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
           StepExportReport r = describe_solid(solid, checked_valid);
           r.triangles = coarsened.triangles_after;
           r.unmerged_bodies = coarsened.unmerged_bodies;
+          r.facet_bodies = coarsened.facet_bodies;
           r.analytic_refused = analytic_refused;
           const int bodies = result_bodies(s);
           if (!r.valid || r.solids != bodies)
@@ -493,7 +540,7 @@ StepExportReport write_result_step(const std::string& path, const TriSurface& s,
                             "); the STL is written: try other smoothing settings (\"optimization.smooth\")");
           write_step_file(solid, path, params.pcurves);
           return report_text(r);
-        });
+        }, brep::OcctBlame::own_shape);
       },
       progress);
   StepExportReport r = report_of(answer);

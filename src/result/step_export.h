@@ -64,6 +64,9 @@ struct StepExportReport {
   int analytic_refused = 0;
   long triangles = 0;       ///< triangles that became faces (after coarsening), before merging
   int unmerged_bodies = 0;  ///< bodies written as facets: OCCT's check refused their merged faces
+  /// Of those, the bodies written without the input's curved faces (merged planar faces, else a
+  /// planar face per triangle): OCCT's check refused the body with its analytic faces too.
+  int facet_bodies = 0;
   double volume = 0;        ///< mm³, by OCCT's GProp
   double seconds = 0;       ///< building, checking and writing (wall time)
   double cpu_seconds = 0;   ///< the same in CPU time of the child that did it
@@ -73,9 +76,10 @@ struct StepExportReport {
 /// The solid bounded by `s` (closed, outward triangles; s.V #P by 3, s.F #Q by 3): the
 /// free-form region coarsened (params.coarsen; `coarsened`, optional: what it did), then with
 /// params.unify coplanar neighbouring triangles as one planar face and straight boundary runs
-/// as one edge (step_planar_faces.h; a body whose merged faces OCCT's check refuses while its
-/// facets pass is built as facets: coarsened->unmerged_bodies), else a planar face per
-/// triangle, every face sharing its edges with its neighbours. One solid per body of the surface (result_bodies; a compound of them when
+/// as one edge (step_planar_faces.h; a body OCCT's check refuses is built again unmerged, then
+/// without the input's curved faces, then as a planar face per triangle, and the first form that
+/// passes is kept: coarsened->unmerged_bodies, and coarsened->facet_bodies for the last two),
+/// else a planar face per triangle, every face sharing its edges with its neighbours. One solid per body of the surface (result_bodies; a compound of them when
 /// there are several, e.g. a detached non-design solid), closed voids as inner shells of the
 /// body holding them. Points no triangle uses are ignored. Throws Error(InvalidShape) naming the
 /// first triangle without area or an open surface (what to change: the smoothing settings).

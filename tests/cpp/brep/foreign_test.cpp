@@ -12,6 +12,7 @@
 #include <GProp_GProps.hxx>
 #include <OSD.hxx>
 #include <STEPControl_Reader.hxx>
+#include <Standard_NullObject.hxx>
 #include <Standard_OutOfRange.hxx>
 #include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
@@ -251,6 +252,22 @@ TEST(OcctGuard, FailuresInWordsWithoutOcctNames) {
       << e.what();
   EXPECT_FALSE(has(e, "NCollection"));
   EXPECT_EQ(guard_occt("adding", [] { return 2 + 3; }), 5);
+}
+
+TEST(OcctGuard, AFailureOnTopOptsOwnShapeDoesNotBlameTheInputs) {
+  // the result's STEP is built from TopOpt's own surface: re-exporting the part cannot help
+  const Error e = error_of([] {
+    guard_occt(
+        "building result.step from the result surface",
+        []() -> int { throw Standard_NullObject("BRep_Tool:: TopoDS_Vertex hasn't gp_Pnt"); }, OcctBlame::own_shape);
+  });
+  EXPECT_EQ(e.code(), ErrorCode::InvalidShape);
+  EXPECT_TRUE(has(e, "building result.step from the result surface failed inside the geometry kernel, OCCT (a "
+                     "missing curve, surface or shape): the fault is in the shape TopOpt made itself"))
+      << e.what();
+  EXPECT_FALSE(has(e, "re-export"));
+  EXPECT_FALSE(has(e, "check the part"));
+  EXPECT_FALSE(has(e, "BRep_Tool"));
 }
 
 TEST(OcctGuard, AccessViolationBecomesANamedErrorWhereOcctsHandlerIsSet) {
