@@ -7,13 +7,18 @@
 
 namespace topopt {
 
+/// The parameter t in [0, 1] of the point a + t (b − a) of segment a-b nearest to p (0 for a
+/// degenerate segment).
+inline double segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  return len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+}
+
 /// The point of segment a-b nearest to p (a for a degenerate segment).
 inline Eigen::Vector3d closest_on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return a + t * ab;
+  return a + segment_parameter(p, a, b) * (b - a);
 }
 
 /// The distance from p to segment a-b.

@@ -86,7 +86,6 @@ std::vector<long> cheapest_path(const TetMesh& mesh, const MatX4i& nb, const std
   return path;
 }
 
-/// Distance from x to the segment a-b.
 /// Per node (#V): within `radius` of the polyline through `points`.
 std::vector<char> nodes_near(const TetMesh& mesh, const std::vector<Point>& points, double radius) {
   Point lo = points[0], hi = points[0];
@@ -114,10 +113,8 @@ std::vector<char> nodes_under(const TetMesh& mesh, const std::vector<Point>& poi
     const Point x = mesh.V.row(v).transpose(), xa = across(x);
     for (size_t i = 0; i + 1 < points.size() && !under[v]; ++i) {
       const Point a = across(points[i]), b = across(points[i + 1]);
-      const Point c = closest_on_segment(xa, a, b);
-      if ((xa - c).norm() > radius) continue;
-      const double ab2 = (b - a).squaredNorm();
-      const double s = ab2 > 0 ? std::clamp((c - a).dot(b - a) / ab2, 0.0, 1.0) : 0.0;
+      const double s = segment_parameter(xa, a, b);
+      if ((xa - (a + s * (b - a))).norm() > radius) continue;
       const double height = (1 - s) * points[i].dot(build) + s * points[i + 1].dot(build);
       under[v] = x.dot(build) <= height;
     }

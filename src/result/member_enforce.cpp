@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <sstream>
 
+#include "mesh/core/spatial_grid.h"
 #include "result/design_hygiene.h"
 #include "result/iso_surface.h"
 #include "simp/controls/member_measure.h"
@@ -18,25 +18,28 @@ using Point = Eigen::Vector3d;
 
 bool is_design(const TetMesh& mesh, long t) { return mesh.domain.size() != mesh.T.rows() || mesh.domain[t] == 0; }
 
-/// Tets sorted by their centre's x, to visit those within a distance of a point.
-struct ByX {
-  std::vector<long> order;
-  std::vector<double> xs;
+/// The tets' centres in the product's spatial grid (mesh/core/spatial_grid.h), cells of `cell`
+/// (mm, the mesh size), to visit those within a distance of a point.
+struct Centres {
   std::vector<Point> centre;  // #T
-  explicit ByX(const TetMesh& mesh) : centre(mesh.T.rows()) {
-    for (long t = 0; t < mesh.T.rows(); ++t) centre[t] = tet_centre(mesh, t);
-    order.resize(centre.size());
-    std::iota(order.begin(), order.end(), 0L);
-    std::sort(order.begin(), order.end(), [&](long a, long b) { return centre[a].x() < centre[b].x(); });
-    for (long t : order) xs.push_back(centre[t].x());
+  mesh::SpatialGrid<3> grid;
+  Centres(const TetMesh& mesh, double cell) : centre(mesh.T.rows()), grid(origin(mesh).data(), cell > 0 ? cell : 1) {
+    for (long t = 0; t < mesh.T.rows(); ++t) {
+      centre[t] = tet_centre(mesh, t);
+      grid.insert(static_cast<int>(t), centre[t].data(), centre[t].data());
+    }
   }
   /// Calls fn(t) for every tet whose centre lies within r of p.
   template <class Fn>
   void within(const Point& p, double r, Fn fn) const {
-    for (auto k = std::lower_bound(xs.begin(), xs.end(), p.x() - r) - xs.begin();
-         k < static_cast<long>(xs.size()) && xs[k] <= p.x() + r; ++k)
-      if ((centre[order[k]] - p).norm() <= r) fn(order[k]);
+    const Point lo = p.array() - r, hi = p.array() + r;
+    grid.for_each(lo.data(), hi.data(), [&](int t) {
+      if ((centre[t] - p).norm() <= r) fn(static_cast<long>(t));
+    });
   }
+
+ private:
+  static Point origin(const TetMesh& mesh) { return mesh.V.rows() ? Point(mesh.V.colwise().minCoeff()) : Point::Zero(); }
 };
 
 /// The crisp design of density at threshold as 0/1 densities (#T).
@@ -68,7 +71,7 @@ std::vector<std::pair<long, double>> thin_tets(const TetMesh& mesh, const VecXd&
 /// Sets solid the design tets within (size − w)/2 + margin of each thin tet's centre (w its
 /// thickness: a plate grows by the shortfall's half on either side); adds what it did to
 /// `report`. Returns the number of tets set solid.
-long thicken(const TetMesh& mesh, const ByX& index, const std::vector<std::pair<long, double>>& thin, double size,
+long thicken(const TetMesh& mesh, const Centres& index, const std::vector<std::pair<long, double>>& thin, double size,
              double margin, VecXd& density, MemberEnforcement& report) {
   long added = 0;
   for (const auto& [t, w] : thin)
@@ -113,7 +116,7 @@ std::vector<char> member_attachments(const TetMesh& mesh, const std::vector<char
     for (int a = 0; a < 4; ++a)
       if (is_design(mesh, t) && anchors[mesh.T(t, a)]) attached[t] = 1;
   if (mesh.domain.size() != nt) return attached;
-  const ByX index(mesh);
+  const Centres index(mesh, cell);
   for (long t = 0; t < nt; ++t)
     if (mesh.domain[t] != 0)
       index.within(index.centre[t], cell, [&](long j) { attached[j] |= mesh.domain[j] == 0; });
@@ -129,7 +132,7 @@ VecXd enforce_min_member(const TetMesh& mesh, const VecXd& density, double thres
   for (long t = 0; t < mesh.T.rows(); ++t)
     if (is_design(mesh, t)) report.design_volume += tet_volume(mesh, t);
   const std::vector<char> attached = member_attachments(mesh, anchors, report.cell);
-  const ByX index(mesh);
+  const Centres index(mesh, report.cell);
   VecXd out = density;
   // The crisp design lies up to about half a cell inside the tets set solid (its tets are those
   // whose node densities average the threshold), so a dilation by the shortfall alone can add
