@@ -16,6 +16,7 @@
 #include "pipeline/problem_checks.h"
 #include "result/curved_faces.h"
 #include "result/iso_surface_refine.h"
+#include "simp/controls/overhang_carry.h"
 #include "simp/controls/overhang_filter.h"
 #include "simp/density_filter.h"
 
@@ -163,6 +164,49 @@ bool hold_loaded_faces(const TetMesh& mesh, const Job& job, const Progress& prog
   return true;
 }
 
+/// Under an overhang control (controls.overhang), the design tets under the non-design solids'
+/// downward faces (simp::carried_tets) tagged non-design in `held` too (made from `mesh` when
+/// `holding` is false; holding is then set), so that SIMP keeps them solid and the control's
+/// filter builds on them; with a note. Returns the share of `mesh`'s design volume they take.
+double hold_carried_tets(const TetMesh& mesh, const simp::OverhangControl& o, const Progress& progress,
+                         bool& holding, TetMesh& held) {
+  if (!o.enabled) return 0.0;
+  const std::vector<char> carried = simp::carried_tets(mesh, o);
+  const long count = std::count(carried.begin(), carried.end(), 1);
+  if (count == 0) return 0.0;
+  if (!holding) held = mesh;
+  holding = true;
+  const int tag = held.domain.maxCoeff() + 1;
+  const VecXd volume = simp::tet_volumes(mesh);
+  double design = 0, taken = 0;
+  for (long t = 0; t < mesh.T.rows(); ++t) {
+    if (mesh.domain[t] != 0) continue;
+    design += volume[t];
+    if (carried[t] && held.domain[t] == 0) held.domain[t] = tag, taken += volume[t];
+  }
+  progress.info("overhang: " + std::to_string(count) +
+                " design tets under the non-design solids' downward faces held solid (" +
+                std::to_string(100 * taken / design).substr(0, 4) +
+                " % of the design volume, counted in the volume fraction) so that the design carries those faces");
+  return design > 0 ? taken / design : 0.0;
+}
+
+/// SIMP's volume fraction of its design domain when the layer of keep_loaded_faces (share
+/// `loaded` of the design volume) stays on top of the fraction and the carried tets (share
+/// `carried`) are taken out of it: the same material as without them. Throws
+/// Error(InvalidParameter) when the carried tets alone take the whole fraction.
+double simp_volume_fraction(double volume_fraction, double loaded, double carried) {
+  if (carried <= 0) return volume_fraction;
+  const double rest = (volume_fraction * (1 - loaded) - carried) / (1 - loaded - carried);
+  if (!(rest > 0))
+    throw Error(ErrorCode::InvalidParameter,
+                "controls.overhang: the design under the non-design solids' downward faces (" +
+                    std::to_string(100 * carried).substr(0, 4) + " % of the design domain) takes the whole volume "
+                    "fraction: raise optimization.volume_fraction or choose a build direction under which those "
+                    "faces do not face down");
+  return rest;
+}
+
 /// The share of `mesh`'s design volume that hold_loaded_faces tagged non-design in `held`.
 double held_share(const TetMesh& mesh, const TetMesh& held) {
   const VecXd volume = simp::tet_volumes(mesh);
@@ -244,6 +288,7 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
   smooth.build.direction = o.direction.normalized();
   smooth.build.angle = o.angle;
   smooth.build.plate = simp::base_plate_height(mesh, smooth.build.direction, o.base_face);
+  smooth.build.margin = o.margin;
   return smooth;
 }
 
@@ -290,20 +335,45 @@ Reextraction reextraction(const Job& job, const TetMesh& mesh) {
   return x;
 }
 
+namespace {
+
+/// Under an overhang control (build active), simp::carried_level of the non-design solids'
+/// undersides on `mesh`, its ramp a mean edge; empty without one.
+VecXd carried_level(const TetMesh& mesh, const result::BuildDirection& build) {
+  if (!build.active()) return {};
+  simp::OverhangControl c;
+  c.enabled = true;
+  c.direction = build.direction;
+  c.angle = build.angle;
+  c.margin = build.margin;
+  return simp::carried_level(mesh, c, simp::mean_edge_length(mesh));
+}
+
+/// The node densities the result is cut from: result::node_densities of `density` (#T), at least
+/// `carried` (#V, or empty) so that the design holds the non-design solids' undersides to their edges.
+VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecXd& carried) {
+  VecXd nd = result::node_densities(mesh, density);
+  if (carried.size() == nd.size()) nd = nd.cwiseMax(carried);
+  return nd;
+}
+
+}  // namespace
+
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
                                   const result::SmoothParams& smooth, double* threshold_used,
                                   const std::vector<char>& anchors, const result::HygieneParams& hygiene,
                                   result::HygieneReport* report, VecXd* design, const Progress& progress,
                                   result::DesignSurfaceReport* surface_report, const result::SourceFaces* source) {
-  const double t = threshold > 0
-                       ? threshold
-                       : result::threshold_for_volume(mesh, result::node_densities(mesh, density), volume_fraction);
+  const VecXd carried = carried_level(mesh, smooth.build);
+  const double t = threshold > 0 ? threshold
+                                 : result::threshold_for_volume(mesh, extraction_densities(mesh, density, carried),
+                                                                volume_fraction);
   if (threshold_used) *threshold_used = t;
   result::HygieneReport found;
   const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
   for (const std::string& w : found.warnings) progress.warn(w);
   const double margin = smooth.remesh ? smooth.crossing_margin : 0.0;
-  const VecXd nd = result::node_densities(mesh, cleaned);
+  const VecXd nd = extraction_densities(mesh, cleaned, carried);
   result::TriSurface s;
   if (smooth.resolution > 1) {
     const result::RefinedField fine = result::refine_near_level(mesh, nd, t);
@@ -353,8 +423,13 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
         {d.name, fem::make_loads(mesh, job.material, {fem::LoadCase{d.name, {d.unit}, 1}}).col(0), d.limit});
   OptimizeResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  TetMesh held;  // keep_loaded_faces: the layer on loaded and supported faces non-design for SIMP
-  const bool holding = set.keep_loaded_faces && hold_loaded_faces(mesh, job, progress, held);
+  // keep_loaded_faces: the layer on loaded and supported faces non-design for SIMP, and under an
+  // overhang control the design carrying the non-design solids' undersides (taken out of the fraction)
+  TetMesh held;
+  bool holding = set.keep_loaded_faces && hold_loaded_faces(mesh, job, progress, held);
+  const double loaded = holding ? held_share(mesh, held) : 0.0;
+  const double carried = hold_carried_tets(mesh, set.simp.controls.overhang, progress, holding, held);
+  simp.volume_fraction = simp_volume_fraction(set.simp.volume_fraction, loaded, carried);
   r.simp =
       (runner ? runner : SimpRunner(simp::optimize))(holding ? held : mesh, job.material, supports, loads, weights,
                                                      simp, progress, on_iteration, fem::gravity_of(job.load_cases));
@@ -364,7 +439,7 @@ OptimizeResult optimize_job(const Job& job, const TetMesh& mesh, const Progress&
   // the shape keeps the volume SIMP ended with (under a mass objective, what the limits left)
   const double simp_kept = simp.responses.objective == simp::Objective::Mass && !r.simp.history.empty()
                                ? r.simp.history.back().volume_fraction
-                               : set.simp.volume_fraction;
+                               : simp.volume_fraction;
   // ... of SIMP's design domain; the layer keep_loaded_faces held solid is design material too
   const double share = holding ? held_share(mesh, held) : 0.0;
   const double kept = simp_kept + (1 - simp_kept) * share;

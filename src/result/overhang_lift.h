@@ -15,6 +15,9 @@ struct BuildDirection {
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< unit, from the plate up; zero: no control
   double angle = 45;                                    ///< degrees: the smallest self-supporting rise from the plate
   double plate = 0;                                     ///< mm: the plate's height along direction
+  /// degrees: the control's margin: the non-design solids' undersides are carried by a funnel whose
+  /// sides rise at angle + margin (simp/controls/overhang_carry.h)
+  double margin = 20;
   /// mm: a triangle with every corner this close to the plate rests on it (simp::overhang_share's)
   double plate_tolerance = 1e-6;
   bool active() const { return direction.squaredNorm() > 0; }
