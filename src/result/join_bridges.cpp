@@ -122,6 +122,49 @@ std::vector<char> nodes_under(const TetMesh& mesh, const std::vector<Point>& poi
   return under;
 }
 
+/// Per node (#V): a node of a non-design tet, or at or above `threshold` of the node densities
+/// of `density` (#T): material.
+std::vector<char> solid_nodes(const TetMesh& mesh, const VecXd& density, double threshold) {
+  const VecXd nd = node_densities(mesh, density);
+  std::vector<char> solid(mesh.V.rows(), 0);
+  for (long v = 0; v < mesh.V.rows(); ++v) solid[v] = nd[v] >= threshold;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain[t] != 0)
+      for (int k = 0; k < 4; ++k) solid[mesh.T(t, k)] = 1;
+  return solid;
+}
+
+/// Per node (#V): the wall that carries the tube of `radius` round the polyline `points` down the
+/// unit `build` direction to the material below it — the nodes under the tube (nodes_under), not
+/// material (`solid`, #V) themselves, that have no material node of that shadow above them within
+/// `column` across the build.
+/// The wall stops on the first material under the tube (a member of the design, a non-design
+/// solid), not at the plate: what lies under that material is its own to print.
+std::vector<char> wall_under(const TetMesh& mesh, const std::vector<Point>& points, double radius,
+                             const Eigen::Vector3d& build, double column, const std::vector<char>& solid) {
+  std::vector<char> wall = nodes_under(mesh, points, radius, build);
+  std::vector<long> material;  // the shadow's material nodes
+  for (long v = 0; v < mesh.V.rows(); ++v)
+    if (wall[v] && solid[v]) material.push_back(v);
+  for (long v = 0; v < mesh.V.rows(); ++v) {
+    if (!wall[v]) continue;
+    if (solid[v]) {  // material already: flagged, it would set the void tets around it solid
+      wall[v] = 0;
+      continue;
+    }
+    const Point x = mesh.V.row(v).transpose();
+    for (long m : material) {
+      const Point d = mesh.V.row(m).transpose() - x;
+      const double up = d.dot(build);
+      if (up > 0 && (d - up * build).norm() <= column) {
+        wall[v] = 0;
+        break;
+      }
+    }
+  }
+  return wall;
+}
+
 /// The path's polyline (tet centres) with each end carried on by `length` along its last step:
 /// the tube then ends inside the pieces it joins, not at their first tet's centre.
 std::vector<Point> extended_ends(std::vector<Point> points, double length) {
@@ -194,12 +237,7 @@ struct NodeGrid {
 double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, double reach, double radius,
                        double threshold, VecXd& density) {
   const long nv = mesh.V.rows();
-  const VecXd nd = node_densities(mesh, density);
-  std::vector<char> solid(nv, 0);
-  for (long v = 0; v < nv; ++v) solid[v] = nd[v] >= threshold;
-  for (long t = 0; t < mesh.T.rows(); ++t)
-    if (mesh.domain[t] != 0)
-      for (int k = 0; k < 4; ++k) solid[mesh.T(t, k)] = 1;
+  const std::vector<char> solid = solid_nodes(mesh, density, threshold);
   const std::vector<char> inner = nodes_near(mesh, axis, reach);               // may close
   const std::vector<char> outer = nodes_near(mesh, axis, reach + 2 * radius);  // what decides
   NodeGrid grid;
@@ -256,7 +294,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
   if (apart.empty()) return density;
   for (long t = 0; t < nt; ++t)
     carrying[t] = before.label[t] >= 0 && before.fate[before.label[t]] == PieceFate::Carries;
-  if (size <= 0) size = default_size(mesh);
+  const double edge = default_size(mesh) / 3;  // the design tets' mean edge
+  if (size <= 0) size = 3 * edge;
   std::vector<Point> centre(nt);
   for (long t = 0; t < nt; ++t) centre[t] = tet_centre(mesh, t);
   VecXd out = density;
@@ -289,7 +328,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
     for (long t : path)
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     if (build.squaredNorm() > 0) {  // a wall under the tube: no ceiling to print it on
-      const std::vector<char> under = nodes_under(mesh, axis, 0.5 * size, build);
+      const std::vector<char> under =
+          wall_under(mesh, axis, 0.5 * size, build, 0.5 * edge, solid_nodes(mesh, out, threshold));
       for (size_t v = 0; v < near.size(); ++v) near[v] |= under[v];
     }
     for (long t = 0; t < nt; ++t) {
