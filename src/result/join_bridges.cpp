@@ -134,18 +134,37 @@ std::vector<char> solid_nodes(const TetMesh& mesh, const VecXd& density, double 
   return solid;
 }
 
+/// Per node (#V): on a triangle of Ω's boundary whose outward normal lies within 60° of −build
+/// (unit): where Ω ends below, nothing to build under it.
+std::vector<char> nodes_on_floor_of_omega(const TetMesh& mesh, const Eigen::Vector3d& build) {
+  std::vector<char> floor(mesh.V.rows(), 0);
+  for (long f = 0; f < mesh.F.rows(); ++f) {
+    const Point a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Point n = (b - a).cross(c - a);
+    if (n.dot(build) < -0.5 * n.norm())
+      for (int k = 0; k < 3; ++k) floor[mesh.F(f, k)] = 1;
+  }
+  return floor;
+}
+
 /// Per node (#V): the wall that carries the tube of `radius` round the polyline `points` down the
 /// unit `build` direction to the material below it — the nodes under the tube (nodes_under), not
-/// material (`solid`, #V) themselves, that have no material node of that shadow above them within
-/// `column` across the build.
-/// The wall stops on the first material under the tube (a member of the design, a non-design
-/// solid), not at the plate: what lies under that material is its own to print.
+/// material (`solid`, #V) themselves, save those with a material node of that shadow above them
+/// within `column` across the build and a gap of at least `gap` between that material and what
+/// lies under it there (material, or Ω's floor). The wall stops on the first material under the
+/// tube (a member of the design, a non-design solid), not at the plate: what lies under that
+/// material is its own to print — unless the void under it is thinner than `gap`, which is filled
+/// as before (a ceiling a millimetre over the plate is no less an overhang than the tube's).
 std::vector<char> wall_under(const TetMesh& mesh, const std::vector<Point>& points, double radius,
-                             const Eigen::Vector3d& build, double column, const std::vector<char>& solid) {
+                             const Eigen::Vector3d& build, double column, double gap, const std::vector<char>& solid) {
   std::vector<char> wall = nodes_under(mesh, points, radius, build);
-  std::vector<long> material;  // the shadow's material nodes
-  for (long v = 0; v < mesh.V.rows(); ++v)
+  const std::vector<char> floor = nodes_on_floor_of_omega(mesh, build);
+  std::vector<long> below_ends, material;  // the shadow's material nodes and those of Ω's floor
+  for (long v = 0; v < mesh.V.rows(); ++v) {
     if (wall[v] && solid[v]) material.push_back(v);
+    if (wall[v] && (solid[v] || floor[v])) below_ends.push_back(v);
+  }
+  const auto in_column = [&](const Point& d) { return (d - d.dot(build) * build).norm() <= column; };
   for (long v = 0; v < mesh.V.rows(); ++v) {
     if (!wall[v]) continue;
     if (solid[v]) {  // material already: flagged, it would set the void tets around it solid
@@ -153,14 +172,15 @@ std::vector<char> wall_under(const TetMesh& mesh, const std::vector<Point>& poin
       continue;
     }
     const Point x = mesh.V.row(v).transpose();
-    for (long m : material) {
-      const Point d = mesh.V.row(m).transpose() - x;
-      const double up = d.dot(build);
-      if (up > 0 && (d - up * build).norm() <= column) {
-        wall[v] = 0;
-        break;
-      }
-    }
+    double above = std::numeric_limits<double>::infinity(), below = -above;  // heights over and under v
+    for (long m : material)
+      if (const Point d = mesh.V.row(m).transpose() - x; d.dot(build) > 0 && in_column(d))
+        above = std::min(above, mesh.V.row(m).dot(build));
+    if (std::isinf(above)) continue;
+    for (long m : below_ends)
+      if (const Point d = mesh.V.row(m).transpose() - x; d.dot(build) <= 0 && in_column(d))
+        below = std::max(below, mesh.V.row(m).dot(build));
+    if (above - below >= gap) wall[v] = 0;
   }
   return wall;
 }
@@ -329,7 +349,7 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     if (build.squaredNorm() > 0) {  // a wall under the tube: no ceiling to print it on
       const std::vector<char> under =
-          wall_under(mesh, axis, 0.5 * size, build, 0.5 * edge, solid_nodes(mesh, out, threshold));
+          wall_under(mesh, axis, 0.5 * size, build, 0.5 * edge, size, solid_nodes(mesh, out, threshold));
       for (size_t v = 0; v < near.size(); ++v) near[v] |= under[v];
     }
     for (long t = 0; t < nt; ++t) {

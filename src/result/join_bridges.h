@@ -45,7 +45,8 @@ double bridge_penalty(double rho);
 /// ends (the plate), so the bridge stands on a wall with sides along the build instead of hanging
 /// as a horizontal tube, whose underside faces straight down (on the bracket lying, 95 mm² too
 /// flat that the overhang pass, which only restores slopes, could not lift); what lies under that
-/// material is its own to print, the wall does not go through it.
+/// material is its own to print, the wall does not go through it — unless the void under it is
+/// thinner than `size`, which is filled (a ceiling just over the plate is an overhang too).
 VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
                              const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges,
                              const Eigen::Vector3d& build = Eigen::Vector3d::Zero());
