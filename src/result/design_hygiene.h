@@ -38,8 +38,8 @@ struct HygieneParams {
   /// <= 0: not.
   double min_member_size = 0;
   /// The build direction of an overhang control (unit, from the plate up; zero: none): a bridge
-  /// is then carried down by a wall along the build to where Ω ends below (join_bridges.h), so that its
-  /// underside is not a ceiling the overhang pass cannot lift.
+  /// is then carried down by a wall along the build to the first material below it, or where Ω ends
+  /// (join_bridges.h), so that its underside is not a ceiling the overhang pass cannot lift.
   Eigen::Vector3d build_direction = Eigen::Vector3d::Zero();
 };
 

@@ -122,6 +122,69 @@ std::vector<char> nodes_under(const TetMesh& mesh, const std::vector<Point>& poi
   return under;
 }
 
+/// Per node (#V): a node of a non-design tet, or at or above `threshold` of the node densities
+/// of `density` (#T): material.
+std::vector<char> solid_nodes(const TetMesh& mesh, const VecXd& density, double threshold) {
+  const VecXd nd = node_densities(mesh, density);
+  std::vector<char> solid(mesh.V.rows(), 0);
+  for (long v = 0; v < mesh.V.rows(); ++v) solid[v] = nd[v] >= threshold;
+  for (long t = 0; t < mesh.T.rows(); ++t)
+    if (mesh.domain[t] != 0)
+      for (int k = 0; k < 4; ++k) solid[mesh.T(t, k)] = 1;
+  return solid;
+}
+
+/// Per node (#V): on a triangle of Ω's boundary whose outward normal lies within 60° of −build
+/// (unit): where Ω ends below, nothing to build under it.
+std::vector<char> nodes_on_floor_of_omega(const TetMesh& mesh, const Eigen::Vector3d& build) {
+  std::vector<char> floor(mesh.V.rows(), 0);
+  for (long f = 0; f < mesh.F.rows(); ++f) {
+    const Point a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Point n = (b - a).cross(c - a);
+    if (n.dot(build) < -0.5 * n.norm())
+      for (int k = 0; k < 3; ++k) floor[mesh.F(f, k)] = 1;
+  }
+  return floor;
+}
+
+/// Per node (#V): the wall that carries the tube of `radius` round the polyline `points` down the
+/// unit `build` direction to the material below it — the nodes under the tube (nodes_under), not
+/// material (`solid`, #V) themselves, save those with a material node of that shadow above them
+/// within `column` across the build and a gap of at least `gap` between that material and what
+/// lies under it there (material, or Ω's floor). The wall stops on the first material under the
+/// tube (a member of the design, a non-design solid), not at the plate: what lies under that
+/// material is its own to print — unless the void under it is thinner than `gap`, which is filled
+/// as before (a ceiling a millimetre over the plate is no less an overhang than the tube's).
+std::vector<char> wall_under(const TetMesh& mesh, const std::vector<Point>& points, double radius,
+                             const Eigen::Vector3d& build, double column, double gap, const std::vector<char>& solid) {
+  std::vector<char> wall = nodes_under(mesh, points, radius, build);
+  const std::vector<char> floor = nodes_on_floor_of_omega(mesh, build);
+  std::vector<long> below_ends, material;  // the shadow's material nodes and those of Ω's floor
+  for (long v = 0; v < mesh.V.rows(); ++v) {
+    if (wall[v] && solid[v]) material.push_back(v);
+    if (wall[v] && (solid[v] || floor[v])) below_ends.push_back(v);
+  }
+  const auto in_column = [&](const Point& d) { return (d - d.dot(build) * build).norm() <= column; };
+  for (long v = 0; v < mesh.V.rows(); ++v) {
+    if (!wall[v]) continue;
+    if (solid[v]) {  // material already: flagged, it would set the void tets around it solid
+      wall[v] = 0;
+      continue;
+    }
+    const Point x = mesh.V.row(v).transpose();
+    double above = std::numeric_limits<double>::infinity(), below = -above;  // heights over and under v
+    for (long m : material)
+      if (const Point d = mesh.V.row(m).transpose() - x; d.dot(build) > 0 && in_column(d))
+        above = std::min(above, mesh.V.row(m).dot(build));
+    if (std::isinf(above)) continue;
+    for (long m : below_ends)
+      if (const Point d = mesh.V.row(m).transpose() - x; d.dot(build) <= 0 && in_column(d))
+        below = std::max(below, mesh.V.row(m).dot(build));
+    if (above - below >= gap) wall[v] = 0;
+  }
+  return wall;
+}
+
 /// The path's polyline (tet centres) with each end carried on by `length` along its last step:
 /// the tube then ends inside the pieces it joins, not at their first tet's centre.
 std::vector<Point> extended_ends(std::vector<Point> points, double length) {
@@ -194,12 +257,7 @@ struct NodeGrid {
 double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, double reach, double radius,
                        double threshold, VecXd& density) {
   const long nv = mesh.V.rows();
-  const VecXd nd = node_densities(mesh, density);
-  std::vector<char> solid(nv, 0);
-  for (long v = 0; v < nv; ++v) solid[v] = nd[v] >= threshold;
-  for (long t = 0; t < mesh.T.rows(); ++t)
-    if (mesh.domain[t] != 0)
-      for (int k = 0; k < 4; ++k) solid[mesh.T(t, k)] = 1;
+  const std::vector<char> solid = solid_nodes(mesh, density, threshold);
   const std::vector<char> inner = nodes_near(mesh, axis, reach);               // may close
   const std::vector<char> outer = nodes_near(mesh, axis, reach + 2 * radius);  // what decides
   NodeGrid grid;
@@ -256,7 +314,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
   if (apart.empty()) return density;
   for (long t = 0; t < nt; ++t)
     carrying[t] = before.label[t] >= 0 && before.fate[before.label[t]] == PieceFate::Carries;
-  if (size <= 0) size = default_size(mesh);
+  const double edge = default_size(mesh) / 3;  // the design tets' mean edge
+  if (size <= 0) size = 3 * edge;
   std::vector<Point> centre(nt);
   for (long t = 0; t < nt; ++t) centre[t] = tet_centre(mesh, t);
   VecXd out = density;
@@ -289,7 +348,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
     for (long t : path)
       for (int k = 0; k < 4; ++k) near[mesh.T(t, k)] = 1;
     if (build.squaredNorm() > 0) {  // a wall under the tube: no ceiling to print it on
-      const std::vector<char> under = nodes_under(mesh, axis, 0.5 * size, build);
+      const std::vector<char> under =
+          wall_under(mesh, axis, 0.5 * size, build, 0.5 * edge, size, solid_nodes(mesh, out, threshold));
       for (size_t v = 0; v < near.size(); ++v) near[v] |= under[v];
     }
     for (long t = 0; t < nt; ++t) {

@@ -39,10 +39,14 @@ double bridge_penalty(double rho);
 /// returned densities; false when no path exists) and returns the densities (#T).
 /// build: an overhang control's build direction (unit; zero: none). With one, the tube is
 /// carried down along −build before the junctions close: every design tet with a node below the
-/// axis and within size / 2 of it across the build direction is set solid too, all the way down
-/// (to the plate, or where Ω ends below), so the bridge stands on a wall with sides along the build instead
-/// of hanging as a horizontal tube, whose underside faces straight down (on the bracket lying,
-/// 95 mm² too flat that the overhang pass, which only restores slopes, could not lift).
+/// axis, within size / 2 of it across the build direction and not under material of that shadow
+/// (a node at or above the threshold, or of a non-design tet, within half an edge across above it)
+/// is set solid too, down to the first material below (a member, a non-design solid) or where Ω
+/// ends (the plate), so the bridge stands on a wall with sides along the build instead of hanging
+/// as a horizontal tube, whose underside faces straight down (on the bracket lying, 95 mm² too
+/// flat that the overhang pass, which only restores slopes, could not lift); what lies under that
+/// material is its own to print, the wall does not go through it — unless the void under it is
+/// thinner than `size`, which is filled (a ceiling just over the plate is an overhang too).
 VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, const VecXd& density, double threshold,
                              const std::vector<char>& anchors, double size, std::vector<Bridge>& bridges,
                              const Eigen::Vector3d& build = Eigen::Vector3d::Zero());
