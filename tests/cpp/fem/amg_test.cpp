@@ -12,6 +12,7 @@
 #include "fem/boundary_conditions.h"
 #include "fem/clamped_beam.h"
 #include "fem/elasticity.h"
+#include "fem/node_block_matrix.h"
 
 namespace topopt::fem {
 namespace {
@@ -116,6 +117,8 @@ TEST(Amg, NodeBlockProductsGiveTheRowWalksVCycleAndProductToTheBit) {
   p.coarse_dofs = 200;
   CsrMatrix blocked = s.A, plain = s.A;
   plain.blocks.clear();
+  ASSERT_TRUE(NodeBlockPattern().build(blocked));  // the blocks' products are the ones compared
+  ASSERT_FALSE(NodeBlockPattern().build(plain));
   SmoothedAggregationAmg by_blocks, by_rows;
   by_blocks.setup(blocked, s.node_ptr, s.modes, p);
   by_rows.setup(plain, s.node_ptr, s.modes, p);
