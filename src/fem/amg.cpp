@@ -10,6 +10,7 @@
 #include "common/adjacency.h"
 #include "common/error.h"
 #include "common/parallel.h"
+#include "fem/node_block_matrix.h"
 
 namespace topopt::fem {
 
@@ -27,9 +28,16 @@ struct Level {
   CsrMatrix P, R;              // to/from the next coarser level
   // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
+  // A in 3×3 node blocks where it fits (the finest level of an elasticity hierarchy: K), then
+  // the products with A read these instead of A and Af: Abf in the V-cycle, Abd (A's values to
+  // the bit) in the power iteration and multiply_finest
+  NodeBlockPattern nb;
+  std::vector<float> Abf;
+  std::vector<double> Abd;
+  bool p_by_blocks = false;  // P's row blocks are nb's, their rows sharing columns: A P from the blocks
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
   // residual, Chebyshev correction, scratch product
-  mutable std::vector<double> b, x, r, d, q;
+  mutable std::vector<double> b, x, r, d, q, xpad;
 };
 
 /// The node of each row: rows node_ptr[k] .. node_ptr[k+1]-1 belong to node k.
@@ -206,14 +214,23 @@ CsrMatrix smoothed_prolongator(const CsrMatrix& A, const CsrMatrix& Pt, const st
   return AP;
 }
 
+/// The rows of A P from A's row blocks b0 .. b1 − 1: from A's 3×3 node blocks where the level
+/// has them and P's row blocks are A's (the same values as from A's rows, in less time).
+CsrMatrix product_slice(const Level& L, long b0, long b1, int threads) {
+  if (L.p_by_blocks)
+    return multiply_rows(L.nb, L.Abd, *L.A, L.P, b0, b1, threads);
+  return multiply_rows(*L.A, L.P, b0, b1, threads);
+}
+
 /// The values of C = R (A P) recomputed for new values of A on C's pattern (the product the setup
 /// made: multiply(R, multiply(A, P))): A P formed a slice of A's row blocks at a time and its
 /// terms added to C as they come (add_product_rows), so that about 1/kSlices of A P is held —
 /// A P is the hierarchy's largest matrix (1.5 times A's entries on the rocker), and keeping it
 /// whole between refreshes was 0.5 GB per million tets. The same additions in the same order as
 /// the product of the whole A P: the same values to the bit.
-void galerkin_values(const CsrMatrix& A, const CsrMatrix& P, const CsrMatrix& R, CsrMatrix& C, int threads) {
+void galerkin_values(const Level& L, CsrMatrix& C, int threads) {
   constexpr long kSlices = 8;
+  const CsrMatrix &A = *L.A, &R = L.R;
   std::fill(C.val.begin(), C.val.end(), 0.0);
   std::vector<int> cursor(row_blocks(R));
   for (size_t b = 0; b < cursor.size(); ++b) cursor[b] = R.ptr[R.blocks.empty() ? b : R.blocks[b]];
@@ -221,7 +238,7 @@ void galerkin_values(const CsrMatrix& A, const CsrMatrix& P, const CsrMatrix& R,
   for (long s = 0; s < kSlices; ++s) {
     const long b0 = blocks * s / kSlices, b1 = blocks * (s + 1) / kSlices;
     if (b0 == b1) continue;
-    const CsrMatrix slice = multiply_rows(A, P, b0, b1, threads);
+    const CsrMatrix slice = product_slice(L, b0, b1, threads);
     add_product_rows(R, slice, A.blocks.empty() ? static_cast<int>(b0) : A.blocks[b0], cursor, C, threads);
   }
 }
@@ -251,9 +268,38 @@ struct SmoothedAggregationAmg::Impl {
   bool coarsen(const CsrMatrix& A, const std::vector<int>& node_ptr, const std::vector<double>& modes,
                std::vector<int>& coarse_ptr, std::vector<double>& coarse_modes, CsrMatrix& Pt) const;
   static void to_single(const CsrMatrix& M, std::vector<float>& out) { out.assign(M.val.begin(), M.val.end()); }
+  /// The copies of L.A's values the products read (Af, or Abf and Abd): after A got new values.
+  static void copy_values(Level& L);
+  /// y = A x on level L in single precision (the V-cycle's products).
+  void single_product(const Level& L, const double* x, double* y) const;
+  /// y = A x on level L with A's values (the same to the bit as L.A->multiply).
+  void exact_product(const Level& L, const double* x, double* y) const;
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
   void cycle(size_t l) const;
 };
+
+void SmoothedAggregationAmg::Impl::copy_values(Level& L) {
+  if (L.nb.empty()) {
+    to_single(*L.A, L.Af);
+    return;
+  }
+  L.nb.fill(*L.A, L.Abd);
+  L.Abf.assign(L.Abd.begin(), L.Abd.end());  // a contiguous copy: cheaper than a second fill's walk
+}
+
+void SmoothedAggregationAmg::Impl::single_product(const Level& L, const double* x, double* y) const {
+  if (L.nb.empty())
+    sparse_product(*L.A, L.Af.data(), x, y, threads);
+  else
+    L.nb.multiply(L.Abf, x, y, L.xpad, threads);
+}
+
+void SmoothedAggregationAmg::Impl::exact_product(const Level& L, const double* x, double* y) const {
+  if (L.nb.empty())
+    L.A->multiply(x, y, threads);
+  else
+    L.nb.multiply(L.Abd, x, y, L.xpad, threads);
+}
 
 void SmoothedAggregationAmg::Impl::estimate_lambda(Level& L, int steps) const {
   // Power iteration on D⁻¹A from a fixed, non-smooth start (deterministic).
@@ -272,7 +318,7 @@ void SmoothedAggregationAmg::Impl::estimate_lambda(Level& L, int steps) const {
     nv = std::sqrt(nv);
     if (nv == 0) break;
     for (double& a : v) a /= nv;
-    L.A->multiply(v.data(), w.data(), threads);
+    exact_product(L, v.data(), w.data());
     double num = 0;
     for (int i = 0; i < n; ++i) {
       w[i] *= L.inv_diag[i];
@@ -383,12 +429,12 @@ void SmoothedAggregationAmg::Impl::smooth(const Level& L, const double* b, doubl
   if (zero_start) {
     for (int i = 0; i < n; ++i) r[i] = b[i], x[i] = 0;
   } else {
-    sparse_product(*L.A, L.Af.data(), x, q, threads);
+    single_product(L, x, q);
     for (int i = 0; i < n; ++i) r[i] = b[i] - q[i];
   }
   for (int i = 0; i < n; ++i) d[i] = dinv[i] * r[i] / theta, x[i] += d[i];
   for (int k = 1; k < params.smoother_degree; ++k) {
-    sparse_product(*L.A, L.Af.data(), d, q, threads);  // r -= A d keeps r = b - A x
+    single_product(L, d, q);  // r -= A d keeps r = b - A x
     const double rho_new = 1 / (2 * sigma - rho);
     const double c1 = rho_new * rho, c2 = 2 * rho_new / delta;
     for (int i = 0; i < n; ++i) {
@@ -411,7 +457,7 @@ void SmoothedAggregationAmg::Impl::cycle(size_t l) const {
     return;
   }
   smooth(L, L.b.data(), L.x.data(), true);
-  sparse_product(*L.A, L.Af.data(), L.x.data(), L.q.data(), threads);
+  single_product(L, L.x.data(), L.q.data());
   for (int i = 0; i < n; ++i) L.r[i] = L.b[i] - L.q[i];
   const Level& C = levels[l + 1];
   sparse_product(L.R, L.Rf.data(), L.r.data(), C.b.data(), threads);
@@ -451,15 +497,17 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     if (n <= params.coarse_dofs || static_cast<int>(m.levels.size()) >= params.max_levels) break;
     CsrMatrix Pt;
     if (!m.coarsen(Al, nodes, modes, coarse_nodes, coarse_modes, Pt)) break;
+    L.nb.build(Al);  // a level with a coarser one below: its products are the V-cycle's
+    Impl::copy_values(L);
     m.estimate_lambda(L);
     L.P = smoothed_prolongator(Al, Pt, L.inv_diag, L.lambda, m.threads);
+    L.p_by_blocks = !L.nb.empty() && L.P.blocks == L.nb.first && L.P.blocks_consistent();
     L.R = transpose(L.P);
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
     // A P only for as long as the product needs it (a refresh forms it again slice by slice)
     CsrMatrix coarse = multiply(L.R, multiply(Al, L.P, m.threads), m.threads);
     Impl::to_single(L.P, L.Pf);
     Impl::to_single(L.R, L.Rf);
-    Impl::to_single(Al, L.Af);
     nodes.swap(coarse_nodes);
     modes.swap(coarse_modes);
     m.levels.emplace_back();
@@ -474,8 +522,8 @@ void SmoothedAggregationAmg::refresh_finest() {
   if (m.levels.empty()) throw Error(ErrorCode::Internal, "AMG: refresh before setup");
   m.inverse_diagonal(m.levels[0]);
   if (m.levels.size() > 1) {
+    Impl::copy_values(m.levels[0]);
     m.estimate_lambda(m.levels[0], 5);
-    Impl::to_single(*m.levels[0].A, m.levels[0].Af);
   } else
     m.factor_coarsest();
 }
@@ -486,10 +534,10 @@ void SmoothedAggregationAmg::refresh_galerkin() {
   for (size_t l = 0; l + 1 < m.levels.size(); ++l) {
     Level& L = m.levels[l];
     m.inverse_diagonal(L);
+    Impl::copy_values(L);
     m.estimate_lambda(L, 5);
-    Impl::to_single(*L.A, L.Af);
     // the setup's pattern: the next level's values rewritten in place (its A points at its `own`)
-    galerkin_values(*L.A, L.P, L.R, m.levels[l + 1].own, m.threads);
+    galerkin_values(L, m.levels[l + 1].own, m.threads);
   }
   m.inverse_diagonal(m.levels.back());
   m.factor_coarsest(true);
@@ -501,6 +549,12 @@ void SmoothedAggregationAmg::apply(const double* r, double* z) const {
   std::copy(r, r + L.A->rows, L.b.begin());
   m.cycle(0);
   std::copy(L.x.begin(), L.x.end(), z);
+}
+
+void SmoothedAggregationAmg::multiply_finest(const double* x, double* y) const {
+  const Impl& m = *impl_;
+  if (m.levels.empty()) throw Error(ErrorCode::Internal, "AMG: product before setup");
+  m.exact_product(m.levels[0], x, y);
 }
 
 int SmoothedAggregationAmg::levels() const { return static_cast<int>(impl_->levels.size()); }

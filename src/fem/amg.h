@@ -83,6 +83,12 @@ class SmoothedAggregationAmg final : public Preconditioner {
   /// The same on vectors (the Preconditioner interface).
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override { apply(r.data(), z.data()); }
 
+  /// y = A x for the finest matrix (the one given to setup) with its values as of the last
+  /// setup or refresh: from the hierarchy's 3×3 node-block copy of it where there is one
+  /// (fem/node_block_matrix.h; the same values to the bit as A.multiply, in less time), else
+  /// A.multiply. x, y: n.
+  void multiply_finest(const double* x, double* y) const;
+
   int levels() const;
   /// Operator complexity: Σ nnz(A_l) / nnz(A_0).
   double complexity() const;

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "common/parallel.h"
+#include "fem/node_block_matrix.h"
 
 namespace topopt::fem {
 
@@ -33,9 +34,132 @@ CsrMatrix multiply(const CsrMatrix& A, const CsrMatrix& B, int threads) {
   return multiply_rows(A, B, 0, row_blocks(A), threads);
 }
 
-// Gustavson's row-by-row product with a dense accumulator per thread; a block's rows share one
-// walk over their column indices.
-CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads) {
+namespace {
+
+/// A thread's dense accumulator for multiply_rows: per column of B the block that last touched
+/// it (mark) and its place (slot) among the columns the block touched, in order (touched);
+/// CsrMatrix::kMaxBlock sums per place (acc).
+struct RowAccumulator {
+  std::vector<int> mark, slot, touched;
+  std::vector<double> acc;
+};
+
+/// The rows r0 .. r0 + nr − 1 of A B (a row block of A: the same columns) summed into `w`, one
+/// walk over the block's column indices. NR: the row count at compile time (0: nr, any count
+/// up to kMaxBlock); the same additions in the same order whatever NR — a fixed count lets the
+/// compiler keep a column's values in registers (a mesh node's 3 rows, an aggregate's 6).
+template <int NR>
+void block_rows_times(const CsrMatrix& A, const CsrMatrix& B, int r0, int nr, int blk, RowAccumulator& w) {
+  constexpr int kB = CsrMatrix::kMaxBlock;
+  const int n = NR ? NR : nr, len = A.ptr[r0 + 1] - A.ptr[r0];
+  w.touched.clear();
+  int* mark = w.mark.data();  // raw pointers: the stores into acc need not reload them
+  int* slot = w.slot.data();
+  double* acc = w.acc.data();
+  const int* a_col = A.col.data() + A.ptr[r0];
+  const double* a_val[kB];
+  for (int r = 0; r < n; ++r) a_val[r] = A.val.data() + A.ptr[r0 + r];
+  for (int k = 0; k < len; ++k) {
+    const int cc = a_col[k];
+    double a[kB];
+    for (int r = 0; r < n; ++r) a[r] = a_val[r][k];
+    for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
+      const int j = B.col[kb];
+      const double v = B.val[kb];
+      if (mark[j] != blk) {
+        mark[j] = blk;
+        slot[j] = static_cast<int>(w.touched.size());
+        w.touched.push_back(j);
+        if (w.acc.size() < w.touched.size() * kB) w.acc.resize(2 * w.touched.size() * kB), acc = w.acc.data();
+        double* q = acc + kB * slot[j];
+        for (int r = 0; r < n; ++r) q[r] = a[r] * v;
+      } else {
+        double* q = acc + kB * slot[j];
+        for (int r = 0; r < n; ++r) q[r] += a[r] * v;
+      }
+    }
+  }
+}
+
+/// The rows of row block `blk` of M B summed into `w` as block_rows_times sums them from M's
+/// compressed rows (the same terms in the same order: M's columns increase, and B's rows of a
+/// node block share their columns), with M's values read from its 3×3 blocks `val`: one column
+/// check per block of B's columns instead of one per entry of M. NR: M's rows in the block (3 or
+/// 0: any); PN: B's rows in every column block (3 or 0: any).
+template <int NR>
+void node_block_rows_times(const NodeBlockPattern& nb, const double* val, const CsrMatrix& B, int blk,
+                           RowAccumulator& w) {
+  constexpr int kB = CsrMatrix::kMaxBlock;
+  const int n = NR ? NR : nb.first[blk + 1] - nb.first[blk];
+  w.touched.clear();
+  int* mark = w.mark.data();
+  int* slot = w.slot.data();
+  double* acc = w.acc.data();
+  for (int k = nb.ptr[blk]; k < nb.ptr[blk + 1]; ++k) {
+    const int m = nb.col[k], p0 = nb.first[m], pn = nb.first[m + 1] - p0;
+    const double* a = val + 9L * k;  // a[3 r + c]: M's row r, column p0 + c
+    const int* bc = B.col.data() + B.ptr[p0];
+    const int blen = B.ptr[p0 + 1] - B.ptr[p0];
+    const double* bv[3];
+    for (int c = 0; c < pn; ++c) bv[c] = B.val.data() + B.ptr[p0 + c];
+    for (int t = 0; t < blen; ++t) {
+      const int j = bc[t];
+      double* q;
+      int c = 1;
+      if (mark[j] != blk) {  // the first term is set, not added (as in block_rows_times)
+        mark[j] = blk;
+        slot[j] = static_cast<int>(w.touched.size());
+        w.touched.push_back(j);
+        if (w.acc.size() < w.touched.size() * kB) w.acc.resize(2 * w.touched.size() * kB), acc = w.acc.data();
+        q = acc + kB * slot[j];
+        for (int r = 0; r < n; ++r) q[r] = a[3 * r] * bv[0][t];
+      } else {
+        q = acc + kB * slot[j];
+        c = 0;
+      }
+      if (pn == 3) {
+        for (int r = 0; r < n; ++r) {
+          double s = q[r];
+          for (int cc = c; cc < 3; ++cc) s += a[3 * r + cc] * bv[cc][t];
+          q[r] = s;
+        }
+      } else {
+        for (int r = 0; r < n; ++r)
+          for (int cc = c; cc < pn; ++cc) q[r] += a[3 * r + cc] * bv[cc][t];
+      }
+    }
+  }
+}
+
+/// add_product_rows for one row block of A (rows r0 .. r0 + nr − 1, from its entry k on, while
+/// the column is below `last`): the terms of X's rows, added into the block's rows of C at the
+/// places `slot` gives their columns. Returns the first entry not added. NR as in
+/// block_rows_times.
+template <int NR>
+int add_block_terms(const CsrMatrix& A, const CsrMatrix& X, int first, int last, int r0, int nr, int k,
+                    const int* slot, CsrMatrix& C) {
+  constexpr int kB = CsrMatrix::kMaxBlock;
+  const int n = NR ? NR : nr, end = A.ptr[r0 + 1];
+  double* c[kB];
+  for (int r = 0; r < n; ++r) c[r] = &C.val[C.ptr[r0 + r]];
+  for (; k < end && A.col[k] < last; ++k) {
+    const int i = A.col[k] - first, offset = k - A.ptr[r0];
+    double a[kB];
+    for (int r = 0; r < n; ++r) a[r] = A.val[A.ptr[r0 + r] + offset];
+    for (int kx = X.ptr[i]; kx < X.ptr[i + 1]; ++kx) {
+      const int t = slot[X.col[kx]];
+      const double v = X.val[kx];
+      for (int r = 0; r < n; ++r) c[r][t] += a[r] * v;
+    }
+  }
+  return k;
+}
+
+/// The driver of multiply_rows: the rows of A B from A's row blocks first .. last − 1, each block
+/// summed by form(r0, nr, blk, w) (its nr rows from row r0 into w's touched columns and sums),
+/// on `threads` threads, gathered into one matrix.
+template <class Form>
+CsrMatrix product_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads, const Form& form) {
   assert(A.cols == B.rows && 0 <= first && first <= last && last <= row_blocks(A));
   constexpr int kB = CsrMatrix::kMaxBlock;
   std::vector<int> blocks = A.blocks;
@@ -57,8 +181,9 @@ CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long
   parallel_for(
       chunks, chunks,
       [&](long cb, long ce) {
-        std::vector<int> mark(B.cols, -1), slot(B.cols), touched;
-        std::vector<double> acc;
+        RowAccumulator w;
+        w.mark.assign(B.cols, -1);
+        w.slot.resize(B.cols);
         for (long c = cb; c < ce; ++c) {
           Part& part = parts[c];
           const long b0 = first + nblocks * c / chunks, b1 = first + nblocks * (c + 1) / chunks;
@@ -66,33 +191,13 @@ CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long
           part.col.reserve(static_cast<size_t>(A.ptr[blocks[b1]] - A.ptr[blocks[b0]]) * 4);
           part.val.reserve(part.col.capacity());
           for (long blk = b0; blk < b1; ++blk) {
-            const int r0 = blocks[blk], nr = blocks[blk + 1] - r0, len = A.ptr[r0 + 1] - A.ptr[r0];
-            touched.clear();
-            for (int k = 0; k < len; ++k) {
-              const int cc = A.col[A.ptr[r0] + k];
-              double a[kB];
-              for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + k];
-              for (int kb = B.ptr[cc]; kb < B.ptr[cc + 1]; ++kb) {
-                const int j = B.col[kb];
-                const double v = B.val[kb];
-                if (mark[j] != blk) {
-                  mark[j] = static_cast<int>(blk);
-                  slot[j] = static_cast<int>(touched.size());
-                  touched.push_back(j);
-                  if (acc.size() < touched.size() * kB) acc.resize(2 * touched.size() * kB);
-                  double* q = &acc[kB * slot[j]];
-                  for (int r = 0; r < nr; ++r) q[r] = a[r] * v;
-                } else {
-                  double* q = &acc[kB * slot[j]];
-                  for (int r = 0; r < nr; ++r) q[r] += a[r] * v;
-                }
-              }
-            }
+            const int r0 = blocks[blk], nr = blocks[blk + 1] - r0;
+            form(r0, nr, static_cast<int>(blk), w);
             for (int r = 0; r < nr; ++r) {
-              part.count.push_back(static_cast<int>(touched.size()));
-              for (size_t t = 0; t < touched.size(); ++t) {
-                part.col.push_back(touched[t]);
-                part.val.push_back(acc[kB * t + r]);
+              part.count.push_back(static_cast<int>(w.touched.size()));
+              for (size_t t = 0; t < w.touched.size(); ++t) {
+                part.col.push_back(w.touched[t]);
+                part.val.push_back(w.acc[kB * t + r]);
               }
             }
           }
@@ -119,10 +224,33 @@ CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long
   return C;
 }
 
+}  // namespace
+
+// Gustavson's row-by-row product with a dense accumulator per thread; a block's rows share one
+// walk over their column indices.
+CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads) {
+  return product_rows(A, B, first, last, threads, [&](int r0, int nr, int blk, RowAccumulator& w) {
+    if (nr == 3)
+      block_rows_times<3>(A, B, r0, nr, blk, w);
+    else
+      block_rows_times<0>(A, B, r0, nr, blk, w);
+  });
+}
+
+CsrMatrix multiply_rows(const NodeBlockPattern& nb, const std::vector<double>& val, const CsrMatrix& A,
+                        const CsrMatrix& B, long first, long last, int threads) {
+  assert(B.blocks == nb.first && A.blocks == nb.first);
+  return product_rows(A, B, first, last, threads, [&](int, int nr, int blk, RowAccumulator& w) {
+    if (nr == 3)
+      node_block_rows_times<3>(nb, val.data(), B, blk, w);
+    else
+      node_block_rows_times<0>(nb, val.data(), B, blk, w);
+  });
+}
+
 void add_product_rows(const CsrMatrix& A, const CsrMatrix& X, int first, std::vector<int>& cursor, CsrMatrix& C,
                       int threads) {
   assert(C.rows == A.rows && C.cols == X.cols);
-  constexpr int kB = CsrMatrix::kMaxBlock;
   const bool one_row = A.blocks.empty();
   const long nblocks = row_blocks(A);
   const int last = first + X.rows;
@@ -134,21 +262,13 @@ void add_product_rows(const CsrMatrix& A, const CsrMatrix& X, int first, std::ve
         for (long blk = bb; blk < be; ++blk) {
           const int r0 = one_row ? static_cast<int>(blk) : A.blocks[blk];
           const int nr = one_row ? 1 : A.blocks[blk + 1] - r0, end = A.ptr[r0 + 1];
-          int k = cursor[blk];
+          const int k = cursor[blk];
           if (k == end || A.col[k] >= last) continue;
           const int c0 = C.ptr[r0], clen = C.ptr[r0 + 1] - c0;
           for (int t = 0; t < clen; ++t) slot[C.col[c0 + t]] = t;
-          for (; k < end && A.col[k] < last; ++k) {
-            const int i = A.col[k] - first, offset = k - A.ptr[r0];
-            double a[kB];
-            for (int r = 0; r < nr; ++r) a[r] = A.val[A.ptr[r0 + r] + offset];
-            for (int kx = X.ptr[i]; kx < X.ptr[i + 1]; ++kx) {
-              const int t = slot[X.col[kx]];
-              const double v = X.val[kx];
-              for (int r = 0; r < nr; ++r) C.val[C.ptr[r0 + r] + t] += a[r] * v;
-            }
-          }
-          cursor[blk] = k;
+          // an aggregate's six coarse dofs (elasticity), or any count
+          cursor[blk] = nr == 6 ? add_block_terms<6>(A, X, first, last, r0, nr, k, slot.data(), C)
+                                : add_block_terms<0>(A, X, first, last, r0, nr, k, slot.data(), C);
         }
       },
       512);

@@ -64,6 +64,14 @@ long row_blocks(const CsrMatrix& A);
 /// row of block `first`, its blocks are those blocks shifted. A product taken a slice at a time.
 CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long last, int threads);
 
+struct NodeBlockPattern;
+/// The same rows of A B (the same values to the bit) with A's values read from its 3×3 node
+/// blocks `val` (nb's pattern of A, fem/node_block_matrix.h): one column check per 3×3 block
+/// of A and column of B instead of one per entry of A. B's row blocks must be A's (nb.first), the
+/// rows of each sharing their columns — the smoothed prolongator's, made from A by multiply.
+CsrMatrix multiply_rows(const NodeBlockPattern& nb, const std::vector<double>& val, const CsrMatrix& A,
+                        const CsrMatrix& B, long first, long last, int threads);
+
 /// C += the terms of A X that come from X's rows first .. first + Xs.rows − 1, given as Xs (its
 /// row 0 is X's row `first`); C has the pattern (and row blocks) of multiply(A, X), A's columns
 /// increase within each row. cursor (one per row block of A) holds the first entry of each

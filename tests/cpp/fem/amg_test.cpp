@@ -6,11 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "fem/boundary_conditions.h"
 #include "fem/clamped_beam.h"
 #include "fem/elasticity.h"
+#include "fem/node_block_matrix.h"
 
 namespace topopt::fem {
 namespace {
@@ -102,6 +104,55 @@ TEST(Amg, GalerkinRefreshEqualsAFreshHierarchyToTheBit) {
   finest_only.apply(r.data(), z_stale.data());
   EXPECT_EQ(z_refreshed, z_fresh);
   EXPECT_GT((z_stale - z_fresh).norm(), 1e-3 * z_fresh.norm());  // the coarse levels matter
+}
+
+TEST(Amg, NodeBlockProductsGiveTheRowWalksVCycleAndProductToTheBit) {
+  // K with its node blocks: the finest level's products read 3×3 blocks (fem/node_block_matrix.h);
+  // the same K without them: the row walk of sparse_product. The two hierarchies are the same
+  // (aggregation goes by node_ptr), so the V-cycles and the finest products must be the same to
+  // the bit, after the setup and after new values (a finest and a Galerkin refresh).
+  TetMesh m = beam({24, 6, 6});
+  System s = clamped_beam_system(m, VecXd::Ones(m.T.rows()));
+  AmgParams p;
+  p.coarse_dofs = 200;
+  CsrMatrix blocked = s.A, plain = s.A;
+  plain.blocks.clear();
+  ASSERT_TRUE(NodeBlockPattern().build(blocked));  // the blocks' products are the ones compared
+  ASSERT_FALSE(NodeBlockPattern().build(plain));
+  SmoothedAggregationAmg by_blocks, by_rows;
+  by_blocks.setup(blocked, s.node_ptr, s.modes, p);
+  by_rows.setup(plain, s.node_ptr, s.modes, p);
+  ASSERT_GE(by_blocks.levels(), 3);
+  const int n = s.A.rows;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> N;
+  Eigen::VectorXd r(n);
+  for (int i = 0; i < n; ++i) r[i] = N(rng);
+  auto expect_same = [&](const char* when) {
+    Eigen::VectorXd z_blocks(n), z_rows(n), y_blocks(n), y_rows(n);
+    by_blocks.apply(r.data(), z_blocks.data());
+    by_rows.apply(r.data(), z_rows.data());
+    EXPECT_EQ(z_blocks, z_rows) << when;
+    by_blocks.multiply_finest(r.data(), y_blocks.data());
+    by_rows.multiply_finest(r.data(), y_rows.data());
+    EXPECT_EQ(y_blocks, y_rows) << when;
+    Eigen::VectorXd y(n);
+    blocked.multiply(r.data(), y.data(), 1);
+    EXPECT_EQ(y_blocks, y) << when;  // the matrix's current values, not the setup's
+  };
+  expect_same("after the setup");
+  std::vector<double> f(n);  // K scaled by f f ᵀ entrywise (symmetric positive definite still)
+  for (int i = 0; i < n; ++i) f[i] = 1 + 0.3 * std::sin(0.7 * i);
+  for (int i = 0; i < n; ++i)
+    for (int k = blocked.ptr[i]; k < blocked.ptr[i + 1]; ++k) blocked.val[k] = plain.val[k] *= f[i] * f[blocked.col[k]];
+  by_blocks.refresh_finest();
+  by_rows.refresh_finest();
+  expect_same("after a finest refresh");
+  for (double* v : {blocked.val.data(), plain.val.data()})
+    for (size_t k = 0; k < blocked.val.size(); ++k) v[k] *= 1.5;
+  by_blocks.refresh_galerkin();
+  by_rows.refresh_galerkin();
+  expect_same("after a Galerkin refresh");
 }
 
 TEST(Amg, MultigridSolveEqualsCholeskyWithVoidContrast) {
