@@ -3,7 +3,7 @@
 // copy), warm-started from the previous solution (each load case from its own). Between SIMP
 // iterations the hierarchy is kept and only its finest smoother refreshed; its coarse matrices are
 // recomputed from the new matrix on the kept aggregates (refresh_galerkin) when the iterations
-// the stale ones cost would soon outweigh a refresh, a solve that runs half a refresh's cost past the
+// the stale ones cost would soon outweigh a refresh, a solve that runs a refresh's cost past the
 // reference is cut there and finished on refreshed coarse matrices, and a new hierarchy is set up
 // when even refreshed coarse matrices need clearly more iterations than the setup's
 // (HierarchyReuse in solver_policy.h). Every solve meets the tolerance whichever happened.

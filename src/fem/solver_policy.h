@@ -49,8 +49,8 @@ class FactorReuse {
 /// matrix would bring the excess to a refresh's cost (the next solve's excess taken as the
 /// last one's: a lower bound while the staleness grows) — the rent-or-buy balance, which for an
 /// excess growing linearly refreshes at the period that minimises iterations plus refreshes.
-/// A single kept solve that runs half of kRefreshCost past the reference is cut there and
-/// finished on refreshed coarse matrices (patience()). A new hierarchy is set up when even a solve on
+/// A single kept solve that runs kRefreshCost past the reference is cut there and finished on
+/// refreshed coarse matrices (patience()). A new hierarchy is set up when even a solve on
 /// refreshed coarse matrices needs clearly more than the first solve after the setup (1.5 times
 /// as many, plus 4: the aggregates no longer fit the design).
 ///
@@ -77,29 +77,32 @@ class HierarchyReuse {
   }
 
   /// The tolerance changed: counts at the old tolerance say nothing at the new one. The next
-  /// kept matrix gets its coarse matrices refreshed, and its solve is the new baseline and
-  /// reference (the hierarchy's aggregates stay).
+  /// solve is the new baseline and reference, on the hierarchy as it is (a refresh forced here
+  /// cost the cantilever's β = 32 phase refreshes the kept hierarchy did without).
   void rebaseline() {
     baseline_ = reference_ = -1;
-    excess_ = kRefreshCost;
+    excess_ = last_ = 0;
   }
 
   /// A solve on the kept hierarchy was cut short (patience reached) and finished on refreshed
   /// coarse matrices, in `iterations` in all (-1: not known): the designs are changing fast, so
   /// the next kept matrix gets its coarse matrices refreshed before its solve too (its count is
-  /// then the new reference), and the staleness of one matrix, the solve's excess, is
-  /// remembered for the matrices after it.
+  /// then the new reference), and what one matrix's staleness cost — the solve's excess and the
+  /// refresh it needed anyway — is remembered for the matrices after it. (The excess alone
+  /// understates it: the solve was cut. Without the refresh's share the rocker's β = 32 phase,
+  /// whose cut solves take 28-31 iterations against 10-13 refreshed, tried a kept solve every
+  /// other matrix.)
   void cut(int iterations = -1) {
     excess_ = kRefreshCost;
-    last_ = std::max(kRefreshCost, iterations - reference_);
+    last_ = std::max(0, iterations - reference_) + kRefreshCost;
   }
 
   /// A kept hierarchy for a new matrix: recompute its coarse matrices now (not only the finest
   /// smoother)? Yes when the excess plus one more solve's like the last kept one would reach
   /// kRefreshCost, or after a cut or a tolerance change. Call once per kept matrix. The last
-  /// kept solve's excess outlives the refresh, fading by a third at each: while one matrix's
-  /// staleness alone costs a refresh (the rocker at β = 32) every matrix is refreshed, and a
-  /// kept solve tries again every third matrix or so.
+  /// kept solve's excess (or a cut one's cost) outlives the refresh, fading by a third at each:
+  /// while one matrix's staleness alone costs a refresh (the rocker at β = 32) every matrix is
+  /// refreshed, and a kept solve is tried again every few matrices.
   bool refresh_coarse_on_update() {
     fresh_ = excess_ + last_ >= kRefreshCost;
     if (fresh_) {
@@ -117,7 +120,7 @@ class HierarchyReuse {
   /// Records a solve's CG iterations (its worst load case); not called for a solve that was
   /// cut and finished on refreshed coarse matrices.
   void record(int iterations) {
-    if (fresh_) {
+    if (fresh_ || reference_ < 0) {
       if (baseline_ < 0)
         baseline_ = iterations;
       else if (iterations > limit())
@@ -132,12 +135,11 @@ class HierarchyReuse {
   }
 
   /// The most CG iterations a solve on the kept coarse matrices may take before it is cut short
-  /// and finished on refreshed ones (from where it stopped): the reference plus half a
-  /// refresh's cost, past which one more matrix like this one would call for a refresh anyway
-  /// (so it is done now, for this solve too). Without a reference (on coarse matrices that fit)
-  /// `cap`.
+  /// and finished on refreshed ones (from where it stopped): the reference plus a refresh's
+  /// cost (half of it cut the cantilever's solves that a kept hierarchy finished at less cost).
+  /// Without a reference (coarse matrices that fit, or the first solve at a new tolerance) `cap`.
   int patience(int cap) const {
-    return fresh_ || reference_ < 0 ? cap : std::min(cap, reference_ + kRefreshCost / 2);
+    return fresh_ || reference_ < 0 ? cap : std::min(cap, reference_ + kRefreshCost);
   }
 
  private:

@@ -77,20 +77,20 @@ TEST(HierarchyReuse, CoarseMatricesRefreshedWhenTheExcessWouldReachARefreshsCost
   EXPECT_TRUE(r.keep(true));  // refreshed, not rebuilt
 }
 
-TEST(HierarchyReuse, PatienceIsTheReferencePlusHalfARefreshsCost) {
+TEST(HierarchyReuse, PatienceIsTheReferencePlusARefreshsCost) {
   HierarchyReuse r(true);
   r.set_up();
   EXPECT_EQ(r.patience(5000), 5000);  // coarse matrices that fit: the solver's own cap
   r.record(12);
   EXPECT_FALSE(r.refresh_coarse_on_update());
-  EXPECT_EQ(r.patience(5000), 12 + HierarchyReuse::kRefreshCost / 2);
+  EXPECT_EQ(r.patience(5000), 12 + HierarchyReuse::kRefreshCost);
   EXPECT_EQ(r.patience(15), 15);  // never above the solver's cap
   r.cut();
   EXPECT_TRUE(r.refresh_coarse_on_update());
   EXPECT_EQ(r.patience(5000), 5000);  // refreshed for this matrix
   r.record(9);
   EXPECT_FALSE(r.refresh_coarse_on_update());
-  EXPECT_EQ(r.patience(5000), 9 + HierarchyReuse::kRefreshCost / 2);
+  EXPECT_EQ(r.patience(5000), 9 + HierarchyReuse::kRefreshCost);
 }
 
 TEST(HierarchyReuse, WhileOneMatrixsStalenessCostsARefreshEveryMatrixIsRefreshed) {
@@ -109,24 +109,27 @@ TEST(HierarchyReuse, WhileOneMatrixsStalenessCostsARefreshEveryMatrixIsRefreshed
   // refreshed for the matrices after the cut, not for ever: the remembered staleness fades and a
   // kept solve is tried again
   EXPECT_GE(refreshed, 3);
-  EXPECT_EQ(r.patience(5000), 12 + cost / 2);
+  EXPECT_EQ(r.patience(5000), 12 + cost);
   r.cut();  // and it is as slow: refreshed again
   EXPECT_TRUE(r.refresh_coarse_on_update());
 }
 
-TEST(HierarchyReuse, ATolerancesChangeRefreshesAndTakesANewBaseline) {
+TEST(HierarchyReuse, ATolerancesChangeTakesANewBaselineOnTheHierarchyAsItIs) {
   HierarchyReuse r(true);
   r.set_up();
   r.record(10);
   EXPECT_FALSE(r.refresh_coarse_on_update());
-  r.record(11);
+  r.record(20);  // kept, 10 beyond the reference
   r.rebaseline();  // counts at the old tolerance say nothing now
-  EXPECT_TRUE(r.refresh_coarse_on_update());
-  r.record(25);  // the new baseline: more iterations at a tighter tolerance are not growth
+  EXPECT_FALSE(r.refresh_coarse_on_update());  // their excess is forgotten, nothing forced
+  EXPECT_EQ(r.patience(5000), 5000);           // no reference at this tolerance yet
+  r.record(25);  // the new baseline and reference: more iterations at a tighter tolerance are not growth
   EXPECT_TRUE(r.keep(true));
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  EXPECT_EQ(r.patience(5000), 25 + HierarchyReuse::kRefreshCost);
   r.cut();
   EXPECT_TRUE(r.refresh_coarse_on_update());
-  r.record(static_cast<int>(1.5 * 25) + 4 + 1);  // against the new baseline: grown
+  r.record(static_cast<int>(1.5 * 25) + 4 + 1);  // refreshed, against the new baseline: grown
   EXPECT_FALSE(r.keep(true));
 }
 
