@@ -168,7 +168,7 @@ TEST(LinearSolver, MultigridKeepsItsHierarchyUntilTheIterationsGrow) {
   EXPECT_EQ(s.preparations, 1);
   EXPECT_EQ(s.reuses, 1);
   // SIMP's void contrast: the kept hierarchy would need far more iterations, so the solve is
-  // cut at the growth that marks it stale (1.5 x baseline + 4) and finished after its coarse
+  // cut at a refresh's cost past the reference (HierarchyReuse::patience) and finished after its coarse
   // matrices are recomputed from the new matrix (no full setup); the next solve on the
   // refreshed hierarchy, from zero, needs fewer iterations than the cut one did in all
   s = step(half_soft(b.mesh, 1e-6));
