@@ -337,8 +337,8 @@ Eigen::MatrixXd DistElasticity::solve(const Eigen::MatrixXd& loads) {
   if (m.dirty) {
     check_petsc(MatZeroEntries(m.K), "MatZeroEntries");
     m.insert(m.K, true);
-    // the serial multigrid's rule (fem::HierarchyReuse): keep the preconditioner while solves on
-    // it stay within 1.5 × the first one's iterations plus 4; a refresh after a cut short solve
+    // the serial multigrid's rule (fem::HierarchyReuse): keep the preconditioner while the
+    // iterations its staleness costs stay below a refresh's; a refresh of the coarse matrices
     // is, on PETSc, a new set-up (the Galerkin products are most of GAMG's set-up)
     bool keep = m.reuse.keep(m.built);
     if (keep && m.reuse.refresh_coarse_on_update()) {

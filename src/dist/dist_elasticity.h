@@ -24,8 +24,9 @@ struct DistSolverParams {
   int max_iterations = 5000;  ///< CG iterations per solve
   Amg amg = Amg::GAMG;        ///< the preconditioner (PETSC_OPTIONS may still override it)
   /// Keep the multigrid built for an earlier matrix while it still pays, by the serial
-  /// multigrid's rule (fem::HierarchyReuse: until a solve needs 1.5 × the iterations of the first
-  /// one on it, plus 4; a solve that reaches that is finished on a new set-up). SIMP's
+  /// multigrid's rule (fem::HierarchyReuse: a new set-up where the serial solver would refresh
+  /// its coarse matrices — once the iterations beyond the first solve's would soon outweigh it —
+  /// and a solve that runs a refresh's cost past that count finished on a new set-up). SIMP's
   /// SolverParams::recycle_factor; false: a new set-up for every new matrix.
   bool reuse = true;
 };

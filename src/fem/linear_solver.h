@@ -35,8 +35,8 @@ struct SolverParams {
   /// previous Cholesky factor (SIMP's stiffness changes little between iterations) and
   /// refactorise only when that would take more than `recycle_iterations` iterations; the
   /// result then meets `recycle_tolerance` (relative residual) instead of machine precision.
-  /// Iterative: keep the multigrid hierarchy (refresh its finest level) until the iteration
-  /// count grows by half.
+  /// Iterative: keep the multigrid hierarchy (refresh its finest level, its coarse matrices
+  /// when the iterations say so: HierarchyReuse in solver_policy.h).
   bool recycle_factor = true;
   int recycle_iterations = 20;
   double recycle_tolerance = 1e-9;
@@ -80,6 +80,7 @@ struct FreeSystem {
 struct SolverStats {
   int preparations = 0;  ///< Cholesky factorisations, or multigrid setups
   int reuses = 0;        ///< solves through a factor or hierarchy built for an earlier matrix
+  int refreshes = 0;     ///< multigrid: Galerkin refreshes of a kept hierarchy's coarse matrices
   int iterations = 0;    ///< CG iterations of the last solve (worst load case); 0 if direct
 };
 

@@ -1,12 +1,12 @@
 // The iterative solver: CG preconditioned by our smoothed-aggregation multigrid (fem/amg.h) on
 // the system's K itself (full compressed rows with node blocks, as Elasticity assembles it: no
-// copy), warm-started from the previous solution. Between SIMP iterations the
-// hierarchy is kept (only its finest smoother refreshed) until the iteration count grows by
-// half (HierarchyReuse in solver_policy.h); a solve on a kept hierarchy that reaches that growth
-// is cut there, the coarse matrices are recomputed from the new matrix on the kept aggregates
-// (refresh_galerkin) and CG goes on. Cantilever, 63 k tets, 20 SIMP iterations: 6 setups and 431
-// CG iterations before, 1 setup, 9 coarse refreshes and ~460 CG iterations after, at about the
-// same CPU time (BENCHMARKS.md, speed targets).
+// copy), warm-started from the previous solution (each load case from its own). Between SIMP
+// iterations the hierarchy is kept and only its finest smoother refreshed; its coarse matrices are
+// recomputed from the new matrix on the kept aggregates (refresh_galerkin) when the iterations
+// the stale ones cost would soon outweigh a refresh, a solve that runs a refresh's cost past the
+// reference is cut there and finished on refreshed coarse matrices, and a new hierarchy is set up
+// when even refreshed coarse matrices need clearly more iterations than the setup's
+// (HierarchyReuse in solver_policy.h). Every solve meets the tolerance whichever happened.
 #include <algorithm>
 #include <sstream>
 
@@ -76,6 +76,7 @@ void MultigridSolver::update(const Progress& progress) {
     // a recent solve found the kept coarse levels stale: recompute them now (R A P on the kept
     // aggregates) rather than lose the patience's iterations on them first
     amg_.refresh_galerkin();
+    ++stats_.refreshes;
     kept_ = false;
     progress.info("multigrid kept, coarse matrices recomputed " + watch.lap());
   } else if (kept_) {
@@ -128,13 +129,12 @@ void MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const 
     PcgResult r = solve_one(b, x, progress);
     if (!r.converged && kept_) {
       // the kept coarse levels no longer fit this matrix: recompute them from it on the kept
-      // aggregates (R A P) and go on from where CG stopped. Cheaper than a setup, and as good
-      // for the next solves; the baseline stays the last setup's (a solve finished from a
-      // half-converged start is none)
+      // aggregates (R A P) and go on from where CG stopped. Cheaper than a setup; a solve
+      // finished from a half-converged start is no reference (not recorded)
       progress.info("multigrid CG slow with the kept hierarchy (" + std::to_string(r.iterations) +
                     " iterations); coarse matrices recomputed");
       amg_.refresh_galerkin();
-      reuse_.cut();
+      ++stats_.refreshes;
       kept_ = false;
       rebuilt = true;
       const int cut = r.iterations;
@@ -151,7 +151,10 @@ void MultigridSolver::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X, const 
     out.col(c) = x;
   }
   progress.info("multigrid CG: " + std::to_string(worst) + " iterations, " + watch.lap());
-  if (!rebuilt) reuse_.record(worst);
+  if (rebuilt)
+    reuse_.cut(worst);
+  else
+    reuse_.record(worst);
   stats_.iterations = worst;
   X = out;
 }

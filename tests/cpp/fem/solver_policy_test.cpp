@@ -24,49 +24,113 @@ TEST(FactorReuse, TwoSolvesFactoriseDirectlyAfterAFailedRecycling) {
   EXPECT_FALSE(r.factorise_before_solve());
 }
 
-TEST(HierarchyReuse, KeptUntilTheIterationsGrowByHalf) {
+TEST(HierarchyReuse, NewHierarchyWhenRefreshedCoarseMatricesOutgrowTheSetup) {
   HierarchyReuse r(true);
   EXPECT_FALSE(r.keep(false));  // nothing built yet
   r.set_up();
   r.record(10);  // the baseline
   EXPECT_TRUE(r.keep(true));
-  r.record(19);  // 1.5 * 10 + 4 = 19: not yet
+  r.cut();  // a kept solve cut short: the next matrix's coarse matrices are refreshed
+  ASSERT_TRUE(r.refresh_coarse_on_update());
+  r.record(19);  // on refreshed coarse matrices, 1.5 * 10 + 4 = 19: not yet
   EXPECT_TRUE(r.keep(true));
-  r.record(20);
+  r.cut();
+  ASSERT_TRUE(r.refresh_coarse_on_update());
+  r.record(20);  // the aggregates no longer fit: a new setup
   EXPECT_FALSE(r.keep(true));
   r.set_up();  // a new hierarchy, a new baseline
   EXPECT_TRUE(r.keep(true));
   r.record(30);
-  r.record(49);
-  EXPECT_TRUE(r.keep(true));
-  r.record(50);
-  EXPECT_FALSE(r.keep(true));
-}
-
-TEST(HierarchyReuse, PatienceIsTheGrowthThatWouldRebuild) {
-  HierarchyReuse r(true);
-  r.set_up();
-  EXPECT_EQ(r.patience(5000), 5000);  // no baseline yet: the solver's own cap
-  r.record(12);
-  EXPECT_EQ(r.patience(5000), 22);  // 1.5 * 12 + 4
-  EXPECT_EQ(r.patience(15), 15);    // never above the solver's cap
-  r.record(22);                     // a solve that used all its patience does not count as grown
-  EXPECT_TRUE(r.keep(true));
-  r.set_up();
-  EXPECT_EQ(r.patience(5000), 5000);
-}
-
-TEST(HierarchyReuse, CoarseLevelsRecomputedUpFrontForTwoMatricesAfterACut) {
-  HierarchyReuse r(true);
-  r.set_up();
-  r.record(12);
-  EXPECT_FALSE(r.refresh_coarse_on_update());  // no cut yet: the finest level only
-  r.cut();
-  for (int k = 0; k < HierarchyReuse::kRefreshAfterCut; ++k) EXPECT_TRUE(r.refresh_coarse_on_update()) << k;
-  EXPECT_FALSE(r.refresh_coarse_on_update());  // then the finest only again, until the next cut
-  r.cut();
-  r.set_up();  // a new hierarchy fits its matrix: nothing to recompute
   EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(60);  // a kept solve, however slow, says nothing of the aggregates
+  EXPECT_TRUE(r.keep(true));
+}
+
+TEST(HierarchyReuse, CoarseMatricesRefreshedWhenTheExcessWouldReachARefreshsCost) {
+  const int cost = HierarchyReuse::kRefreshCost;
+  HierarchyReuse r(true);
+  r.set_up();
+  r.record(12);  // baseline and reference
+  // kept solves 2, 3, then 4 beyond the reference: refreshed once the excess so far plus one more
+  // solve like the last reaches the cost, not before
+  int excess = 0, last = 0, kept = 0;
+  for (int extra = 2;; ++extra) {
+    const bool refresh = r.refresh_coarse_on_update();
+    EXPECT_EQ(refresh, excess + last >= cost) << extra;
+    if (refresh) break;
+    r.record(12 + extra);
+    excess += extra;
+    last = extra;
+    ++kept;
+  }
+  EXPECT_GE(kept, 3);  // at 14: 2 + 3 + 4 + 5 kept, then 14 + 5 ahead: the refresh
+  // the refreshed solve is the new reference: a kept solve of its count adds nothing
+  r.record(15);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(15);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(14);  // fewer than the reference: no negative excess
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  // one kept solve half a refresh's cost past it: the next one like it would reach the cost
+  r.record(15 + (cost + 1) / 2);
+  EXPECT_TRUE(r.refresh_coarse_on_update());
+  EXPECT_TRUE(r.keep(true));  // refreshed, not rebuilt
+}
+
+TEST(HierarchyReuse, PatienceIsTheReferencePlusARefreshsCost) {
+  HierarchyReuse r(true);
+  r.set_up();
+  EXPECT_EQ(r.patience(5000), 5000);  // coarse matrices that fit: the solver's own cap
+  r.record(12);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  EXPECT_EQ(r.patience(5000), 12 + HierarchyReuse::kRefreshCost);
+  EXPECT_EQ(r.patience(15), 15);  // never above the solver's cap
+  r.cut();
+  EXPECT_TRUE(r.refresh_coarse_on_update());
+  EXPECT_EQ(r.patience(5000), 5000);  // refreshed for this matrix
+  r.record(9);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  EXPECT_EQ(r.patience(5000), 9 + HierarchyReuse::kRefreshCost);
+}
+
+TEST(HierarchyReuse, WhileOneMatrixsStalenessCostsARefreshEveryMatrixIsRefreshed) {
+  const int cost = HierarchyReuse::kRefreshCost;
+  HierarchyReuse r(true);
+  r.set_up();
+  r.record(12);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.cut(12 + 3 * cost);  // one matrix on the kept coarse matrices cost three refreshes
+  int refreshed = 0;
+  while (r.refresh_coarse_on_update()) {
+    r.record(12);  // each refreshed solve as fast as the reference
+    ++refreshed;
+    ASSERT_LT(refreshed, 10);
+  }
+  // refreshed for the matrices after the cut, not for ever: the remembered staleness fades and a
+  // kept solve is tried again
+  EXPECT_GE(refreshed, 3);
+  EXPECT_EQ(r.patience(5000), 12 + cost);
+  r.cut();  // and it is as slow: refreshed again
+  EXPECT_TRUE(r.refresh_coarse_on_update());
+}
+
+TEST(HierarchyReuse, ATolerancesChangeTakesANewBaselineOnTheHierarchyAsItIs) {
+  HierarchyReuse r(true);
+  r.set_up();
+  r.record(10);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(20);  // kept, 10 beyond the reference
+  r.rebaseline();  // counts at the old tolerance say nothing now
+  EXPECT_FALSE(r.refresh_coarse_on_update());  // their excess is forgotten, nothing forced
+  EXPECT_EQ(r.patience(5000), 5000);           // no reference at this tolerance yet
+  r.record(25);  // the new baseline and reference: more iterations at a tighter tolerance are not growth
+  EXPECT_TRUE(r.keep(true));
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  EXPECT_EQ(r.patience(5000), 25 + HierarchyReuse::kRefreshCost);
+  r.cut();
+  EXPECT_TRUE(r.refresh_coarse_on_update());
+  r.record(static_cast<int>(1.5 * 25) + 4 + 1);  // refreshed, against the new baseline: grown
+  EXPECT_FALSE(r.keep(true));
 }
 
 TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
