@@ -21,9 +21,9 @@
 #include <TopoDS.hxx>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "common/error.h"
+#include "common/number_text.h"
 
 namespace topopt::brep {
 
@@ -126,12 +126,7 @@ double common_volume(const TopoDS_Shape& a, const TopoDS_Shape& b) {
   }
 }
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string fmt(double x) { return number_text(x, 4); }
 
 }  // namespace
 

@@ -21,9 +21,9 @@
 #include <algorithm>
 #include <cmath>
 #include <gp_Pln.hxx>
-#include <sstream>
 
 #include "common/error.h"
+#include "common/number_text.h"
 
 namespace topopt::brep {
 namespace {
@@ -31,13 +31,6 @@ namespace {
 constexpr int kSamples = 5;
 
 bool finite(const gp_Pnt& p) { return std::isfinite(p.X()) && std::isfinite(p.Y()) && std::isfinite(p.Z()); }
-
-std::string mm(double d) {
-  std::ostringstream s;
-  s.precision(3);
-  s << d << " mm";
-  return s.str();
-}
 
 /// What a check found wrong, with the label and the advice around it.
 struct Damage {
@@ -125,8 +118,8 @@ void check_edge_on_face(const TopoDS_Edge& edge, int e, const Handle(Geom_Surfac
   if (!std::isfinite(d))
     damaged(name + " is not on Face" + std::to_string(f) + ", which it bounds (its distance is not a finite number)");
   if (d > allowed)
-    damaged(name + " lies " + mm(d) + " away from Face" + std::to_string(f) +
-            ", which it bounds (allowed: " + mm(allowed) + ")");
+    damaged(name + " lies " + mm_text(d) + " away from Face" + std::to_string(f) +
+            ", which it bounds (allowed: " + mm_text(allowed) + ")");
 }
 
 }  // namespace

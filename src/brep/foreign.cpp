@@ -19,6 +19,7 @@
 
 #include "brep/occt_guard.h"
 #include "common/error.h"
+#include "common/number_text.h"
 #include "common/isolate.h"
 
 namespace topopt::brep {
@@ -26,12 +27,7 @@ namespace {
 
 constexpr double kMB = 1024.0 * 1024.0;
 
-std::string seconds_text(double s) {
-  std::ostringstream out;
-  out.precision(3);
-  out << s << " s";
-  return out.str();
-}
+std::string seconds_text(double s) { return number_text(s, 3) + " s"; }
 
 /// Address space in use now (bytes), from /proc/self/statm; 0 if unknown.
 double address_space_now() {

@@ -2,9 +2,9 @@
 #include "pipeline/mesh_settings.h"
 
 #include <cmath>
-#include <sstream>
 
 #include "common/error.h"
+#include "common/number_text.h"
 #include "pipeline/problem_checks.h"
 
 namespace topopt::pipeline {
@@ -13,12 +13,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 /// A length as a user reads it: 4 significant digits.
-std::string mm(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v << " mm";
-  return s.str();
-}
+std::string mm(double v) { return mm_text(v, 4); }
 
 }  // namespace
 

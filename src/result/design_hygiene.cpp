@@ -11,6 +11,7 @@
 
 #include "common/adjacency.h"
 #include "common/face_key.h"
+#include "common/number_text.h"
 #include "common/triangle_closest.h"
 #include "result/iso_surface.h"
 #include "result/join_bridges.h"
@@ -36,12 +37,7 @@ struct Groups {
 
 Point node(const TetMesh& mesh, int v) { return mesh.V.row(v).transpose(); }
 
-std::string mm3(double v) {
-  std::ostringstream s;
-  s.precision(v < 10 ? 2 : 4);
-  s << v << " mm³";
-  return s.str();
-}
+std::string mm3(double v) { return amount_text(v, " mm³"); }
 
 /// Volume, non-design solids, anchoring and centre of each labelled piece of the result shape
 /// (labels: level_components at `threshold` of the node densities nd).

@@ -7,8 +7,8 @@
 #include <map>
 #include <queue>
 #include <set>
-#include <sstream>
 
+#include "common/number_text.h"
 #include "common/triangle_closest.h"
 #include "result/iso_surface.h"
 
@@ -291,12 +291,6 @@ double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, doub
   return added + fill_notches(mesh, inner, threshold, kNotchRounds, density);
 }
 
-std::string mm(double v, const char* unit) {
-  std::ostringstream s;
-  s.precision(v < 10 ? 2 : 4);
-  s << v << unit;
-  return s.str();
-}
 
 }  // namespace
 
@@ -379,8 +373,8 @@ VecXd join_non_design_solids(const TetMesh& mesh, const MatX4i& neighbours, cons
 std::string bridge_warning(const Bridge& bridge) {
   const std::string it = bridge.nondesign.size() > 1 ? "them" : "it";
   return "joined " + solids_named(bridge.nondesign) + " to the part with a bridge through the design (" +
-         mm(bridge.volume, " mm³") + " of material added, " + mm(bridge.length, " mm") + " long, " +
-         mm(bridge.size, " mm") + " across): the design left " + it +
+         amount_text(bridge.volume, " mm³") + " of material added, " + amount_text(bridge.length, " mm") + " long, " +
+         amount_text(bridge.size, " mm") + " across): the design left " + it +
          " apart from the supports and loads; \"result\": "
          "{\"join_non_design\": false} leaves " +
          it + " apart instead";

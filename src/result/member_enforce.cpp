@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "common/number_text.h"
 #include "mesh/core/spatial_grid.h"
 #include "result/design_hygiene.h"
 #include "result/iso_surface.h"
@@ -91,12 +92,7 @@ long thicken(const TetMesh& mesh, const Centres& index, const std::vector<std::p
   return added;
 }
 
-std::string mm(double v, int precision = 3) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
+std::string mm(double v, int precision = 3) { return number_text(v, precision); }
 
 }  // namespace
 

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <cstring>
 #include <set>
-#include <sstream>
 
 #include <unordered_map>
 
 #include "common/cpu_time.h"
 #include "common/error.h"
+#include "common/number_text.h"
 #include "common/isolate.h"
 #include "fem/elasticity.h"
 #include "fem/kept_part.h"
@@ -21,12 +21,7 @@ namespace topopt::result {
 namespace {
 
 /// v with 4 significant digits ("311.9", "1.234e+05"), as the other messages print figures.
-std::string four_digits(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
+std::string four_digits(double v) { return number_text(v, 4); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "common/error.h"
+#include "common/number_text.h"
 
 namespace topopt::simp {
 namespace {
@@ -94,12 +95,7 @@ Eigen::Vector3d unit(const Eigen::Vector3d& v, const std::string& what) {
   return v / n;
 }
 
-std::string percent(double share) {
-  std::ostringstream s;
-  s.precision(3);
-  s << 100 * share << " %";
-  return s.str();
-}
+std::string percent(double share) { return number_text(100 * share, 3) + " %"; }
 
 /// A mirror plane or cyclic axis must map most of the design domain onto itself.
 void require_symmetry(double share, const std::string& what) {

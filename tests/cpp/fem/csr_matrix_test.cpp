@@ -10,6 +10,8 @@
 #include <random>
 #include <utility>
 
+#include "fem/dense_of.h"
+
 namespace topopt::fem {
 namespace {
 
@@ -35,13 +37,6 @@ CsrMatrix random_blocked(int rows, int cols, int block, unsigned seed) {
   }
   M.blocks.push_back(rows);
   return M;
-}
-
-Eigen::MatrixXd dense(const CsrMatrix& M) {
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(M.rows, M.cols);
-  for (int i = 0; i < M.rows; ++i)
-    for (int k = M.ptr[i]; k < M.ptr[i + 1]; ++k) D(i, M.col[k]) += M.val[k];
-  return D;
 }
 
 TEST(CsrMatrix, ProductsEqualDenseArithmetic) {

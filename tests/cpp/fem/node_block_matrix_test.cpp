@@ -10,6 +10,8 @@
 #include <random>
 #include <utility>
 
+#include "fem/dense_of.h"
+
 namespace topopt::fem {
 namespace {
 
@@ -35,13 +37,6 @@ CsrMatrix node_matrix(int nodes, const std::vector<int>& sizes, unsigned seed) {
     }
   }
   return M;
-}
-
-Eigen::MatrixXd dense(const CsrMatrix& M) {
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(M.rows, M.cols);
-  for (int i = 0; i < M.rows; ++i)
-    for (int k = M.ptr[i]; k < M.ptr[i + 1]; ++k) D(i, M.col[k]) += M.val[k];
-  return D;
 }
 
 void expect_row_walk_sums(const CsrMatrix& M, bool padded) {
