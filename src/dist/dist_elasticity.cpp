@@ -360,8 +360,8 @@ Eigen::MatrixXd DistElasticity::solve(const Eigen::MatrixXd& loads) {
 void DistElasticity::set_tolerance(double tolerance) {
   Impl& m = *impl_;
   if (tolerance == m.params.tolerance) return;
-  m.params.tolerance = tolerance;
-  m.reuse.rebaseline();  // iteration counts at another tolerance say nothing of a stale preconditioner
+  m.reuse.rebaseline(m.params.tolerance, tolerance);
+  m.params.tolerance = tolerance;  // iteration counts at another tolerance say nothing of a stale preconditioner
   check_petsc(KSPSetTolerances(m.ksp, tolerance, 1e-300, 1e300, m.params.max_iterations), "KSPSetTolerances");
 }
 

@@ -32,7 +32,7 @@ struct SimpCore {
   double tol_change = 0.01;
   double tol_objective = 1e-4;
   fem::SolverParams solver;
-  double early_solver_tolerance = 1e-3;
+  double early_solver_tolerance = 1e-2;
 
   static SimpCore of(const simp::SimpParams& p) {
     return {p.volume_fraction, p.law,           p.filter, p.sensitivity_filter,

@@ -50,8 +50,8 @@ class MultigridSolver final : public LinearSolver {
   SolverStats stats() const override { return stats_; }
   void set_tolerance(double tolerance) override {
     if (tolerance == params_.tolerance) return;
-    params_.tolerance = tolerance;
-    reuse_.rebaseline();  // iteration counts at another tolerance say nothing of a stale hierarchy
+    reuse_.rebaseline(params_.tolerance, tolerance);
+    params_.tolerance = tolerance;  // iteration counts at another tolerance say nothing of a stale hierarchy
   }
 
  private:

@@ -4,6 +4,7 @@
 // still pays and rebuilt when it stops paying.
 #pragma once
 #include <algorithm>
+#include <cmath>
 
 namespace topopt::fem {
 
@@ -73,13 +74,22 @@ class HierarchyReuse {
     grown_ = false;
     baseline_ = reference_ = -1;
     excess_ = last_ = 0;
+    expected_ = -1.0;
     fresh_ = true;
   }
 
-  /// The tolerance changed: counts at the old tolerance say nothing at the new one. The next
-  /// solve is the new baseline and reference, on the hierarchy as it is (a refresh forced here
-  /// cost the cantilever's β = 32 phase refreshes the kept hierarchy did without).
-  void rebaseline() {
+  /// The tolerance changed from `from` to `to` (relative residuals in (0, 1)): the counts at the
+  /// old tolerance are not those at the new one. The next solve is the new baseline and
+  /// reference, on the hierarchy as it is (a refresh forced here cost the cantilever's β = 32
+  /// phase refreshes the kept hierarchy did without) — unless it needs clearly more than the
+  /// current baseline scaled to the new tolerance (CG's iterations grow as log(1 / tolerance):
+  /// a baseline of 9 at 1e-2 expects 22.5 at 1e-5): then the aggregates no longer fit the
+  /// design and the next matrix gets a new hierarchy. Without the scaled test the rocker, solved
+  /// at 1e-2 below its final β, ran the whole β = 32 phase on the uniform start's aggregates:
+  /// its first solve at 1e-5 (53 iterations) became the baseline, so nothing ever outgrew it.
+  void rebaseline(double from, double to) {
+    const bool scalable = baseline_ > 0 && from > 0 && from < 1 && to > 0 && to < 1;
+    expected_ = scalable ? baseline_ * std::log(to) / std::log(from) : -1.0;
     baseline_ = reference_ = -1;
     excess_ = last_ = 0;
   }
@@ -121,10 +131,13 @@ class HierarchyReuse {
   /// cut and finished on refreshed coarse matrices.
   void record(int iterations) {
     if (fresh_ || reference_ < 0) {
-      if (baseline_ < 0)
+      if (baseline_ < 0) {
         baseline_ = iterations;
-      else if (iterations > limit())
+        if (expected_ > 0 && iterations > limit(expected_)) grown_ = true;  // the first at a new tolerance
+        expected_ = -1.0;
+      } else if (iterations > limit(baseline_)) {
         grown_ = true;
+      }
       reference_ = iterations;
       excess_ = 0;
     } else if (reference_ >= 0) {
@@ -143,8 +156,8 @@ class HierarchyReuse {
   }
 
  private:
-  /// Clearly more iterations than the baseline: 1.5 times as many, plus 4.
-  int limit() const { return static_cast<int>(1.5 * baseline_) + 4; }
+  /// Clearly more iterations than `baseline`: 1.5 times as many, plus 4.
+  static int limit(double baseline) { return static_cast<int>(1.5 * baseline) + 4; }
 
   bool allowed_;
   bool grown_ = false;
@@ -153,6 +166,7 @@ class HierarchyReuse {
   int reference_ = -1;  // iterations of the first solve after the last setup or refresh
   int excess_ = 0;      // iterations beyond the reference of the kept solves since then
   int last_ = 0;        // the last kept solve's iterations beyond the reference
+  double expected_ = -1.0;  // after a tolerance change, the old baseline scaled to the new tolerance
 };
 
 }  // namespace topopt::fem

@@ -120,7 +120,7 @@ TEST(HierarchyReuse, ATolerancesChangeTakesANewBaselineOnTheHierarchyAsItIs) {
   r.record(10);
   EXPECT_FALSE(r.refresh_coarse_on_update());
   r.record(20);  // kept, 10 beyond the reference
-  r.rebaseline();  // counts at the old tolerance say nothing now
+  r.rebaseline(1e-3, 1e-5);  // counts at the old tolerance are not those at the new one
   EXPECT_FALSE(r.refresh_coarse_on_update());  // their excess is forgotten, nothing forced
   EXPECT_EQ(r.patience(5000), 5000);           // no reference at this tolerance yet
   r.record(25);  // the new baseline and reference: more iterations at a tighter tolerance are not growth
@@ -131,6 +131,56 @@ TEST(HierarchyReuse, ATolerancesChangeTakesANewBaselineOnTheHierarchyAsItIs) {
   EXPECT_TRUE(r.refresh_coarse_on_update());
   r.record(static_cast<int>(1.5 * 25) + 4 + 1);  // refreshed, against the new baseline: grown
   EXPECT_FALSE(r.keep(true));
+}
+
+TEST(HierarchyReuse, AFirstSolveAtANewToleranceFarPastTheScaledBaselineSetsUpAnew) {
+  // the setup's first solve took 9 iterations at 1e-2: at 1e-5, log(1e-5) / log(1e-2) = 2.5 times
+  // as many are expected (22.5), and clearly more is 1.5 * 22.5 + 4 = 37
+  const auto first_at_new_tolerance = [](int iterations) {
+    HierarchyReuse r(true);
+    r.set_up();
+    r.record(9);
+    EXPECT_FALSE(r.refresh_coarse_on_update());
+    r.record(12);  // a kept solve at the old tolerance
+    r.rebaseline(1e-2, 1e-5);
+    EXPECT_FALSE(r.refresh_coarse_on_update());  // nothing forced: the hierarchy as it is
+    EXPECT_EQ(r.patience(5000), 5000);           // no reference at this tolerance yet
+    r.record(iterations);
+    return r.keep(true);
+  };
+  EXPECT_TRUE(first_at_new_tolerance(22));  // as the tolerance alone explains
+  EXPECT_TRUE(first_at_new_tolerance(37));  // not clearly more
+  EXPECT_FALSE(first_at_new_tolerance(38));
+  EXPECT_FALSE(first_at_new_tolerance(53));  // the rocker's β = 32 on the uniform start's aggregates
+
+  // only the first solve at the new tolerance is judged so: a later kept solve is no growth
+  HierarchyReuse r(true);
+  r.set_up();
+  r.record(9);
+  r.rebaseline(1e-2, 1e-5);
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(30);  // the new baseline, within 37
+  EXPECT_FALSE(r.refresh_coarse_on_update());
+  r.record(40);  // kept, stale coarse matrices: an excess, not growth
+  EXPECT_TRUE(r.keep(true));
+
+  // a looser tolerance lowers the expectation (40 at 1e-5: 16 at 1e-2, clearly more is 28)
+  HierarchyReuse loose(true);
+  loose.set_up();
+  loose.record(40);
+  loose.rebaseline(1e-5, 1e-2);
+  EXPECT_FALSE(loose.refresh_coarse_on_update());
+  loose.record(29);
+  EXPECT_FALSE(loose.keep(true));
+
+  // a new setup forgets the expectation: its first solve is the baseline whatever its count
+  HierarchyReuse fresh(true);
+  fresh.set_up();
+  fresh.record(9);
+  fresh.rebaseline(1e-2, 1e-5);
+  fresh.set_up();
+  fresh.record(60);
+  EXPECT_TRUE(fresh.keep(true));
 }
 
 TEST(HierarchyReuse, NeverKeptWhenReuseIsOff) {
