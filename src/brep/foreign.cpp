@@ -19,8 +19,8 @@
 
 #include "brep/occt_guard.h"
 #include "common/error.h"
-#include "common/number_text.h"
 #include "common/isolate.h"
+#include "common/number_text.h"
 
 namespace topopt::brep {
 namespace {

@@ -291,7 +291,6 @@ double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, doub
   return added + fill_notches(mesh, inner, threshold, kNotchRounds, density);
 }
 
-
 }  // namespace
 
 double bridge_penalty(double rho) { return 1 + (kVoidPenalty - 1) * (1 - std::clamp(rho, 0.0, 1.0)); }

@@ -11,8 +11,8 @@
 
 #include "common/cpu_time.h"
 #include "common/error.h"
-#include "common/number_text.h"
 #include "common/isolate.h"
+#include "common/number_text.h"
 #include "fem/elasticity.h"
 #include "fem/kept_part.h"
 #include "result/design_hygiene.h"

@@ -121,7 +121,8 @@ TEST(NodeBlockMatrix, MatricesTheBlocksDoNotFitAreRefused) {
   EXPECT_TRUE(p.empty());
   EXPECT_FALSE(p.build(node_matrix(200, {1}, 5)));  // a scalar problem: 9 values stored for 1
   CsrMatrix unsorted = M;                           // a row's columns not increasing
-  for (int i = 0; i < unsorted.rows; ++i) std::reverse(&unsorted.col[unsorted.ptr[i]], &unsorted.col[unsorted.ptr[i + 1]]);
+  for (int i = 0; i < unsorted.rows; ++i)
+    std::reverse(&unsorted.col[unsorted.ptr[i]], &unsorted.col[unsorted.ptr[i + 1]]);
   EXPECT_FALSE(p.build(unsorted));
   CsrMatrix no_blocks = M;
   no_blocks.blocks.clear();

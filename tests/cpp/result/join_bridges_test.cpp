@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mesh/core/structured_box.h"
@@ -44,22 +45,30 @@ bool in(const Eigen::Vector3d& c, std::array<double, 6> b) {
   return c[0] > b[0] && c[1] > b[1] && c[2] > b[2] && c[0] < b[3] && c[1] < b[4] && c[2] < b[5];
 }
 
-PadFixture pad_fixture(double background = 0.02, double grey = -1) {
+/// A box of 1 mm cells with the given non-design boxes: the non-design tets at density 1, the
+/// design's given by `density` of the tet's centroid; no anchors yet.
+template <class Density>
+PadFixture box_fixture(std::array<double, 3> size, std::vector<std::array<double, 6>> nondesign,
+                       const Density& density) {
   mesh::StructuredBoxParams p;
-  p.size = {24, 12, 12};
-  p.cells = {24, 12, 12};
-  p.nondesign = {{0, 3, 0, 3, 9, 6}, {21, 3, 0, 24, 9, 6}, {10, 3, 9, 18, 9, 12}};
+  p.size = size;
+  for (int a = 0; a < 3; ++a) p.cells[a] = static_cast<int>(size[a]);
+  p.nondesign = std::move(nondesign);
   PadFixture f;
   f.mesh = mesh::structured_box_mesh(p);
   const MatX3d c = simp::tet_centroids(f.mesh);
   f.density.resize(f.mesh.T.rows());
-  for (long t = 0; t < f.mesh.T.rows(); ++t) {
-    const Eigen::Vector3d x = c.row(t).transpose();
-    f.density[t] = f.mesh.domain[t] != 0 || in(x, {0, 4, 1, 24, 8, 5}) ? 1.0
-                   : grey >= 0 && in(x, {16, 3, 5, 18, 9, 9})          ? grey
-                                                                       : background;
-  }
+  for (long t = 0; t < f.mesh.T.rows(); ++t)
+    f.density[t] = f.mesh.domain[t] != 0 ? 1.0 : density(Eigen::Vector3d(c.row(t).transpose()));
   f.anchors.assign(f.mesh.V.rows(), 0);
+  return f;
+}
+
+PadFixture pad_fixture(double background = 0.02, double grey = -1) {
+  PadFixture f = box_fixture(
+      {24, 12, 12}, {{0, 3, 0, 3, 9, 6}, {21, 3, 0, 24, 9, 6}, {10, 3, 9, 18, 9, 12}}, [&](const Eigen::Vector3d& x) {
+        return in(x, {0, 4, 1, 24, 8, 5}) ? 1.0 : grey >= 0 && in(x, {16, 3, 5, 18, 9, 9}) ? grey : background;
+      });
   for (long v = 0; v < f.mesh.V.rows(); ++v) {
     const Eigen::Vector3d x = f.mesh.V.row(v).transpose();
     if (x[0] < 1e-9) f.anchors[v] |= kAnchorSupport;
@@ -270,22 +279,12 @@ bool under_slab(const Eigen::Vector3d& c) { return c[1] > 8 && c[1] < 10 && c[2]
 /// 4 + 2 (y − 8) to 8 + 2 (y − 8): its underside rises at 63°, it prints). A grey strip (0.49,
 /// below the threshold) from the wall to the column at z 16..19 is the bridge's cheapest way.
 PadFixture slab_fixture() {
-  mesh::StructuredBoxParams p;
-  p.size = {24, 16, 22};
-  p.cells = {24, 16, 22};
-  p.nondesign = {{0, 4, 0, 3, 8, 20}, {21, 4, 0, 24, 8, 20}, {10, 14, 0, 16, 16, 20}};
-  PadFixture f;
-  f.mesh = mesh::structured_box_mesh(p);
-  const MatX3d c = simp::tet_centroids(f.mesh);
-  f.density.resize(f.mesh.T.rows());
-  for (long t = 0; t < f.mesh.T.rows(); ++t) {
-    const Eigen::Vector3d x = c.row(t).transpose();
-    const bool slab = x[0] > 8 && x[0] < 18 && x[1] > 8 && x[1] < 10 && !under_slab(x) && x[2] < 8 + 2 * (x[1] - 8);
-    f.density[t] = f.mesh.domain[t] != 0 || in(x, {0, 4, 0, 24, 8, 20}) || slab ? 1.0
-                   : in(x, {12, 8, 16, 14, 14, 19})                            ? 0.49
-                                                                               : 0.02;
-  }
-  f.anchors.assign(f.mesh.V.rows(), 0);
+  PadFixture f = box_fixture(
+      {24, 16, 22}, {{0, 4, 0, 3, 8, 20}, {21, 4, 0, 24, 8, 20}, {10, 14, 0, 16, 16, 20}},
+      [](const Eigen::Vector3d& x) {
+        const bool slab = x[0] > 8 && x[0] < 18 && x[1] > 8 && x[1] < 10 && !under_slab(x) && x[2] < 8 + 2 * (x[1] - 8);
+        return in(x, {0, 4, 0, 24, 8, 20}) || slab ? 1.0 : in(x, {12, 8, 16, 14, 14, 19}) ? 0.49 : 0.02;
+      });
   for (long v = 0; v < f.mesh.V.rows(); ++v) {
     const Eigen::Vector3d x = f.mesh.V.row(v).transpose();
     const bool end = x[1] > 4 - 1e-9 && x[1] < 8 + 1e-9 && x[2] < 20 + 1e-9;
