@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/number_text.h"
 #include "fem/boundary_conditions.h"
 #include "io/stl.h"
 #include "io/vtu.h"
@@ -186,7 +187,7 @@ double hold_carried_tets(const TetMesh& mesh, const simp::OverhangControl& o, co
   }
   progress.info("overhang: " + std::to_string(count) +
                 " design tets under the non-design solids' downward faces held solid (" +
-                std::to_string(100 * taken / design).substr(0, 4) +
+                number_text(100 * taken / design, 3) +
                 " % of the design volume, counted in the volume fraction) so that the design carries those faces");
   return design > 0 ? taken / design : 0.0;
 }
@@ -201,7 +202,7 @@ double simp_volume_fraction(double volume_fraction, double loaded, double carrie
   if (!(rest > 0))
     throw Error(ErrorCode::InvalidParameter,
                 "controls.overhang: the design under the non-design solids' downward faces (" +
-                    std::to_string(100 * carried).substr(0, 4) + " % of the design domain) takes the whole volume "
+                    number_text(100 * carried, 3) + " % of the design domain) takes the whole volume "
                     "fraction: raise optimization.volume_fraction or choose a build direction under which those "
                     "faces do not face down");
   return rest;

@@ -74,10 +74,6 @@ bool under(const Eigen::Vector3d& c, const Eigen::Vector3d& a, const Eigen::Vect
          (a - e).cross(p - e).dot(n) / nn >= tol;
 }
 
-}  // namespace
-
-namespace {
-
 /// The carried faces and their outline (their edges that only one of them has), and the funnel
 /// under them: a point at height h below the nearest carried face above it, inset by `inset`
 /// across the build direction from the outline, lies in it when inset >= h / slope.
