@@ -4,12 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <queue>
 #include <set>
 
 #include "common/number_text.h"
 #include "common/triangle_closest.h"
+#include "mesh/core/spatial_grid.h"
 #include "result/iso_surface.h"
 
 namespace topopt::result {
@@ -222,27 +222,27 @@ double fill_notches(const TetMesh& mesh, const std::vector<char>& inner, double 
   return added;
 }
 
-/// Some of the mesh's nodes bucketed in cubes of side `cell` (keyed by integer cube
-/// coordinates), to find those within `cell` of a point.
-struct NodeGrid {
-  double cell = 1;
-  std::map<std::array<long, 3>, std::vector<long>> buckets;
-  std::array<long, 3> key(const Point& x) const {
-    return {static_cast<long>(std::floor(x[0] / cell)), static_cast<long>(std::floor(x[1] / cell)),
-            static_cast<long>(std::floor(x[2] / cell))};
+/// The nodes flagged in `keep` (#V) in the product's spatial grid (mesh/core/spatial_grid.h), cells
+/// of `radius`, to visit those within `radius` of a point.
+struct NodeBalls {
+  const TetMesh& mesh;
+  double radius;
+  mesh::SpatialGrid<3> grid;
+  NodeBalls(const TetMesh& m, const std::vector<char>& keep, double r)
+      : mesh(m), radius(r), grid(Point(m.V.colwise().minCoeff()).data(), r) {
+    for (long v = 0; v < m.V.rows(); ++v)
+      if (keep[v]) {
+        const Point x = m.V.row(v).transpose();
+        grid.insert(static_cast<int>(v), x.data(), x.data());
+      }
   }
-  /// Calls f(u) for every bucketed node u within `cell` of x.
+  /// Calls f(u) for every kept node u within `radius` of x.
   template <class F>
-  void around(const TetMesh& mesh, const Point& x, F&& f) const {
-    const std::array<long, 3> k = key(x);
-    for (long i = -1; i <= 1; ++i)
-      for (long j = -1; j <= 1; ++j)
-        for (long l = -1; l <= 1; ++l) {
-          const auto it = buckets.find({k[0] + i, k[1] + j, k[2] + l});
-          if (it == buckets.end()) continue;
-          for (long u : it->second)
-            if ((mesh.V.row(u).transpose() - x).norm() <= cell) f(u);
-        }
+  void around(const Point& x, F&& f) const {
+    const Point lo = x.array() - radius, hi = x.array() + radius;
+    grid.for_each(lo.data(), hi.data(), [&](int u) {
+      if ((mesh.V.row(u).transpose() - x).norm() <= radius) f(static_cast<long>(u));
+    });
   }
 };
 
@@ -260,14 +260,11 @@ double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, doub
   const std::vector<char> solid = solid_nodes(mesh, density, threshold);
   const std::vector<char> inner = nodes_near(mesh, axis, reach);               // may close
   const std::vector<char> outer = nodes_near(mesh, axis, reach + 2 * radius);  // what decides
-  NodeGrid grid;
-  grid.cell = radius;
-  for (long v = 0; v < nv; ++v)
-    if (outer[v]) grid.buckets[grid.key(mesh.V.row(v).transpose())].push_back(v);
+  const NodeBalls grid(mesh, outer, radius);
   std::vector<char> dilated(nv, 0);
   for (long v = 0; v < nv; ++v) {
     if (!outer[v]) continue;
-    grid.around(mesh, mesh.V.row(v).transpose(), [&](long u) { dilated[v] |= solid[u]; });
+    grid.around(mesh.V.row(v).transpose(), [&](long u) { dilated[v] |= solid[u]; });
   }
   std::vector<char> closed(nv, 0);
   for (long v = 0; v < nv; ++v) {
@@ -276,7 +273,7 @@ double close_junctions(const TetMesh& mesh, const std::vector<Point>& axis, doub
       continue;
     }
     bool all = true;
-    grid.around(mesh, mesh.V.row(v).transpose(), [&](long u) { all = all && dilated[u]; });
+    grid.around(mesh.V.row(v).transpose(), [&](long u) { all = all && dilated[u]; });
     closed[v] = all;
   }
   double added = 0;
