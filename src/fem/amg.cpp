@@ -28,6 +28,12 @@ struct Level {
   CsrMatrix P, R;              // to/from the next coarser level
   // single-precision copies of A, P, R's values: what the V-cycle reads (see sparse_product)
   std::vector<float> Af, Pf, Rf;
+  // P and R in blocks of a node's rows by an aggregate's coarse dofs where they fit (the finest
+  // level of an elasticity hierarchy), then the V-cycle's transfers read Pbf and Rbf (single
+  // precision, the same sums as the row walks on Pf and Rf) and Pf, Rf stay empty
+  ProlongatorBlocks pb;
+  RestrictionBlocks rb;
+  std::vector<float> Pbf, Rbf;
   // A in 3×3 node blocks where it fits (the finest level of an elasticity hierarchy: K), then
   // the products with A read these instead of A and Af: Abf in the V-cycle, Abd (A's values to
   // the bit) in the power iteration and multiply_finest
@@ -37,7 +43,7 @@ struct Level {
   bool p_by_blocks = false;  // P's row blocks are nb's, their rows sharing columns: A P from the blocks
   // work vectors of the V-cycle (apply() is logically const): right-hand side, solution,
   // residual, Chebyshev correction, scratch product
-  mutable std::vector<double> b, x, r, d, q, xpad;
+  mutable std::vector<double> b, x, r, d, q, xpad, tpad;  // tpad: the transfers' padded x
 };
 
 /// The node of each row: rows node_ptr[k] .. node_ptr[k+1]-1 belong to node k.
@@ -274,6 +280,13 @@ struct SmoothedAggregationAmg::Impl {
   void single_product(const Level& L, const double* x, double* y) const;
   /// y = A x on level L with A's values (the same to the bit as L.A->multiply).
   void exact_product(const Level& L, const double* x, double* y) const;
+  /// The single-precision copies of L.P and L.R the V-cycle reads: in blocks where they fit
+  /// (fine_nodes: the offsets of L's node blocks, coarse_nodes: the aggregates' coarse dofs), else
+  /// row-wise. P and R are kept for the hierarchy's life, so once per setup.
+  static void copy_transfers(Level& L, const std::vector<int>& fine_nodes, const std::vector<int>& coarse_nodes);
+  /// y = R r (restriction to the next level) and y = P x (prolongation from it), single precision.
+  void restrict_to(const Level& L, const double* r, double* y) const;
+  void prolong_from(const Level& L, const double* x, double* y) const;
   void smooth(const Level& L, const double* b, double* x, bool zero_start) const;
   void cycle(size_t l) const;
 };
@@ -283,8 +296,7 @@ void SmoothedAggregationAmg::Impl::copy_values(Level& L) {
     to_single(*L.A, L.Af);
     return;
   }
-  L.nb.fill(*L.A, L.Abd);
-  L.Abf.assign(L.Abd.begin(), L.Abd.end());  // a contiguous copy: cheaper than a second fill's walk
+  L.nb.fill(*L.A, L.Abd, L.Abf);
 }
 
 void SmoothedAggregationAmg::Impl::single_product(const Level& L, const double* x, double* y) const {
@@ -299,6 +311,33 @@ void SmoothedAggregationAmg::Impl::exact_product(const Level& L, const double* x
     L.A->multiply(x, y, threads);
   else
     L.nb.multiply(L.Abd, x, y, L.xpad, threads);
+}
+
+void SmoothedAggregationAmg::Impl::copy_transfers(Level& L, const std::vector<int>& fine_nodes,
+                                                  const std::vector<int>& coarse_nodes) {
+  L.Pf.clear(), L.Rf.clear(), L.Pbf.clear(), L.Rbf.clear();
+  if (L.pb.build(L.P, coarse_nodes))
+    L.pb.fill(L.P, L.Pbf);
+  else
+    to_single(L.P, L.Pf);
+  if (L.rb.build(L.R, fine_nodes))
+    L.rb.fill(L.R, L.Rbf);
+  else
+    to_single(L.R, L.Rf);
+}
+
+void SmoothedAggregationAmg::Impl::restrict_to(const Level& L, const double* r, double* y) const {
+  if (L.rb.empty())
+    sparse_product(L.R, L.Rf.data(), r, y, threads);
+  else
+    L.rb.multiply(L.Rbf, r, y, L.tpad, threads);
+}
+
+void SmoothedAggregationAmg::Impl::prolong_from(const Level& L, const double* x, double* y) const {
+  if (L.pb.empty())
+    sparse_product(L.P, L.Pf.data(), x, y, threads);
+  else
+    L.pb.multiply(L.Pbf, x, y, L.tpad, threads);
 }
 
 void SmoothedAggregationAmg::Impl::estimate_lambda(Level& L, int steps) const {
@@ -460,9 +499,9 @@ void SmoothedAggregationAmg::Impl::cycle(size_t l) const {
   single_product(L, L.x.data(), L.q.data());
   for (int i = 0; i < n; ++i) L.r[i] = L.b[i] - L.q[i];
   const Level& C = levels[l + 1];
-  sparse_product(L.R, L.Rf.data(), L.r.data(), C.b.data(), threads);
+  restrict_to(L, L.r.data(), C.b.data());
   cycle(l + 1);
-  sparse_product(L.P, L.Pf.data(), C.x.data(), L.q.data(), threads);
+  prolong_from(L, C.x.data(), L.q.data());
   for (int i = 0; i < n; ++i) L.x[i] += L.q[i];
   smooth(L, L.b.data(), L.x.data(), false);
 }
@@ -506,8 +545,7 @@ void SmoothedAggregationAmg::setup(const CsrMatrix& A, const std::vector<int>& n
     L.R.blocks = coarse_nodes;  // an aggregate's coarse dofs share their fine rows
     // A P only for as long as the product needs it (a refresh forms it again slice by slice)
     CsrMatrix coarse = multiply(L.R, multiply(Al, L.P, m.threads), m.threads);
-    Impl::to_single(L.P, L.Pf);
-    Impl::to_single(L.R, L.Rf);
+    Impl::copy_transfers(L, nodes, coarse_nodes);
     nodes.swap(coarse_nodes);
     modes.swap(coarse_modes);
     m.levels.emplace_back();

@@ -35,20 +35,8 @@
 namespace topopt::fem {
 namespace {
 
-/// Local entry p of the 78 upper-triangle entries (i <= j) of a 12 by 12 element matrix.
-struct LocalPair {
-  int i, j;
-};
+/// The 78 upper-triangle entries (I <= J) of a 12 by 12 element matrix (element_stiffness_upper).
 constexpr int kPairs = 78;
-
-std::array<LocalPair, kPairs> make_pairs() {
-  std::array<LocalPair, kPairs> p{};
-  int k = 0;
-  for (int i = 0; i < 12; ++i)
-    for (int j = i; j < 12; ++j) p[k++] = {i, j};
-  return p;
-}
-const std::array<LocalPair, kPairs> kLocalPairs = make_pairs();
 
 /// The node graph of tets T (#T by 4) on nv nodes: each node's neighbours through the tets,
 /// itself included, sorted.
@@ -105,8 +93,8 @@ struct Elasticity::Impl {
   void build_colours();
   void check_rigid_body_modes();
   void assemble();
-  /// Adds tet t's upper-triangle entries Ke (78, kLocalPairs' order) and their mirror images
-  /// into K's values.
+  /// Adds tet t's upper-triangle entries Ke (78, element_stiffness_upper's order) and their mirror images
+  /// into K's values (add_free_element_upper where its four nodes have all dofs free, the most).
   void add_element(long t, const double* Ke);
   /// loads (3#V by #cases) on the free dofs, minus the reactions of prescribed displacements.
   Eigen::MatrixXd free_loads(const Eigen::MatrixXd& loads) const;
@@ -354,23 +342,18 @@ void Elasticity::Impl::check_rigid_body_modes() {
 
 void Elasticity::Impl::add_element(long t, const double* Ke) {
   int dof[12], first[4], len[4];  // free index of each local dof; per node its first and its row length
+  bool all_free = true;
   for (int a = 0; a < 4; ++a) {
     const int n = mesh.T(t, a);
     for (int i = 0; i < 3; ++i) dof[3 * a + i] = free_index[3 * n + i];
     first[a] = first_free(n);
     len[a] = first[a] < 0 ? 0 : K.ptr[first[a] + 1] - K.ptr[first[a]];
+    all_free &= dof[3 * a] >= 0 && dof[3 * a + 1] >= 0 && dof[3 * a + 2] >= 0;
   }
-  const int* at = &block_at[16 * t];
-  double* val = K.val.data();
-  for (int p = 0; p < kPairs; ++p) {
-    const int I = kLocalPairs[p].i, J = kLocalPairs[p].j;
-    if (dof[I] < 0 || dof[J] < 0) continue;
-    const int a = I / 3, b = J / 3, i = dof[I] - first[a], j = dof[J] - first[b];
-    // entry (I, J) and its mirror (J, I): the element matrix is symmetric, and both take the
-    // upper triangle's value, so K is symmetric to the bit
-    val[at[4 * a + b] + i * len[a] + j] += Ke[p];
-    if (I != J) val[at[4 * b + a] + j * len[b] + i] += Ke[p];
-  }
+  if (all_free)
+    add_free_element_upper(len, &block_at[16 * t], Ke, K.val.data());
+  else
+    add_element_upper(dof, first, len, &block_at[16 * t], Ke, K.val.data());
 }
 
 void Elasticity::Impl::assemble() {
@@ -391,7 +374,7 @@ void Elasticity::Impl::assemble() {
     parallel_for(
         static_cast<long>(list.size()), threads,
         [&](long b, long e) {
-          double Ke[kPairs];  // the upper triangle, in kLocalPairs' order
+          double Ke[kPairs];  // the upper triangle, in element_stiffness_upper's order
           for (long k = b; k < e; ++k) add(list[k], Ke);
         },
         512);

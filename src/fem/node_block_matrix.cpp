@@ -51,6 +51,25 @@ void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<Value>& out) const {
   }
 }
 
+void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const {
+  const size_t size = 9 * col.size();
+  if (exact.size() != size || single.size() != size) exact.assign(size, 0.0), single.assign(size, 0.0f);
+  for (int b = 0; b < nodes; ++b) {
+    const int r0 = first[b], nr = first[b + 1] - r0, len = M.ptr[r0 + 1] - M.ptr[r0];
+    int blk = ptr[b];
+    for (int k = 0; k < len; ++k) {
+      const int c = M.col[M.ptr[r0] + k];
+      while (c >= first[col[blk] + 1]) ++blk;  // columns increase: the block of c is this one or later
+      const long at = 9L * blk + (c - first[col[blk]]);
+      for (int r = 0; r < nr; ++r) {
+        const double v = M.val[M.ptr[r0 + r] + k];
+        exact[at + 3 * r] = v;
+        single[at + 3 * r] = static_cast<float>(v);
+      }
+    }
+  }
+}
+
 template <class Value>
 void NodeBlockPattern::multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
                                 int threads) const {
@@ -92,6 +111,124 @@ void NodeBlockPattern::multiply(const std::vector<Value>& val, const double* x, 
       },
       1024);
 }
+
+template <int RB, int CB>
+bool BlockPattern<RB, CB>::build(const CsrMatrix& M, const std::vector<int>& columns) {
+  *this = BlockPattern();
+  if (M.blocks.size() < 2 || !M.blocks_consistent() || columns.size() < 2 || columns.front() != 0 ||
+      columns.back() != M.cols)
+    return false;
+  BlockPattern P;
+  P.row_blocks = static_cast<int>(M.blocks.size()) - 1;
+  P.row_first = M.blocks;
+  P.col_first = columns;
+  const int column_blocks = static_cast<int>(columns.size()) - 1;
+  std::vector<int> block_of(M.cols);
+  for (int j = 0; j < column_blocks; ++j) {
+    const int nc = columns[j + 1] - columns[j];
+    if (nc < 1 || nc > CB) return false;
+    P.padded |= nc < CB;
+    for (int c = columns[j]; c < columns[j + 1]; ++c) block_of[c] = j;
+  }
+  std::vector<int> met(column_blocks, -1);  // the last row block whose row met each column block
+  P.ptr.reserve(P.row_blocks + 1);
+  P.ptr.push_back(0);
+  for (int b = 0; b < P.row_blocks; ++b) {
+    const int r0 = M.blocks[b];  // the block's other rows have the same columns (blocks_consistent)
+    if (M.blocks[b + 1] - r0 > RB) return false;
+    int previous = -1;
+    for (int k = M.ptr[r0]; k < M.ptr[r0 + 1]; ++k) {
+      const int c = M.col[k], j = block_of[c];
+      if (previous >= 0 && j == block_of[previous]) {
+        if (c <= previous) return false;  // within a block the row walk's order is the columns'
+      } else {
+        if (met[j] == b) return false;  // the block's entries are not consecutive in the row
+        met[j] = b;
+        P.col.push_back(j);
+      }
+      previous = c;
+    }
+    P.ptr.push_back(static_cast<int>(P.col.size()));
+  }
+  if (static_cast<double>(RB * CB) * static_cast<double>(P.col.size()) > kMaxFill * static_cast<double>(M.nonzeros()))
+    return false;
+  *this = std::move(P);
+  return true;
+}
+
+template <int RB, int CB>
+template <class Value>
+void BlockPattern<RB, CB>::fill(const CsrMatrix& M, std::vector<Value>& out) const {
+  constexpr long kValues = RB * CB;
+  out.assign(kValues * col.size(), Value(0));
+  for (int b = 0; b < row_blocks; ++b) {
+    const int r0 = row_first[b], nr = row_first[b + 1] - r0, len = M.ptr[r0 + 1] - M.ptr[r0];
+    int blk = ptr[b];
+    for (int k = 0; k < len; ++k) {
+      const int c = M.col[M.ptr[r0] + k];
+      // a block's entries are consecutive and the blocks in the row's order: past this one, the next
+      if (c < col_first[col[blk]] || c >= col_first[col[blk] + 1]) ++blk;
+      Value* v = &out[kValues * blk + (c - col_first[col[blk]])];
+      for (int r = 0; r < nr; ++r) v[CB * r] = static_cast<Value>(M.val[M.ptr[r0 + r] + k]);
+    }
+  }
+}
+
+template <int RB, int CB>
+template <class Value>
+void BlockPattern<RB, CB>::multiply(const std::vector<Value>& val, const double* x, double* y,
+                                    std::vector<double>& scratch, int threads) const {
+  const double* xs = x;  // x with CB entries per column block (as it is when no block is padded)
+  if (padded) {
+    const long column_blocks = static_cast<long>(col_first.size()) - 1;
+    scratch.resize(CB * column_blocks);
+    parallel_for(
+        column_blocks, threads,
+        [&](long b, long e) {
+          for (long j = b; j < e; ++j) {
+            const int c0 = col_first[j], nc = col_first[j + 1] - c0;
+            for (int c = 0; c < CB; ++c) scratch[CB * j + c] = c < nc ? x[c0 + c] : 0.0;
+          }
+        },
+        4096);
+    xs = scratch.data();
+  }
+  const int* bp = ptr.data();
+  const int* bc = col.data();
+  const Value* bv = val.data();
+  parallel_for(
+      row_blocks, threads,
+      [&](long b, long e) {
+        for (long n = b; n < e; ++n) {
+          // each row's terms in the row walk's order: block by block, columns increasing
+          double s[RB] = {};
+          for (int k = bp[n]; k < bp[n + 1]; ++k) {
+            const double* xv = xs + static_cast<long>(CB) * bc[k];
+            const Value* v = bv + static_cast<long>(RB * CB) * k;
+            for (int c = 0; c < CB; ++c)
+              for (int r = 0; r < RB; ++r) s[r] += v[CB * r + c] * xv[c];
+          }
+          const int r0 = row_first[n], nr = row_first[n + 1] - r0;
+          for (int r = 0; r < nr; ++r) y[r0 + r] = s[r];
+        }
+      },
+      512);
+}
+
+template struct BlockPattern<3, 6>;
+template struct BlockPattern<6, 3>;
+template void BlockPattern<3, 6>::fill(const CsrMatrix&, std::vector<float>&) const;
+template void BlockPattern<3, 6>::fill(const CsrMatrix&, std::vector<double>&) const;
+template void BlockPattern<6, 3>::fill(const CsrMatrix&, std::vector<float>&) const;
+template void BlockPattern<6, 3>::fill(const CsrMatrix&, std::vector<double>&) const;
+template void BlockPattern<3, 6>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&,
+                                           int) const;
+template void BlockPattern<3, 6>::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&,
+                                           int) const;
+template void BlockPattern<6, 3>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&,
+                                           int) const;
+template void BlockPattern<6, 3>::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&,
+                                           int) const;
 
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<float>&) const;
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<double>&) const;

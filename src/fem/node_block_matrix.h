@@ -3,7 +3,8 @@
 // summed in one walk. For the products that dominate an iterative solve (CG's matvec, the
 // multigrid's finest smoother and residual): on a matrix shaped like the rocker's K (5 M entries,
 // one thread) 1.4–2.2 ms a product in single precision against 2.4–2.9 ms for the row walk of
-// sparse_product (BENCHMARKS.md, branch speed10).
+// sparse_product (BENCHMARKS.md, branch speed10). The multigrid's transfers (prolongator and
+// restriction) in blocks of a node's rows by an aggregate's coarse dofs (BlockPattern, branch speed14).
 #pragma once
 #include <vector>
 
@@ -35,11 +36,58 @@ struct NodeBlockPattern {
   /// within a block, padding 0. `out` is resized.
   template <class Value>
   void fill(const CsrMatrix& M, std::vector<Value>& out) const;
+  /// fill's double values and their single-precision copy in one walk over M. A refill of vectors
+  /// of the right size (SIMP's next matrix, the same pattern) writes M's entries only: the padding
+  /// is still the zeros the first fill wrote.
+  void fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const;
   /// y = M x with the block values `val` (fill's), on `threads` threads. x, y: M.rows.
   /// `scratch`: a work vector (the padded x), resized here.
   template <class Value>
   void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
                 int threads) const;
 };
+
+/// The pattern of a rectangular CsrMatrix M in dense RB × CB blocks (block compressed rows), for
+/// the multigrid's transfers: the prolongator P (rows: the fine level's node blocks of at most 3
+/// rows; columns: the aggregates' coarse dofs, at most 6 each: RB = 3, CB = 6) and the
+/// restriction R = Pᵀ (RB = 6, CB = 3). Block row b is M's row block b (M.blocks, its rows sharing
+/// their columns) padded to RB rows; each block is one column block (`col_first`) of M padded to
+/// CB columns. A row's entries in one column block must be consecutive with columns increasing
+/// (the blocks may come in any order: P's aggregates come in the order its product first met
+/// them), so a product adds each row's terms in the row walk's order (sparse_product), padding
+/// adding zeros: the same values to the bit (a zero sum may differ in its sign). One column index
+/// per RB × CB values, where the row walk reads one per value.
+template <int RB, int CB>
+struct BlockPattern {
+  int row_blocks = 0;          ///< M's row blocks
+  std::vector<int> row_first;  ///< row_blocks+1: the first row of each (M.blocks)
+  std::vector<int> col_first;  ///< #column blocks+1: the first column of each
+  std::vector<int> ptr;        ///< row_blocks+1 offsets into col
+  std::vector<int> col;        ///< the column block of each RB × CB block
+  bool padded = false;         ///< some column block has fewer than CB columns (x is copied padded)
+  /// At most this many stored values per entry of M, else the blocks do not pay.
+  static constexpr double kMaxFill = 1.3;
+
+  /// Builds the pattern of M with column blocks `columns` (offsets, first 0, last M.cols). Returns
+  /// false (and leaves the pattern empty) if M does not fit: no row blocks or rows of a block not
+  /// sharing their columns, a row block of more than RB rows or a column block of more than CB
+  /// columns, a row's entries of one column block not consecutive and increasing, or more than
+  /// kMaxFill stored values per entry.
+  bool build(const CsrMatrix& M, const std::vector<int>& columns);
+  bool empty() const { return row_blocks == 0; }
+  /// Values of M (same pattern as build's) in the blocks' layout: RB × CB per block, row-major
+  /// within a block, padding 0. `out` is resized.
+  template <class Value>
+  void fill(const CsrMatrix& M, std::vector<Value>& out) const;
+  /// y = M x with the block values `val` (fill's), on `threads` threads. x: M.cols, y: M.rows.
+  /// `scratch`: a work vector (the padded x), resized here.
+  template <class Value>
+  void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
+                int threads) const;
+};
+
+/// The multigrid's transfers in blocks: P from fine node blocks to aggregates, R = Pᵀ back.
+using ProlongatorBlocks = BlockPattern<3, 6>;
+using RestrictionBlocks = BlockPattern<6, 3>;
 
 }  // namespace topopt::fem

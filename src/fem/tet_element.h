@@ -68,6 +68,50 @@ inline void element_stiffness_upper(const double* g, double vol, double lambda, 
     }
 }
 
+/// Adds a tet's element matrix, given as its upper triangle Ke (78 values, element_stiffness_upper's
+/// order), into the values `val` of a matrix in full compressed rows whose rows come in node blocks
+/// sharing their columns (Elasticity's K). Entry (I, J) and its mirror (J, I) both take Ke's value,
+/// so the matrix is symmetric to the bit. dof: the row of each of the 12 local dofs (-1: a fixed dof,
+/// no row); first: each node's first row (-1: none); len: the length of each node's rows; at: for
+/// nodes a, b (entry 4a + b) the position in val of the entry (first[a], first[b]) (-1: no such).
+inline void add_element_upper(const int* dof, const int* first, const int* len, const int* at, const double* Ke,
+                              double* val) {
+  int p = 0;
+  for (int I = 0; I < 12; ++I)
+    for (int J = I; J < 12; ++J, ++p) {
+      if (dof[I] < 0 || dof[J] < 0) continue;
+      const int a = I / 3, b = J / 3, i = dof[I] - first[a], j = dof[J] - first[b];
+      val[at[4 * a + b] + i * len[a] + j] += Ke[p];
+      if (I != J) val[at[4 * b + a] + j * len[b] + i] += Ke[p];
+    }
+}
+
+/// add_element_upper for a tet whose four nodes have all three dofs as rows (most tets): the same
+/// values into the same entries, block by block, without a test per entry (its assembly's
+/// scatter costs about half). len, at: as add_element_upper's.
+inline void add_free_element_upper(const int* len, const int* at, const double* Ke, double* val) {
+  int p = 0;  // Ke's order: row I = 3a + i, its columns J >= I
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) {
+      // the diagonal block (a, a) from its diagonal on, and its mirror below the diagonal
+      double* diagonal = val + at[5 * a];
+      diagonal[i * len[a] + i] += Ke[p++];
+      for (int j = i + 1; j < 3; ++j, ++p) {
+        diagonal[i * len[a] + j] += Ke[p];
+        diagonal[j * len[a] + i] += Ke[p];
+      }
+      // the blocks (a, b > a), their row i, and the mirrors (b, a), their column i
+      for (int b = a + 1; b < 4; ++b) {
+        double* upper = val + at[4 * a + b] + i * len[a];
+        double* lower = val + at[4 * b + a] + i;
+        for (int j = 0; j < 3; ++j, ++p) {
+          upper[j] += Ke[p];
+          lower[j * len[b]] += Ke[p];
+        }
+      }
+    }
+}
+
 /// The strain ε = sym(∇u) of a linear tet with gradients g (4 by 3, row-major) under the
 /// corner displacements u (12: 3a + component), ∇u = Σ_a u_a ⊗ g_a.
 inline Eigen::Matrix3d element_strain(const double* g, const double* u) {

@@ -119,6 +119,12 @@ ComplianceProblem::Stages ComplianceProblem::filtered(const VecXd& x) const {
   return s;
 }
 
+const ComplianceProblem::Stages& ComplianceProblem::filtered(const VecXd& x, Stages& scratch) const {
+  if (x.size() == staged_x_.size() && x == staged_x_) return stages_;
+  scratch = filtered(x);
+  return scratch;
+}
+
 VecXd ComplianceProblem::project(const VecXd& rho_tilde, double eta) const {
   if (!params_.projection.enabled) return rho_tilde;
   Heaviside h = proj_;
@@ -141,6 +147,7 @@ VecXd ComplianceProblem::physical_to_variables(const VecXd& x, const VecXd& d) c
 double ComplianceProblem::compliance(const VecXd& x, VecXd* dc) {
   const int num_design = static_cast<int>(design_.size());
   stages_ = filtered(x);
+  staged_x_ = x;
   rho_bar_ = project(stages_.tilde, eta_.eroded);
   if (robust_)  // the dilated volume's bound follows the intermediate design (Wang et al. 2011)
     volume_scale_ = volume_of(project(stages_.tilde, eta_.intermediate)) /
@@ -206,7 +213,8 @@ double ComplianceProblem::volume_fraction(const VecXd& x, VecXd* dv) const {
     return volume_weights_.dot(x);
   }
   // with a minimum member size: the dilated design's volume, scaled (volume_scale_)
-  const Stages s = filtered(x);
+  Stages scratch;
+  const Stages& s = filtered(x, scratch);
   if (dv) *dv = volume_scale_ * chain(s, vd_ / design_volume_, eta_.dilated);
   return volume_scale_ * volume_of(project(s.tilde, eta_.dilated));
 }

@@ -173,10 +173,15 @@ class ComplianceProblem {
   struct Stages {
     VecXd filtered, drawn, tilde;
   };
-  Stages stages_;  // of the last compliance() call
-  VecXd rho_bar_;  // #D: its physical densities
+  Stages stages_;   // of the last compliance() call
+  VecXd staged_x_;  // #N: its x
+  VecXd rho_bar_;   // #D: its physical densities
   VecXd chain(const Stages& s, VecXd d_bar, double eta) const;
   Stages filtered(const VecXd& x) const;
+  /// filtered(x): stages_ itself when x is the last compliance() call's (SIMP's volume and its
+  /// gradient at the x just analysed: one filter application less an iteration), else made in
+  /// `scratch`.
+  const Stages& filtered(const VecXd& x, Stages& scratch) const;
   VecXd project(const VecXd& rho_tilde, double eta) const;
   double volume_of(const VecXd& rho_bar) const { return vd_.dot(rho_bar) / design_volume_; }
   double grey_of(const VecXd& rho_bar) const;  // share of the design volume with 0.1 < ρ̄ < 0.9

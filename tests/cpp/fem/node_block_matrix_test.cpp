@@ -72,6 +72,24 @@ TEST(NodeBlockMatrix, ProductsEqualTheRowWalkToTheBit) {
   expect_row_walk_sums(node_matrix(300, {3, 3, 3, 2, 3, 3, 3, 3, 1, 3, 3, 3}, 2), true);
 }
 
+TEST(NodeBlockMatrix, OneWalkFillsBothPrecisionsAndARefillKeepsThePaddingZero) {
+  CsrMatrix M = node_matrix(200, {3, 3, 3, 2, 3, 3, 3, 3, 1, 3, 3, 3}, 6);
+  NodeBlockPattern p;
+  ASSERT_TRUE(p.build(M));
+  ASSERT_TRUE(p.padded);
+  std::vector<double> exact, fresh_d;
+  std::vector<float> single, fresh_f;
+  p.fill(M, exact, single);
+  for (int round = 0; round < 2; ++round) {  // the first fill, then a refill of new values
+    p.fill(M, fresh_d);
+    p.fill(M, fresh_f);
+    EXPECT_EQ(exact, fresh_d) << round;
+    EXPECT_EQ(single, fresh_f) << round;
+    for (double& v : M.val) v = 2 * v + 0.25;  // every entry changes (none becomes 0)
+    p.fill(M, exact, single);
+  }
+}
+
 TEST(NodeBlockMatrix, MatrixProductFromTheBlocksEqualsTheRowWalksToTheBit) {
   // M B with B = M X: B has M's row blocks, each block's rows sharing their columns (as the
   // smoothed prolongator has them); the refresh forms M B a slice of row blocks at a time.
@@ -127,6 +145,116 @@ TEST(NodeBlockMatrix, MatricesTheBlocksDoNotFitAreRefused) {
   CsrMatrix no_blocks = M;
   no_blocks.blocks.clear();
   EXPECT_FALSE(p.build(no_blocks));
+}
+
+/// A rows-by-cols matrix whose row blocks (`row_sizes` cycled) share their columns and whose
+/// columns come in blocks (`col_sizes` cycled; the offsets in `col_first`): each row block reaches
+/// random column blocks, in a random order (as the prolongator's rows meet their aggregates), a
+/// block's columns consecutive and increasing, some of them left out.
+CsrMatrix transfer_matrix(int row_blocks, const std::vector<int>& row_sizes, int col_blocks,
+                          const std::vector<int>& col_sizes, unsigned seed, std::vector<int>& col_first) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> value(-1, 1);
+  std::bernoulli_distribution reach(0.2), drop(0.04);
+  col_first.assign(1, 0);
+  for (int j = 0; j < col_blocks; ++j) col_first.push_back(col_first.back() + col_sizes[j % col_sizes.size()]);
+  CsrMatrix M;
+  M.blocks.assign(1, 0);
+  for (int b = 0; b < row_blocks; ++b) M.blocks.push_back(M.blocks.back() + row_sizes[b % row_sizes.size()]);
+  M.rows = M.blocks.back();
+  M.cols = col_first.back();
+  M.ptr.assign(1, 0);
+  for (int b = 0; b < row_blocks; ++b) {
+    std::vector<int> reached;
+    for (int j = 0; j < col_blocks; ++j)
+      if (reach(rng) || j == b % col_blocks) reached.push_back(j);
+    std::shuffle(reached.begin(), reached.end(), rng);
+    std::vector<int> cols;
+    for (int j : reached) {
+      const size_t before = cols.size();
+      for (int c = col_first[j]; c < col_first[j + 1]; ++c)
+        if (!drop(rng)) cols.push_back(c);
+      if (cols.size() == before) cols.push_back(col_first[j]);
+    }
+    for (int r = M.blocks[b]; r < M.blocks[b + 1]; ++r) {
+      for (int c : cols) M.col.push_back(c), M.val.push_back(value(rng));
+      M.ptr.push_back(static_cast<int>(M.col.size()));
+    }
+  }
+  return M;
+}
+
+template <int RB, int CB>
+void expect_transfer_row_walk_sums(const CsrMatrix& M, const std::vector<int>& col_first) {
+  BlockPattern<RB, CB> p;
+  ASSERT_TRUE(p.build(M, col_first));
+  std::vector<double> vd, scratch;
+  std::vector<float> vf;
+  p.fill(M, vd);
+  p.fill(M, vf);
+  const std::vector<float> single(M.val.begin(), M.val.end());
+  std::mt19937 rng(13);
+  std::normal_distribution<double> N;
+  Eigen::VectorXd x(M.cols);
+  for (int i = 0; i < M.cols; ++i) x[i] = N(rng);
+  const Eigen::VectorXd ref = dense(M) * x;
+  for (int threads : {1, 2}) {
+    Eigen::VectorXd walk(M.rows), blocks(M.rows), walk_f(M.rows), blocks_f(M.rows);
+    sparse_product(M, M.val.data(), x.data(), walk.data(), threads);
+    p.multiply(vd, x.data(), blocks.data(), scratch, threads);
+    sparse_product(M, single.data(), x.data(), walk_f.data(), threads);
+    p.multiply(vf, x.data(), blocks_f.data(), scratch, threads);
+    EXPECT_EQ(blocks, walk) << threads << " threads";  // the same terms in the same order
+    EXPECT_EQ(blocks_f, walk_f) << threads << " threads";
+    EXPECT_LT((blocks - ref).norm(), 1e-13 * ref.norm());
+    EXPECT_GT((blocks_f - blocks).norm(), 0.0);  // the float values were read
+  }
+}
+
+TEST(NodeBlockMatrix, TransferProductsEqualTheRowWalkToTheBit) {
+  // the prolongator's shape: node blocks of 1-3 rows by aggregates of 1-6 coarse dofs, and the
+  // restriction's (its transpose's): aggregates by nodes; full blocks only, and some padded
+  std::vector<int> cf;
+  for (const auto& [rows, cols] : {std::pair<std::vector<int>, std::vector<int>>{{3}, {6}},
+                                   {{3, 3, 3, 2, 3, 3, 3, 3, 3, 1}, {6, 6, 6, 6, 5, 6, 6, 6, 6, 3}}}) {
+    CsrMatrix P = transfer_matrix(400, rows, 60, cols, 21, cf);
+    expect_transfer_row_walk_sums<3, 6>(P, cf);
+    CsrMatrix R = transfer_matrix(60, cols, 400, rows, 22, cf);
+    expect_transfer_row_walk_sums<6, 3>(R, cf);
+  }
+}
+
+TEST(NodeBlockMatrix, TransfersTheBlocksDoNotFitAreRefused) {
+  std::vector<int> cf;
+  const CsrMatrix P = transfer_matrix(100, {3}, 20, {6}, 23, cf);
+  ProlongatorBlocks p;
+  ASSERT_TRUE(p.build(P, cf));
+  EXPECT_FALSE(p.empty());
+  RestrictionBlocks r;
+  EXPECT_FALSE(r.build(P, cf));  // row blocks of 3 fit, but column blocks of 6 are more than 3
+  std::vector<int> wide;
+  EXPECT_FALSE(p.build(transfer_matrix(100, {3}, 20, {7}, 24, wide), wide));  // 7 columns a block
+  EXPECT_TRUE(p.empty());
+  // rows over two column blocks of 6: the blocks in any order, each block's columns
+  // consecutive in the row and increasing
+  auto one_row = [](const std::vector<int>& cols) {  // a block of 3 rows with these columns
+    CsrMatrix M;
+    const int n = static_cast<int>(cols.size());
+    M.rows = 3, M.cols = 12, M.blocks = {0, 3}, M.ptr = {0, n, 2 * n, 3 * n};
+    for (int r = 0; r < 3; ++r) M.col.insert(M.col.end(), cols.begin(), cols.end());
+    M.val.assign(M.col.size(), 1.0);
+    return M;
+  };
+  const std::vector<int> two = {0, 6, 12};
+  EXPECT_TRUE(p.build(one_row({6, 7, 8, 9, 10, 11, 0, 1, 2, 3, 4, 5}), two));
+  EXPECT_FALSE(p.build(one_row({0, 1, 2, 6, 7, 8, 9, 10, 11, 3, 4, 5}), two));  // block 0 met twice
+  EXPECT_FALSE(p.build(one_row({1, 0, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}), two));  // not increasing
+  CsrMatrix no_blocks = P;
+  no_blocks.blocks.clear();
+  EXPECT_FALSE(p.build(no_blocks, cf));
+  std::vector<int> scalar(P.cols + 1);  // one column a block: 18 values stored for at most 3
+  for (int c = 0; c <= P.cols; ++c) scalar[c] = c;
+  EXPECT_FALSE(p.build(P, scalar));
 }
 
 }  // namespace

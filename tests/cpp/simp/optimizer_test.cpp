@@ -235,6 +235,35 @@ TEST(Simp, OcOnTheLinearisedVolumeMeetsTheRealVolumeAsTightlyAsTheExactBisection
   }
 }
 
+TEST(Simp, TheVolumeAtTheAnalysedDesignIsTheVolumeOfAFreshProblemToTheBit) {
+  // The loop asks for the volume and its gradient at the x compliance() just analysed: the
+  // problem takes that x's filtered densities from the analysis instead of filtering again. The
+  // figures must be a fresh problem's to the bit, at that x and at any other (no stale reuse).
+  Case c = cantilever();
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.projection.enabled = true;
+  ComplianceProblem analysed(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  ComplianceProblem fresh(c.mesh, c.mat, c.supports, c.loads, {}, p);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(0.3, 0.7);
+  VecXd x(analysed.num_variables());
+  for (long i = 0; i < x.size(); ++i) x[i] = u(rng);
+  VecXd y = x;
+  y[3] += 0.1;
+  for (double beta : {1.0, 16.0}) {
+    analysed.set_beta(beta);
+    fresh.set_beta(beta);
+    analysed.compliance(x);
+    for (const VecXd* at : {&x, &y, &x}) {
+      VecXd dv, dv_fresh;
+      EXPECT_EQ(analysed.volume_fraction(*at, &dv), fresh.volume_fraction(*at, &dv_fresh)) << beta;
+      EXPECT_EQ(dv, dv_fresh) << beta;
+    }
+  }
+}
+
 TEST(Simp, MmaReachesAboutTheSameDesignAsOc) {
   Case c = cantilever();
   SimpParams p;
