@@ -5,6 +5,10 @@
 #include <cmath>
 #include <optional>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace topopt::simp {
 
 namespace {
@@ -47,22 +51,13 @@ Bracket bisect(const Excess& excess_at, double hint) {
   return b;
 }
 
-/// OC's candidate design for a multiplier λ: x_i sqrt(−dc_i / (λ dv_i)) within the move limits
-/// and [0, 1] (top88's heuristic update). The product is 0 where either factor is: a variable at
-/// 0, or one without stiffening (dc_i ≥ 0; under a steep projection the chain rule underflows to
-/// exactly 0). Computed as written, those made NaN (0 × ∞, 0 / 0) when λ dv_i underflows to 0 —
-/// the bracket searches λ down to 1e-300 when even the upper limits hold too little material —
-/// and the clamp let the NaN through.
+/// OC's candidate design for a multiplier λ (oc_candidates), in a vector of its own.
 class Candidates {
  public:
   Candidates(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move)
       : x_(x), dc_(dc), dv_(dv), move_(move), xnew_(x.size()) {}
   const VecXd& at(double lambda) {
-    for (long i = 0; i < x_.size(); ++i) {
-      const double gain = std::max(-dc_[i], 0.0);
-      const double scaled = gain > 0 && x_[i] > 0 ? x_[i] * std::sqrt(gain / (lambda * dv_[i])) : 0.0;
-      xnew_[i] = std::clamp(scaled, std::max(0.0, x_[i] - move_[i]), std::min(1.0, x_[i] + move_[i]));
-    }
+    oc_candidates(x_, dc_, dv_, move_, lambda, xnew_);
     return xnew_;
   }
 
@@ -133,6 +128,41 @@ double corrected_linear_multiplier(Candidates& candidates, const VecXd& x, const
 }
 
 }  // namespace
+
+double oc_candidate(double x, double dc, double dv, double move, double lambda) {
+  const double gain = std::max(-dc, 0.0);
+  const double scaled = gain > 0 && x > 0 ? x * std::sqrt(gain / (lambda * dv)) : 0.0;
+  return std::clamp(scaled, std::max(0.0, x - move), std::min(1.0, x + move));
+}
+
+void oc_candidates(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move, double lambda, VecXd& out) {
+  const long n = x.size();
+  out.resize(n);
+  long i = 0;
+#if defined(__SSE2__)
+  // oc_candidate's operations two at a time; its selections as masks with its own comparisons
+  // (a NaN compares false either way), so the same values to the bit
+  const __m128d lam = _mm_set1_pd(lambda), zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+  const auto select = [](__m128d mask, __m128d a, __m128d b) {
+    return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b));
+  };
+  for (; i + 2 <= n; i += 2) {
+    const __m128d xi = _mm_loadu_pd(&x[i]), mv = _mm_loadu_pd(&move[i]);
+    // 0 − dc is −dc but for dc = 0 (+0, not −0): a case the mask drops, as gain > 0 does
+    const __m128d minus_dc = _mm_sub_pd(zero, _mm_loadu_pd(&dc[i]));
+    const __m128d take = _mm_and_pd(_mm_cmplt_pd(zero, minus_dc), _mm_cmplt_pd(zero, xi));
+    const __m128d root = _mm_sqrt_pd(_mm_div_pd(minus_dc, _mm_mul_pd(lam, _mm_loadu_pd(&dv[i]))));
+    const __m128d scaled = _mm_and_pd(take, _mm_mul_pd(xi, root));
+    const __m128d below = _mm_sub_pd(xi, mv), above = _mm_add_pd(xi, mv);
+    const __m128d lo = select(_mm_cmplt_pd(zero, below), below, zero);  // std::max(0, x − move)
+    const __m128d hi = select(_mm_cmplt_pd(above, one), above, one);    // std::min(1, x + move)
+    // std::clamp(scaled, lo, hi): lo if scaled < lo, else hi if hi < scaled, else scaled
+    const __m128d upper = select(_mm_cmplt_pd(hi, scaled), hi, scaled);
+    _mm_storeu_pd(&out[i], select(_mm_cmplt_pd(scaled, lo), lo, upper));
+  }
+#endif
+  for (; i < n; ++i) out[i] = oc_candidate(x[i], dc[i], dv[i], move[i], lambda);
+}
 
 VecXd oc_update(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move,
                 const std::function<double(const VecXd&)>& volume_excess, double* multiplier,

@@ -16,6 +16,20 @@ struct OcLinearisation {
   std::function<double(double)> global_sum;
 };
 
+/// OC's candidate for one variable at multiplier λ: x sqrt(−dc / (λ dv)) within [x − move,
+/// x + move] ∩ [0, 1] (top88's heuristic update), taken as 0 before the clamp where x is 0 or
+/// dc ≥ 0 (no stiffening; under a steep projection the chain rule underflows to exactly 0): computed
+/// as written, those would be NaN (0 × ∞, 0 / 0) when λ dv underflows to 0 — the bracket searches λ
+/// down to 1e-300 — and the clamp would let the NaN through.
+double oc_candidate(double x, double dc, double dv, double move, double lambda);
+
+/// oc_candidate for every variable (x, dc, dv, move: #D) into out (#D, resized): two at a time in
+/// SSE2 where the compiler targets it (every x86-64), the same operations in the same order (IEEE
+/// division and square root are correctly rounded in either form): the same values to the bit,
+/// about half the time of the scalar loop, whose square roots and divisions OC's bisection repeats
+/// per step (5 % of the rocker's SIMP profile, BENCHMARKS.md, speed14).
+void oc_candidates(const VecXd& x, const VecXd& dc, const VecXd& dv, const VecXd& move, double lambda, VecXd& out);
+
 /// Optimality criteria with move limits. x: #D current design variables in [0, 1]; dc: #D
 /// objective sensitivities (<= 0 for compliance); dv: #D constraint sensitivities (> 0);
 /// move: #D largest change of each variable (MoveLimits, or one value for all);
