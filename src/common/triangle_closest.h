@@ -4,6 +4,8 @@
 #pragma once
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace topopt {
 
@@ -48,6 +50,19 @@ inline Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen
   if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
   const double denom = 1 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+/// Where the ray p + s u (s > 0, u a unit vector) meets the triangle (a, b, c): s, or +inf
+/// when it misses (Möller–Trumbore).
+inline double ray_triangle_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& a,
+                               const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, h = u.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d s = p - a, q = s.cross(e1);
+  const double bu = s.dot(h) / det, bv = u.dot(q) / det, t = e2.dot(q) / det;
+  if (bu < 0 || bv < 0 || bu + bv > 1 || t <= 0) return std::numeric_limits<double>::infinity();
+  return t;
 }
 
 }  // namespace topopt

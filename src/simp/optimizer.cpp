@@ -76,7 +76,7 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fp.pad_free_faces = robust_ && member.pad_faces;  // a member along a free face held too (member_size.h)
   fp.pad_weight = member.pad_weight;
   filter_ = make_filter(mesh, design_, volume, fp, progress,
-                        fp.pad_free_faces ? held_nodes(mesh.V.rows(), supports.dofs, loads) : std::vector<char>{});
+                        fp.pad_free_faces ? unpadded_nodes(mesh, supports.dofs, loads, member) : std::vector<char>{});
   progress.info("filter: " + filter_->describe());
   const double tolerance = params.controls.tolerance > 0 ? params.controls.tolerance : mean_edge_length(mesh);
   controls_ = std::make_unique<DesignMap>(mesh, design_, params.controls, tolerance);

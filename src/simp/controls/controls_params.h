@@ -95,6 +95,15 @@ struct MemberSizeParams {
   /// κ of the padding (FilterParams::pad_weight): how much of the void beyond a free face the
   /// filter sees; a full design reads 1/(1 + κ) at the face.
   double pad_weight = 1.0;
+  /// With padding: a free face is padded only where the part behind it is at least this many
+  /// minimum sizes thick (thin_part_nodes). Padded on both faces, a member spanning a part of
+  /// thickness s reads 1 − e^(−s/2ℓ) at most; on the bracket (10 mm plates, 9 mm, ℓ = 3.42 mm) that
+  /// is 0.77, so a member must be about 21 mm wide in the plane to survive erosion (η_e = 0.75)
+  /// and the eroded design came apart at volume 0.3 and 0.45 (docs/optimization.md, branch
+  /// member9); at 1.5 sizes a full-thickness member of 1.3 sizes survives (the cantilever, 10 mm at
+  /// 6 mm). A member spanning the part's thickness is the part's, not the design's, as the member
+  /// measure counts it (PartFaces::Clipped). <= 0: every free face padded.
+  double pad_thickness = 1.5;
   /// Largest member: no solid ball of this diameter (the local volume constraint, with MMA).
   double max_size = 0;
   double max_solid = 0.9;  ///< 1 − ε: the largest solid share of an element's ball; in (0.5, 1)

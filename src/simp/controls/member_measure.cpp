@@ -13,19 +13,6 @@
 namespace topopt::simp {
 namespace {
 
-/// Where the ray p + s u (s > 0, u a unit vector) meets the triangle (a, b, c): s, or +inf
-/// when it misses (Möller–Trumbore).
-double ray_hit(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-               const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e1 = b - a, e2 = c - a, h = u.cross(e2);
-  const double det = e1.dot(h);
-  if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::numeric_limits<double>::infinity();
-  const Eigen::Vector3d s = p - a, q = s.cross(e1);
-  const double bu = s.dot(h) / det, bv = u.dot(q) / det, t = e2.dot(q) / det;
-  if (bu < 0 || bv < 0 || bu + bv > 1 || t <= 0) return std::numeric_limits<double>::infinity();
-  return t;
-}
-
 /// The rows of F whose node triple is (`keep` true) or is not (false) in `set`.
 MatX3i rows_in(const MatX3i& F, const std::unordered_set<FaceKey, FaceKeyHash>& set, bool keep) {
   std::vector<long> rows;
@@ -94,8 +81,8 @@ VecXd ray_to_triangles(const MatX3d& V, const MatX3i& F, const MatX3d& P, const 
     for (long f = 0; f < F.rows(); ++f) {
       const Eigen::Vector3d to = sphere.centre.row(f).transpose() - p;
       if (to.norm() - sphere.radius[f] >= s[i] || (to - to.dot(u) * u).norm() > sphere.radius[f]) continue;
-      s[i] = std::min(
-          s[i], ray_hit(p, u, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose()));
+      s[i] = std::min(s[i], ray_triangle_hit(p, u, V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(),
+                                             V.row(F(f, 2)).transpose()));
     }
   }
   return s;

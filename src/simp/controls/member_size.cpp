@@ -6,6 +6,9 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/tet_boundary.h"
+#include "common/triangle_closest.h"
+#include "mesh/core/spatial_grid.h"
 #include "simp/density_filter.h"
 
 namespace topopt::simp {
@@ -89,6 +92,43 @@ std::vector<char> held_nodes(long num_nodes, const std::vector<int>& supported_d
   for (long i = 0; i < loads.rows() && i / 3 < num_nodes; ++i)
     if (loads.row(i).cwiseAbs().maxCoeff() > 0) held[i / 3] = 1;
   return held;
+}
+
+std::vector<char> thin_part_nodes(const TetMesh& mesh, double thickness) {
+  std::vector<char> thin(static_cast<size_t>(mesh.V.rows()), 0);
+  if (!(thickness > 0) || mesh.T.rows() == 0) return thin;
+  const MatX3i F = boundary_triangles(mesh.T);  // normals point out of the part
+  auto corner = [&](long f, int k) -> Eigen::Vector3d { return mesh.V.row(F(f, k)).transpose(); };
+  const Eigen::Vector3d origin = mesh.V.colwise().minCoeff().transpose();
+  mesh::SpatialGrid<3> grid(origin.data(), thickness / 4);
+  for (long f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d lo = corner(f, 0).cwiseMin(corner(f, 1)).cwiseMin(corner(f, 2)),
+                          hi = corner(f, 0).cwiseMax(corner(f, 1)).cwiseMax(corner(f, 2));
+    grid.insert(static_cast<int>(f), lo.data(), hi.data());
+  }
+  for (long f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = corner(f, 0), b = corner(f, 1), c = corner(f, 2), n = (b - a).cross(c - a);
+    if (n.norm() == 0) continue;
+    const Eigen::Vector3d p = (a + b + c) / 3, u = -n.normalized(), q = p + thickness * u;
+    const Eigen::Vector3d lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+    double hit = thickness;  // the first boundary triangle along the inward normal, within `thickness`
+    grid.for_each(lo.data(), hi.data(), [&](int g) {
+      if (g != f) hit = std::min(hit, ray_triangle_hit(p, u, corner(g, 0), corner(g, 1), corner(g, 2)));
+    });
+    if (hit < thickness)
+      for (int k = 0; k < 3; ++k) thin[F(f, k)] = 1;
+  }
+  return thin;
+}
+
+std::vector<char> unpadded_nodes(const TetMesh& mesh, const std::vector<int>& supported_dofs,
+                                 const Eigen::MatrixXd& loads, const MemberSizeParams& p) {
+  std::vector<char> out = held_nodes(mesh.V.rows(), supported_dofs, loads);
+  if (p.pad_thickness > 0 && p.min_size > 0) {
+    const std::vector<char> thin = thin_part_nodes(mesh, p.pad_thickness * p.min_size);
+    for (size_t i = 0; i < out.size(); ++i) out[i] |= thin[i];
+  }
+  return out;
 }
 
 void check_member_size(const MemberSizeParams& p, double mesh_size, bool projection) {

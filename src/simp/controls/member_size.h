@@ -53,6 +53,17 @@ double robust_filter_radius(double min_size, FilterKind kind, const RobustThresh
 /// with void (FilterParams::pad_free_faces), so the design keeps reaching its supports and loads.
 std::vector<char> held_nodes(long num_nodes, const std::vector<int>& supported_dofs, const Eigen::MatrixXd& loads);
 
+/// #V flags, nonzero at the nodes of the boundary triangles of `mesh` (all its tets) behind which
+/// the part is thinner than `thickness` (mm): from the triangle's centre along its inward normal
+/// to the part's boundary. The minimum size's filter leaves a face whose three nodes are flagged
+/// unpadded (MemberSizeParams::pad_thickness), as it does the faces held_nodes flags.
+std::vector<char> thin_part_nodes(const TetMesh& mesh, double thickness);
+
+/// #V flags of the nodes whose faces the minimum size's filter leaves unpadded: held_nodes (the
+/// supports and loads) and thin_part_nodes at p.pad_thickness × p.min_size (none when <= 0).
+std::vector<char> unpadded_nodes(const TetMesh& mesh, const std::vector<int>& supported_dofs,
+                                 const Eigen::MatrixXd& loads, const MemberSizeParams& p);
+
 /// Throws Error(InvalidParameter), naming the job key and what to change, for member sizes
 /// that cannot work on a mesh of mean edge length `mesh_size` (mm): a minimum size below two
 /// mesh sizes (a member must span elements), a maximum size below three mesh sizes or not above

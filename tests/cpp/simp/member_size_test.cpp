@@ -268,13 +268,16 @@ TEST(MemberSize, TheSizeIsHeldOnTheResultWhereTheRobustDesignFallsShort) {
 TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
   // volume 0.9, min size 8 mm padded on the 10 × 10 mm section (8 × 4 × 4 cells of 2.5 mm): the
   // radius (10.9 mm) is wider than the section, no member survives erosion and the run says what
-  // to change; 4 mm on 1.25 mm cells (16 × 8 × 8) fits and is not named
+  // to change; 4 mm on 1.25 mm cells (16 × 8 × 8) fits and is not named. Every free face padded
+  // (pad_thickness 0): by default a section thinner than 1.5 sizes is not padded, and the 10 mm
+  // section at 8 mm would then be a full bar that survives erosion
   auto run = [](std::array<int, 3> cells, double size, std::string& warnings, bool& connects) {
     Cantilever b(cells);
     SimpParams p;
     p.volume_fraction = 0.9;
     p.max_iterations = 30;
     p.controls.member.min_size = size;
+    p.controls.member.pad_thickness = 0;
     Progress progress;
     progress.log = [&](LogLevel level, const std::string& m) {
       if (level == LogLevel::Warning) warnings += m + "\n";
@@ -295,6 +298,58 @@ TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
   EXPECT_TRUE(fits_connects);
   EXPECT_EQ(fits.find("came apart"), std::string::npos) << fits;
   EXPECT_EQ(fits.find("does not join"), std::string::npos) << fits;
+}
+
+/// A plate 30 × 20 × 5 mm (1.25 mm cells) fixed at x = 0 (Face1), a non-design pad at x in [28, 30]
+/// pulled along −y on its end face (Face2): bent in its plane, so its members span its thickness.
+struct ThinPlate {
+  mesh::StructuredBoxParams box;
+  TetMesh mesh;
+  fem::Material mat;
+  fem::Supports supports;
+  Eigen::MatrixXd loads;
+  ThinPlate() {
+    box.origin = {0, -10, -2.5};
+    box.size = {30, 20, 5};
+    box.cells = {24, 16, 4};
+    box.nondesign = {{28, -10, -2.5, 30, 10, 2.5}};
+    mesh = mesh::structured_box_mesh(box);
+    supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
+    fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
+    loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {pull}, 1}});
+  }
+};
+
+TEST(MemberSize, FacesOfAPartThinnerThanOneAndAHalfSizesAreNotPadded) {
+  // thin_part_nodes flags the nodes of the faces behind which the part is thinner than the given
+  // thickness, by a ray along each boundary triangle's inward normal: on the 5 mm plate at 1.5 × 4.5
+  // mm the ±z faces only (20 and 30 mm across the others); on the 10 × 10 mm test beam nothing at
+  // 1.5 × 4 mm and its four side faces at 1.5 × 8 mm (its end faces are 30 mm apart). The minimum
+  // size's filter leaves those faces unpadded (unpadded_nodes), with the supports' and loads'.
+  const ThinPlate plate;
+  const std::vector<char> thin = thin_part_nodes(plate.mesh, 1.5 * 4.5);
+  long flagged = 0;
+  for (long i = 0; i < plate.mesh.V.rows(); ++i) {
+    const bool face = std::abs(std::abs(plate.mesh.V(i, 2)) - 2.5) < 1e-9;
+    EXPECT_EQ(thin[i] != 0, face) << "node " << i;
+    flagged += thin[i];
+  }
+  EXPECT_GT(flagged, 0);
+  const Cantilever beam({16, 8, 8});
+  const std::vector<char> none = thin_part_nodes(beam.mesh, 1.5 * 4), sides = thin_part_nodes(beam.mesh, 1.5 * 8);
+  for (long i = 0; i < beam.mesh.V.rows(); ++i) {
+    const double y = std::abs(beam.mesh.V(i, 1)), z = std::abs(beam.mesh.V(i, 2));
+    EXPECT_EQ(none[i], 0) << "node " << i;
+    EXPECT_EQ(sides[i] != 0, std::abs(y - 5) < 1e-9 || std::abs(z - 5) < 1e-9) << "node " << i;
+  }
+  // the faces the filter is told to leave unpadded: these and the supports' and loads'
+  MemberSizeParams p;
+  p.min_size = 4.5;
+  const std::vector<char> unpadded = unpadded_nodes(plate.mesh, plate.supports.dofs, plate.loads, p);
+  const std::vector<char> held = held_nodes(plate.mesh.V.rows(), plate.supports.dofs, plate.loads);
+  for (long i = 0; i < plate.mesh.V.rows(); ++i) EXPECT_EQ(unpadded[i] != 0, thin[i] || held[i]) << "node " << i;
+  p.pad_thickness = 0;
+  EXPECT_EQ(unpadded_nodes(plate.mesh, plate.supports.dofs, plate.loads, p), held);
 }
 
 TEST(MemberSize, PaddedFilterSeesAMemberAlongAFreeFaceAsInTheMiddle) {
