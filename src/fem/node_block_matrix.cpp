@@ -5,6 +5,29 @@
 
 namespace topopt::fem {
 
+namespace {
+
+/// x with `width` entries per block (blocks [first[j], first[j+1]) of x, at most `width` long, the
+/// rest zeros) in scratch; x itself when no block is padded.
+const double* padded_x(const std::vector<int>& first, int width, bool padded, const double* x,
+                       std::vector<double>& scratch, int threads) {
+  if (!padded) return x;
+  const long blocks = static_cast<long>(first.size()) - 1;
+  scratch.resize(static_cast<size_t>(width) * blocks);
+  parallel_for(
+      blocks, threads,
+      [&](long b, long e) {
+        for (long j = b; j < e; ++j) {
+          const int c0 = first[j], nc = first[j + 1] - c0;
+          for (int c = 0; c < width; ++c) scratch[width * j + c] = c < nc ? x[c0 + c] : 0.0;
+        }
+      },
+      4096);
+  return scratch.data();
+}
+
+}  // namespace
+
 bool NodeBlockPattern::build(const CsrMatrix& M) {
   *this = NodeBlockPattern();
   if (M.rows != M.cols || M.blocks.size() < 2 || !M.blocks_consistent()) return false;
@@ -36,24 +59,8 @@ bool NodeBlockPattern::build(const CsrMatrix& M) {
   return true;
 }
 
-template <class Value>
-void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<Value>& out) const {
-  out.assign(9 * col.size(), Value(0));
-  for (int b = 0; b < nodes; ++b) {
-    const int r0 = first[b], nr = first[b + 1] - r0, len = M.ptr[r0 + 1] - M.ptr[r0];
-    int blk = ptr[b];
-    for (int k = 0; k < len; ++k) {
-      const int c = M.col[M.ptr[r0] + k];
-      while (c >= first[col[blk] + 1]) ++blk;  // columns increase: the block of c is this one or later
-      Value* v = &out[9L * blk + (c - first[col[blk]])];
-      for (int r = 0; r < nr; ++r) v[3 * r] = static_cast<Value>(M.val[M.ptr[r0 + r] + k]);
-    }
-  }
-}
-
-void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const {
-  const size_t size = 9 * col.size();
-  if (exact.size() != size || single.size() != size) exact.assign(size, 0.0), single.assign(size, 0.0f);
+template <class Put>
+void NodeBlockPattern::walk(const CsrMatrix& M, Put put) const {
   for (int b = 0; b < nodes; ++b) {
     const int r0 = first[b], nr = first[b + 1] - r0, len = M.ptr[r0 + 1] - M.ptr[r0];
     int blk = ptr[b];
@@ -61,32 +68,30 @@ void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std:
       const int c = M.col[M.ptr[r0] + k];
       while (c >= first[col[blk] + 1]) ++blk;  // columns increase: the block of c is this one or later
       const long at = 9L * blk + (c - first[col[blk]]);
-      for (int r = 0; r < nr; ++r) {
-        const double v = M.val[M.ptr[r0 + r] + k];
-        exact[at + 3 * r] = v;
-        single[at + 3 * r] = static_cast<float>(v);
-      }
+      for (int r = 0; r < nr; ++r) put(at + 3 * r, M.val[M.ptr[r0 + r] + k]);
     }
   }
 }
 
 template <class Value>
+void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<Value>& out) const {
+  out.assign(9 * col.size(), Value(0));
+  walk(M, [&](long at, double v) { out[at] = static_cast<Value>(v); });
+}
+
+void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const {
+  const size_t size = 9 * col.size();
+  if (exact.size() != size || single.size() != size) exact.assign(size, 0.0), single.assign(size, 0.0f);
+  walk(M, [&](long at, double v) {
+    exact[at] = v;
+    single[at] = static_cast<float>(v);
+  });
+}
+
+template <class Value>
 void NodeBlockPattern::multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
                                 int threads) const {
-  const double* xs = x;  // x with 3 entries per row block (as it is when no block is padded)
-  if (padded) {
-    scratch.resize(3L * nodes);
-    parallel_for(
-        nodes, threads,
-        [&](long b, long e) {
-          for (long n = b; n < e; ++n) {
-            const int r0 = first[n], nr = first[n + 1] - r0;
-            for (int j = 0; j < 3; ++j) scratch[3 * n + j] = j < nr ? x[r0 + j] : 0.0;
-          }
-        },
-        4096);
-    xs = scratch.data();
-  }
+  const double* xs = padded_x(first, 3, padded, x, scratch, threads);  // 3 entries per row block
   const int* bp = ptr.data();
   const int* bc = col.data();
   const Value* bv = val.data();
@@ -178,21 +183,7 @@ template <int RB, int CB>
 template <class Value>
 void BlockPattern<RB, CB>::multiply(const std::vector<Value>& val, const double* x, double* y,
                                     std::vector<double>& scratch, int threads) const {
-  const double* xs = x;  // x with CB entries per column block (as it is when no block is padded)
-  if (padded) {
-    const long column_blocks = static_cast<long>(col_first.size()) - 1;
-    scratch.resize(CB * column_blocks);
-    parallel_for(
-        column_blocks, threads,
-        [&](long b, long e) {
-          for (long j = b; j < e; ++j) {
-            const int c0 = col_first[j], nc = col_first[j + 1] - c0;
-            for (int c = 0; c < CB; ++c) scratch[CB * j + c] = c < nc ? x[c0 + c] : 0.0;
-          }
-        },
-        4096);
-    xs = scratch.data();
-  }
+  const double* xs = padded_x(col_first, CB, padded, x, scratch, threads);  // CB entries per column block
   const int* bp = ptr.data();
   const int* bc = col.data();
   const Value* bv = val.data();

@@ -45,6 +45,11 @@ struct NodeBlockPattern {
   template <class Value>
   void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
                 int threads) const;
+
+ private:
+  /// Both fills' one walk over M: put(index in the blocks' values, M's value) for every entry.
+  template <class Put>
+  void walk(const CsrMatrix& M, Put put) const;
 };
 
 /// The pattern of a rectangular CsrMatrix M in dense RB × CB blocks (block compressed rows), for

@@ -39,19 +39,20 @@ CsrMatrix node_matrix(int nodes, const std::vector<int>& sizes, unsigned seed) {
   return M;
 }
 
-void expect_row_walk_sums(const CsrMatrix& M, bool padded) {
-  NodeBlockPattern p;
-  ASSERT_TRUE(p.build(M));
-  EXPECT_EQ(p.padded, padded);
+/// The products of pattern p (built from M) with M's values in double and in single precision,
+/// on 1 and 2 threads, against sparse_product's row walk (to the bit) and dense arithmetic, for a
+/// random x drawn with `seed`.
+template <class Pattern>
+void expect_products_equal_the_row_walk(const Pattern& p, const CsrMatrix& M, unsigned seed) {
   std::vector<double> vd, scratch;
   std::vector<float> vf;
   p.fill(M, vd);
   p.fill(M, vf);
   const std::vector<float> single(M.val.begin(), M.val.end());
-  std::mt19937 rng(9);
+  std::mt19937 rng(seed);
   std::normal_distribution<double> N;
-  Eigen::VectorXd x(M.rows);
-  for (int i = 0; i < M.rows; ++i) x[i] = N(rng);
+  Eigen::VectorXd x(M.cols);
+  for (int i = 0; i < M.cols; ++i) x[i] = N(rng);
   const Eigen::VectorXd ref = dense(M) * x;
   for (int threads : {1, 2}) {
     Eigen::VectorXd walk(M.rows), blocks(M.rows), walk_f(M.rows), blocks_f(M.rows);
@@ -64,6 +65,13 @@ void expect_row_walk_sums(const CsrMatrix& M, bool padded) {
     EXPECT_LT((blocks - ref).norm(), 1e-13 * ref.norm());
     EXPECT_GT((blocks_f - blocks).norm(), 0.0);  // the float values were read
   }
+}
+
+void expect_row_walk_sums(const CsrMatrix& M, bool padded) {
+  NodeBlockPattern p;
+  ASSERT_TRUE(p.build(M));
+  EXPECT_EQ(p.padded, padded);
+  expect_products_equal_the_row_walk(p, M, 9);
 }
 
 TEST(NodeBlockMatrix, ProductsEqualTheRowWalkToTheBit) {
@@ -188,27 +196,7 @@ template <int RB, int CB>
 void expect_transfer_row_walk_sums(const CsrMatrix& M, const std::vector<int>& col_first) {
   BlockPattern<RB, CB> p;
   ASSERT_TRUE(p.build(M, col_first));
-  std::vector<double> vd, scratch;
-  std::vector<float> vf;
-  p.fill(M, vd);
-  p.fill(M, vf);
-  const std::vector<float> single(M.val.begin(), M.val.end());
-  std::mt19937 rng(13);
-  std::normal_distribution<double> N;
-  Eigen::VectorXd x(M.cols);
-  for (int i = 0; i < M.cols; ++i) x[i] = N(rng);
-  const Eigen::VectorXd ref = dense(M) * x;
-  for (int threads : {1, 2}) {
-    Eigen::VectorXd walk(M.rows), blocks(M.rows), walk_f(M.rows), blocks_f(M.rows);
-    sparse_product(M, M.val.data(), x.data(), walk.data(), threads);
-    p.multiply(vd, x.data(), blocks.data(), scratch, threads);
-    sparse_product(M, single.data(), x.data(), walk_f.data(), threads);
-    p.multiply(vf, x.data(), blocks_f.data(), scratch, threads);
-    EXPECT_EQ(blocks, walk) << threads << " threads";  // the same terms in the same order
-    EXPECT_EQ(blocks_f, walk_f) << threads << " threads";
-    EXPECT_LT((blocks - ref).norm(), 1e-13 * ref.norm());
-    EXPECT_GT((blocks_f - blocks).norm(), 0.0);  // the float values were read
-  }
+  expect_products_equal_the_row_walk(p, M, 13);
 }
 
 TEST(NodeBlockMatrix, TransferProductsEqualTheRowWalkToTheBit) {

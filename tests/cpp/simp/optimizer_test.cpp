@@ -186,6 +186,24 @@ double summed_volume(const Case& c, const ComplianceProblem& prob, const VecXd& 
   return kept / total;
 }
 
+/// The two volume tests' settings: volume fraction 0.4, filter radius 5, the Heaviside projection.
+SimpParams projected_params() {
+  SimpParams p;
+  p.volume_fraction = 0.4;
+  p.filter.radius = 5;
+  p.projection.enabled = true;
+  return p;
+}
+
+/// n design variables drawn uniformly from [0.3, 0.7] with `seed`.
+VecXd random_design(long n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.3, 0.7);
+  VecXd x(n);
+  for (long i = 0; i < n; ++i) x[i] = u(rng);
+  return x;
+}
+
 TEST(Simp, OcOnTheLinearisedVolumeMeetsTheRealVolumeAsTightlyAsTheExactBisection) {
   // One OC step, as the loop takes it (density filter, Heaviside projection), from a random
   // design 0.1 off the target: the multiplier bisected on the real volume (a filter application
@@ -196,15 +214,9 @@ TEST(Simp, OcOnTheLinearisedVolumeMeetsTheRealVolumeAsTightlyAsTheExactBisection
   // to 2.7e-7, 1.2e-7, 3.8e-7 (43-44 evaluations), the corrected one to 0.9e-7, 4.6e-7, 5.5e-7
   // (3, 5, 10: from this start, far from a settled design, β 32 takes the most rounds).
   Case c = cantilever();
-  SimpParams p;
-  p.volume_fraction = 0.4;
-  p.filter.radius = 5;
-  p.projection.enabled = true;
+  const SimpParams p = projected_params();
   ComplianceProblem prob(c.mesh, c.mat, c.supports, c.loads, {}, p);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(0.3, 0.7);
-  VecXd x(prob.num_variables());
-  for (long i = 0; i < x.size(); ++i) x[i] = u(rng);
+  const VecXd x = random_design(prob.num_variables(), 7);
   for (double beta : {1.0, 8.0, 32.0}) {
     SCOPED_TRACE("beta " + std::to_string(beta));
     prob.set_beta(beta);
@@ -240,16 +252,10 @@ TEST(Simp, TheVolumeAtTheAnalysedDesignIsTheVolumeOfAFreshProblemToTheBit) {
   // problem takes that x's filtered densities from the analysis instead of filtering again. The
   // figures must be a fresh problem's to the bit, at that x and at any other (no stale reuse).
   Case c = cantilever();
-  SimpParams p;
-  p.volume_fraction = 0.4;
-  p.filter.radius = 5;
-  p.projection.enabled = true;
+  const SimpParams p = projected_params();
   ComplianceProblem analysed(c.mesh, c.mat, c.supports, c.loads, {}, p);
   ComplianceProblem fresh(c.mesh, c.mat, c.supports, c.loads, {}, p);
-  std::mt19937 rng(8);
-  std::uniform_real_distribution<double> u(0.3, 0.7);
-  VecXd x(analysed.num_variables());
-  for (long i = 0; i < x.size(); ++i) x[i] = u(rng);
+  VecXd x = random_design(analysed.num_variables(), 8);
   VecXd y = x;
   y[3] += 0.1;
   for (double beta : {1.0, 16.0}) {
