@@ -1,6 +1,7 @@
 // Sparse matrix kernels (see csr_matrix.h).
 #include "fem/csr_matrix.h"
 
+#include <immintrin.h>
 #include <algorithm>
 #include <cassert>
 #include <numeric>
@@ -81,14 +82,48 @@ void block_rows_times(const CsrMatrix& A, const CsrMatrix& B, int r0, int nr, in
   }
 }
 
+/// One column j of B's row block p0 .. p0 + pn − 1 (entry t of its rows, bv[c][t]) times M's
+/// 3×3 block `a` (column-major: a[r + 3 c]), into j's sums q of M's n rows: q[r] (+)= a[r + 3 c]
+/// bv[c][t] for c = 0 .. pn − 1, the first term set, not added, when `set` (as block_rows_times).
+struct ScalarColumns {
+  static void add(const double* a, const double* const* bv, int t, int n, int pn, double* q, bool set) {
+    const int c0 = set ? 1 : 0;
+    if (set)
+      for (int r = 0; r < n; ++r) q[r] = a[r] * bv[0][t];
+    for (int r = 0; r < n; ++r) {
+      double s = q[r];
+      for (int c = c0; c < pn; ++c) s += a[r + 3 * c] * bv[c][t];
+      q[r] = s;
+    }
+  }
+};
+
+/// ScalarColumns with M's three rows in one AVX register's lanes where the block and B's row
+/// block are full (n = pn = 3): each row's products and sums in the scalar order, rounded alike (no
+/// fused multiply-add), the same values to the bit. The fourth lane reads a[3 + 3 c] (the next
+/// column's, or the next block's, or the values' one past the end: NodeBlockPattern::values) and
+/// writes q[3], which no row reads (RowAccumulator keeps CsrMatrix::kMaxBlock = 8 sums a column).
+struct AvxColumns {
+  __attribute__((target("avx"))) static inline void add(const double* a, const double* const* bv, int t, int n, int pn,
+                                                        double* q, bool set) {
+    if (n != 3 || pn != 3) return ScalarColumns::add(a, bv, t, n, pn, q, set);
+    __m256d s = _mm256_mul_pd(_mm256_loadu_pd(a), _mm256_set1_pd(bv[0][t]));
+    if (!set) s = _mm256_add_pd(_mm256_loadu_pd(q), s);
+    s = _mm256_add_pd(s, _mm256_mul_pd(_mm256_loadu_pd(a + 3), _mm256_set1_pd(bv[1][t])));
+    s = _mm256_add_pd(s, _mm256_mul_pd(_mm256_loadu_pd(a + 6), _mm256_set1_pd(bv[2][t])));
+    _mm256_storeu_pd(q, s);
+  }
+};
+static_assert(CsrMatrix::kMaxBlock >= 4, "AvxColumns writes four sums a column");
+
 /// The rows of row block `blk` of M B summed into `w` as block_rows_times sums them from M's
 /// compressed rows (the same terms in the same order: M's columns increase, and B's rows of a
 /// node block share their columns), with M's values read from its 3×3 blocks `val`: one column
 /// check per block of B's columns instead of one per entry of M. NR: M's rows in the block (3 or
-/// 0: any); PN: B's rows in every column block (3 or 0: any).
-template <int NR>
-void node_block_rows_times(const NodeBlockPattern& nb, const double* val, const CsrMatrix& B, int blk,
-                           RowAccumulator& w) {
+/// 0: any); Columns: how a block meets one column of B (ScalarColumns, AvxColumns).
+template <int NR, class Columns>
+inline void node_block_rows_times(const NodeBlockPattern& nb, const double* val, const CsrMatrix& B, int blk,
+                                  RowAccumulator& w) {
   constexpr int kB = CsrMatrix::kMaxBlock;
   const int n = NR ? NR : nb.first[blk + 1] - nb.first[blk];
   w.touched.clear();
@@ -97,38 +132,35 @@ void node_block_rows_times(const NodeBlockPattern& nb, const double* val, const 
   double* acc = w.acc.data();
   for (int k = nb.ptr[blk]; k < nb.ptr[blk + 1]; ++k) {
     const int m = nb.col[k], p0 = nb.first[m], pn = nb.first[m + 1] - p0;
-    const double* a = val + 9L * k;  // a[3 r + c]: M's row r, column p0 + c
+    const double* a = val + 9L * k;  // a[r + 3 c]: M's row r, column p0 + c (column-major blocks)
     const int* bc = B.col.data() + B.ptr[p0];
     const int blen = B.ptr[p0 + 1] - B.ptr[p0];
     const double* bv[3];
     for (int c = 0; c < pn; ++c) bv[c] = B.val.data() + B.ptr[p0 + c];
     for (int t = 0; t < blen; ++t) {
       const int j = bc[t];
-      double* q;
-      int c = 1;
-      if (mark[j] != blk) {  // the first term is set, not added (as in block_rows_times)
+      const bool set = mark[j] != blk;
+      if (set) {  // the first term is set, not added (as in block_rows_times)
         mark[j] = blk;
         slot[j] = static_cast<int>(w.touched.size());
         w.touched.push_back(j);
         if (w.acc.size() < w.touched.size() * kB) w.acc.resize(2 * w.touched.size() * kB), acc = w.acc.data();
-        q = acc + kB * slot[j];
-        for (int r = 0; r < n; ++r) q[r] = a[3 * r] * bv[0][t];
-      } else {
-        q = acc + kB * slot[j];
-        c = 0;
       }
-      if (pn == 3) {
-        for (int r = 0; r < n; ++r) {
-          double s = q[r];
-          for (int cc = c; cc < 3; ++cc) s += a[3 * r + cc] * bv[cc][t];
-          q[r] = s;
-        }
-      } else {
-        for (int r = 0; r < n; ++r)
-          for (int cc = c; cc < pn; ++cc) q[r] += a[3 * r + cc] * bv[cc][t];
-      }
+      Columns::add(a, bv, t, n, pn, acc + kB * slot[j], set);
     }
   }
+}
+
+/// node_block_rows_times for a block of 3 rows or any, by the scalar or the AVX columns.
+template <int NR>
+void scalar_node_block_rows(const NodeBlockPattern& nb, const double* val, const CsrMatrix& B, int blk,
+                            RowAccumulator& w) {
+  node_block_rows_times<NR, ScalarColumns>(nb, val, B, blk, w);
+}
+template <int NR>
+__attribute__((target("avx"), flatten)) void avx_node_block_rows(const NodeBlockPattern& nb, const double* val,
+                                                                 const CsrMatrix& B, int blk, RowAccumulator& w) {
+  node_block_rows_times<NR, AvxColumns>(nb, val, B, blk, w);
 }
 
 /// add_product_rows for one row block of A (rows r0 .. r0 + nr − 1, from its entry k on, while
@@ -240,11 +272,14 @@ CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long
 CsrMatrix multiply_rows(const NodeBlockPattern& nb, const std::vector<double>& val, const CsrMatrix& A,
                         const CsrMatrix& B, long first, long last, int threads) {
   assert(B.blocks == nb.first && A.blocks == nb.first);
+  const bool avx = NodeBlockPattern::fastest_kernel() == NodeBlockPattern::Kernel::Avx;
   return product_rows(A, B, first, last, threads, [&](int, int nr, int blk, RowAccumulator& w) {
-    if (nr == 3)
-      node_block_rows_times<3>(nb, val.data(), B, blk, w);
+    if (avx)
+      nr == 3 ? avx_node_block_rows<3>(nb, val.data(), B, blk, w) : avx_node_block_rows<0>(nb, val.data(), B, blk, w);
+    else if (nr == 3)
+      scalar_node_block_rows<3>(nb, val.data(), B, blk, w);
     else
-      node_block_rows_times<0>(nb, val.data(), B, blk, w);
+      scalar_node_block_rows<0>(nb, val.data(), B, blk, w);
   });
 }
 

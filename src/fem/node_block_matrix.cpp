@@ -1,6 +1,8 @@
 // 3×3 node blocks of the elasticity matrix (see node_block_matrix.h).
 #include "fem/node_block_matrix.h"
 
+#include <immintrin.h>
+
 #include "common/parallel.h"
 
 namespace topopt::fem {
@@ -66,21 +68,21 @@ void NodeBlockPattern::walk(const CsrMatrix& M, Put put) const {
     int blk = ptr[b];
     for (int k = 0; k < len; ++k) {
       const int c = M.col[M.ptr[r0] + k];
-      while (c >= first[col[blk] + 1]) ++blk;  // columns increase: the block of c is this one or later
-      const long at = 9L * blk + (c - first[col[blk]]);
-      for (int r = 0; r < nr; ++r) put(at + 3 * r, M.val[M.ptr[r0 + r] + k]);
+      while (c >= first[col[blk] + 1]) ++blk;                // columns increase: the block of c is this one or later
+      const long at = 9L * blk + 3 * (c - first[col[blk]]);  // a block's column c at 3 c
+      for (int r = 0; r < nr; ++r) put(at + r, M.val[M.ptr[r0 + r] + k]);
     }
   }
 }
 
 template <class Value>
 void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<Value>& out) const {
-  out.assign(9 * col.size(), Value(0));
+  out.assign(values(), Value(0));
   walk(M, [&](long at, double v) { out[at] = static_cast<Value>(v); });
 }
 
 void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const {
-  const size_t size = 9 * col.size();
+  const size_t size = values();
   if (exact.size() != size || single.size() != size) exact.assign(size, 0.0), single.assign(size, 0.0f);
   walk(M, [&](long at, double v) {
     exact[at] = v;
@@ -88,31 +90,78 @@ void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std:
   });
 }
 
+NodeBlockPattern::Kernel NodeBlockPattern::fastest_kernel() {
+  return __builtin_cpu_supports("avx") ? Kernel::Avx : Kernel::Scalar;
+}
+
+namespace {
+
+/// y's rows of node blocks b .. e − 1 from the block values `bv` (9 a block, column-major) and
+/// the padded x `xs` (3 a node), one row at a time within a block's column: each row's terms in
+/// column order, as the row walk adds them; three sums side by side.
+template <class Value>
+void scalar_block_rows(const NodeBlockPattern& p, const Value* bv, const double* xs, double* y, long b, long e) {
+  const int* bp = p.ptr.data();
+  const int* bc = p.col.data();
+  for (long n = b; n < e; ++n) {
+    double s0 = 0, s1 = 0, s2 = 0;
+    for (int k = bp[n]; k < bp[n + 1]; ++k) {
+      const double* xv = xs + 3L * bc[k];
+      const Value* v = bv + 9L * k;
+      s0 += v[0] * xv[0], s1 += v[1] * xv[0], s2 += v[2] * xv[0];
+      s0 += v[3] * xv[1], s1 += v[4] * xv[1], s2 += v[5] * xv[1];
+      s0 += v[6] * xv[2], s1 += v[7] * xv[2], s2 += v[8] * xv[2];
+    }
+    const int r0 = p.first[n], nr = p.first[n + 1] - r0;
+    y[r0] = s0;
+    if (nr > 1) y[r0 + 1] = s1;
+    if (nr > 2) y[r0 + 2] = s2;
+  }
+}
+
+/// A block's column as four doubles (its three rows and the next value, which no row uses).
+__attribute__((target("avx"))) inline __m256d column_of(const float* v) { return _mm256_cvtps_pd(_mm_loadu_ps(v)); }
+__attribute__((target("avx"))) inline __m256d column_of(const double* v) { return _mm256_loadu_pd(v); }
+
+/// scalar_block_rows with a node's three rows in the lanes of one AVX register: lane r adds
+/// v[3 c + r] x_c for c = 0, 1, 2, block after block — each row's products and sums in the
+/// scalar kernel's order, rounded alike (no fused multiply-add: the target is AVX alone), so the
+/// same values to the bit, in about two thirds of its time (BENCHMARKS.md, branch speed17).
+/// The fourth lane reads the next value (the fill's one past the last block at the end).
+template <class Value>
+__attribute__((target("avx"))) void avx_block_rows(const NodeBlockPattern& p, const Value* bv, const double* xs,
+                                                   double* y, long b, long e) {
+  const int* bp = p.ptr.data();
+  const int* bc = p.col.data();
+  for (long n = b; n < e; ++n) {
+    __m256d s = _mm256_setzero_pd();
+    for (int k = bp[n]; k < bp[n + 1]; ++k) {
+      const double* xv = xs + 3L * bc[k];
+      const Value* v = bv + 9L * k;
+      s = _mm256_add_pd(s, _mm256_mul_pd(column_of(v), _mm256_broadcast_sd(xv)));
+      s = _mm256_add_pd(s, _mm256_mul_pd(column_of(v + 3), _mm256_broadcast_sd(xv + 1)));
+      s = _mm256_add_pd(s, _mm256_mul_pd(column_of(v + 6), _mm256_broadcast_sd(xv + 2)));
+    }
+    alignas(32) double sum[4];
+    _mm256_store_pd(sum, s);
+    const int r0 = p.first[n], nr = p.first[n + 1] - r0;
+    for (int r = 0; r < nr; ++r) y[r0 + r] = sum[r];
+  }
+}
+
+}  // namespace
+
 template <class Value>
 void NodeBlockPattern::multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
-                                int threads) const {
+                                int threads, Kernel kernel) const {
   const double* xs = padded_x(first, 3, padded, x, scratch, threads);  // 3 entries per row block
-  const int* bp = ptr.data();
-  const int* bc = col.data();
-  const Value* bv = val.data();
   parallel_for(
       nodes, threads,
       [&](long b, long e) {
-        for (long n = b; n < e; ++n) {
-          // each row's terms in column order, as the row walk adds them; three sums side by side
-          double s0 = 0, s1 = 0, s2 = 0;
-          for (int k = bp[n]; k < bp[n + 1]; ++k) {
-            const double* xv = xs + 3L * bc[k];
-            const Value* v = bv + 9L * k;
-            s0 += v[0] * xv[0], s1 += v[3] * xv[0], s2 += v[6] * xv[0];
-            s0 += v[1] * xv[1], s1 += v[4] * xv[1], s2 += v[7] * xv[1];
-            s0 += v[2] * xv[2], s1 += v[5] * xv[2], s2 += v[8] * xv[2];
-          }
-          const int r0 = first[n], nr = first[n + 1] - r0;
-          y[r0] = s0;
-          if (nr > 1) y[r0 + 1] = s1;
-          if (nr > 2) y[r0 + 2] = s2;
-        }
+        if (kernel == Kernel::Avx)
+          avx_block_rows(*this, val.data(), xs, y, b, e);
+        else
+          scalar_block_rows(*this, val.data(), xs, y, b, e);
       },
       1024);
 }
@@ -223,9 +272,9 @@ template void BlockPattern<6, 3>::multiply(const std::vector<double>&, const dou
 
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<float>&) const;
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<double>&) const;
-template void NodeBlockPattern::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&,
-                                         int) const;
-template void NodeBlockPattern::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&,
-                                         int) const;
+template void NodeBlockPattern::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&, int,
+                                         Kernel) const;
+template void NodeBlockPattern::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&, int,
+                                         Kernel) const;
 
 }  // namespace topopt::fem

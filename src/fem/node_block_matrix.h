@@ -3,8 +3,9 @@
 // summed in one walk. For the products that dominate an iterative solve (CG's matvec, the
 // multigrid's finest smoother and residual): on a matrix shaped like the rocker's K (5 M entries,
 // one thread) 1.4–2.2 ms a product in single precision against 2.4–2.9 ms for the row walk of
-// sparse_product (BENCHMARKS.md, branch speed10). The multigrid's transfers (prolongator and
-// restriction) in blocks of a node's rows by an aggregate's coarse dofs (BlockPattern, branch speed14).
+// sparse_product (BENCHMARKS.md, branch speed10); a node's three rows in one AVX register's lanes
+// cut it by a third more (branch speed17). The multigrid's transfers (prolongator and restriction)
+// in blocks of a node's rows by an aggregate's coarse dofs (BlockPattern, branch speed14).
 #pragma once
 #include <vector>
 
@@ -32,19 +33,28 @@ struct NodeBlockPattern {
   /// row, or more than kMaxFill padded values per entry.
   bool build(const CsrMatrix& M);
   bool empty() const { return nodes == 0; }
-  /// Values of M (M.val, same pattern as build's) in the blocks' layout: 9 per block, row-major
-  /// within a block, padding 0. `out` is resized.
+  /// The product's kernels: one row at a time, or a node's three rows in the lanes of one AVX
+  /// register (x86-64 CPUs from 2011 on). Both add each row's terms in the row walk's order and
+  /// round alike: the same values to the bit.
+  enum class Kernel { Scalar, Avx };
+  /// The kernel this CPU runs fastest: Avx where it has AVX, else Scalar.
+  static Kernel fastest_kernel();
+  /// The number of block values: 9 per block and one more (read, never used, by the AVX kernel's
+  /// last column; 0).
+  size_t values() const { return 9 * col.size() + 1; }
+  /// Values of M (M.val, same pattern as build's) in the blocks' layout: 9 per block, column-major
+  /// within a block (a column's 3 rows side by side), padding 0; values() in all. `out` is resized.
   template <class Value>
   void fill(const CsrMatrix& M, std::vector<Value>& out) const;
   /// fill's double values and their single-precision copy in one walk over M. A refill of vectors
   /// of the right size (SIMP's next matrix, the same pattern) writes M's entries only: the padding
   /// is still the zeros the first fill wrote.
   void fill(const CsrMatrix& M, std::vector<double>& exact, std::vector<float>& single) const;
-  /// y = M x with the block values `val` (fill's), on `threads` threads. x, y: M.rows.
+  /// y = M x with the block values `val` (fill's), on `threads` threads, by `kernel`. x, y: M.rows.
   /// `scratch`: a work vector (the padded x), resized here.
   template <class Value>
-  void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
-                int threads) const;
+  void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch, int threads,
+                Kernel kernel = fastest_kernel()) const;
 
  private:
   /// Both fills' one walk over M: put(index in the blocks' values, M's value) for every entry.

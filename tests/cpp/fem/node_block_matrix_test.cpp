@@ -80,6 +80,41 @@ TEST(NodeBlockMatrix, ProductsEqualTheRowWalkToTheBit) {
   expect_row_walk_sums(node_matrix(300, {3, 3, 3, 2, 3, 3, 3, 3, 1, 3, 3, 3}, 2), true);
 }
 
+TEST(NodeBlockMatrix, BothKernelsEqualTheRowWalkToTheBit) {
+  // the AVX kernel (a node's three rows in one register's lanes) and the scalar one, each against
+  // the row walk in double and single precision, with and without padded nodes, on 1 and 2 threads
+  using Kernel = NodeBlockPattern::Kernel;
+  const bool avx = __builtin_cpu_supports("avx");
+  EXPECT_EQ(NodeBlockPattern::fastest_kernel(), avx ? Kernel::Avx : Kernel::Scalar);
+  for (const std::vector<int>& sizes : {std::vector<int>{3}, std::vector<int>{3, 3, 3, 2, 3, 3, 3, 3, 1, 3, 3, 3}}) {
+    const CsrMatrix M = node_matrix(400, sizes, 31);
+    NodeBlockPattern p;
+    ASSERT_TRUE(p.build(M));
+    std::vector<double> vd, scratch;
+    std::vector<float> vf;
+    p.fill(M, vd);
+    p.fill(M, vf);
+    ASSERT_EQ(vd.size(), p.values());
+    const std::vector<float> single(M.val.begin(), M.val.end());
+    std::mt19937 rng(32);
+    std::normal_distribution<double> N;
+    Eigen::VectorXd x(M.cols), walk(M.rows), walk_f(M.rows);
+    for (int i = 0; i < M.cols; ++i) x[i] = N(rng);
+    sparse_product(M, M.val.data(), x.data(), walk.data(), 1);
+    sparse_product(M, single.data(), x.data(), walk_f.data(), 1);
+    for (Kernel kernel : {Kernel::Scalar, Kernel::Avx}) {
+      if (kernel == Kernel::Avx && !avx) continue;
+      for (int threads : {1, 2}) {
+        Eigen::VectorXd y(M.rows), y_f(M.rows);
+        p.multiply(vd, x.data(), y.data(), scratch, threads, kernel);
+        p.multiply(vf, x.data(), y_f.data(), scratch, threads, kernel);
+        EXPECT_EQ(y, walk) << static_cast<int>(kernel) << ", " << threads << " threads";
+        EXPECT_EQ(y_f, walk_f) << static_cast<int>(kernel) << ", " << threads << " threads";
+      }
+    }
+  }
+}
+
 TEST(NodeBlockMatrix, OneWalkFillsBothPrecisionsAndARefillKeepsThePaddingZero) {
   CsrMatrix M = node_matrix(200, {3, 3, 3, 2, 3, 3, 3, 3, 1, 3, 3, 3}, 6);
   NodeBlockPattern p;
