@@ -214,7 +214,7 @@ template <int RB, int CB>
 template <class Value>
 void BlockPattern<RB, CB>::fill(const CsrMatrix& M, std::vector<Value>& out) const {
   constexpr long kValues = RB * CB;
-  out.assign(kValues * col.size(), Value(0));
+  out.assign(values(), Value(0));
   for (int b = 0; b < row_blocks; ++b) {
     const int r0 = row_first[b], nr = row_first[b + 1] - r0, len = M.ptr[r0 + 1] - M.ptr[r0];
     int blk = ptr[b];
@@ -222,35 +222,80 @@ void BlockPattern<RB, CB>::fill(const CsrMatrix& M, std::vector<Value>& out) con
       const int c = M.col[M.ptr[r0] + k];
       // a block's entries are consecutive and the blocks in the row's order: past this one, the next
       if (c < col_first[col[blk]] || c >= col_first[col[blk] + 1]) ++blk;
-      Value* v = &out[kValues * blk + (c - col_first[col[blk]])];
-      for (int r = 0; r < nr; ++r) v[CB * r] = static_cast<Value>(M.val[M.ptr[r0 + r] + k]);
+      Value* v = &out[kValues * blk + RB * (c - col_first[col[blk]])];  // a block's column c at RB c
+      for (int r = 0; r < nr; ++r) v[r] = static_cast<Value>(M.val[M.ptr[r0 + r] + k]);
     }
   }
 }
 
+namespace {
+
+/// y's rows of row blocks b .. e − 1 of a BlockPattern p (RB × CB blocks, column-major values
+/// `bv`; the padded x `xs`, CB a column block), one row at a time: each row's terms in the row
+/// walk's order, block by block, columns increasing.
+template <int RB, int CB, class Value>
+void scalar_transfer_rows(const BlockPattern<RB, CB>& p, const Value* bv, const double* xs, double* y, long b, long e) {
+  for (long n = b; n < e; ++n) {
+    double s[RB] = {};
+    for (int k = p.ptr[n]; k < p.ptr[n + 1]; ++k) {
+      const double* xv = xs + static_cast<long>(CB) * p.col[k];
+      const Value* v = bv + static_cast<long>(RB * CB) * k;
+      for (int c = 0; c < CB; ++c)
+        for (int r = 0; r < RB; ++r) s[r] += v[RB * c + r] * xv[c];
+    }
+    const int r0 = p.row_first[n], nr = p.row_first[n + 1] - r0;
+    for (int r = 0; r < nr; ++r) y[r0 + r] = s[r];
+  }
+}
+
+/// Two of a column's values as doubles (rows 4 and 5 of the restriction's 6).
+__attribute__((target("avx"))) inline __m128d pair_of(const float* v) {
+  return _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(v))));
+}
+__attribute__((target("avx"))) inline __m128d pair_of(const double* v) { return _mm_loadu_pd(v); }
+
+/// scalar_transfer_rows with a block's rows in the lanes of AVX registers (RB = 3: one register,
+/// its fourth lane reading the next value — the next column's, block's, or the fill's one past the
+/// end — and never stored; RB = 6: four lanes and two): each row's products and sums in the scalar
+/// order, rounded alike (no fused multiply-add), the same values to the bit.
+template <int RB, int CB, class Value>
+__attribute__((target("avx"))) void avx_transfer_rows(const BlockPattern<RB, CB>& p, const Value* bv, const double* xs,
+                                                      double* y, long b, long e) {
+  static_assert(RB == 3 || RB == 6, "the transfers' blocks: 3 or 6 rows");
+  for (long n = b; n < e; ++n) {
+    __m256d lo = _mm256_setzero_pd();  // rows 0-3 (0-2 and a lane not used when RB = 3)
+    __m128d hi = _mm_setzero_pd();     // rows 4-5 when RB = 6
+    for (int k = p.ptr[n]; k < p.ptr[n + 1]; ++k) {
+      const double* xv = xs + static_cast<long>(CB) * p.col[k];
+      const Value* v = bv + static_cast<long>(RB * CB) * k;
+      for (int c = 0; c < CB; ++c, v += RB) {
+        const __m256d x = _mm256_broadcast_sd(xv + c);
+        lo = _mm256_add_pd(lo, _mm256_mul_pd(column_of(v), x));
+        if (RB == 6) hi = _mm_add_pd(hi, _mm_mul_pd(pair_of(v + 4), _mm256_castpd256_pd128(x)));
+      }
+    }
+    alignas(32) double sum[8];
+    _mm256_store_pd(sum, lo);
+    _mm_store_pd(sum + 4, hi);
+    const int r0 = p.row_first[n], nr = p.row_first[n + 1] - r0;
+    for (int r = 0; r < nr; ++r) y[r0 + r] = sum[r];
+  }
+}
+
+}  // namespace
+
 template <int RB, int CB>
 template <class Value>
 void BlockPattern<RB, CB>::multiply(const std::vector<Value>& val, const double* x, double* y,
-                                    std::vector<double>& scratch, int threads) const {
+                                    std::vector<double>& scratch, int threads, Kernel kernel) const {
   const double* xs = padded_x(col_first, CB, padded, x, scratch, threads);  // CB entries per column block
-  const int* bp = ptr.data();
-  const int* bc = col.data();
-  const Value* bv = val.data();
   parallel_for(
       row_blocks, threads,
       [&](long b, long e) {
-        for (long n = b; n < e; ++n) {
-          // each row's terms in the row walk's order: block by block, columns increasing
-          double s[RB] = {};
-          for (int k = bp[n]; k < bp[n + 1]; ++k) {
-            const double* xv = xs + static_cast<long>(CB) * bc[k];
-            const Value* v = bv + static_cast<long>(RB * CB) * k;
-            for (int c = 0; c < CB; ++c)
-              for (int r = 0; r < RB; ++r) s[r] += v[CB * r + c] * xv[c];
-          }
-          const int r0 = row_first[n], nr = row_first[n + 1] - r0;
-          for (int r = 0; r < nr; ++r) y[r0 + r] = s[r];
-        }
+        if (kernel == Kernel::Avx)
+          avx_transfer_rows(*this, val.data(), xs, y, b, e);
+        else
+          scalar_transfer_rows(*this, val.data(), xs, y, b, e);
       },
       512);
 }
@@ -261,14 +306,14 @@ template void BlockPattern<3, 6>::fill(const CsrMatrix&, std::vector<float>&) co
 template void BlockPattern<3, 6>::fill(const CsrMatrix&, std::vector<double>&) const;
 template void BlockPattern<6, 3>::fill(const CsrMatrix&, std::vector<float>&) const;
 template void BlockPattern<6, 3>::fill(const CsrMatrix&, std::vector<double>&) const;
-template void BlockPattern<3, 6>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&,
-                                           int) const;
+template void BlockPattern<3, 6>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&, int,
+                                           Kernel) const;
 template void BlockPattern<3, 6>::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&,
-                                           int) const;
-template void BlockPattern<6, 3>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&,
-                                           int) const;
+                                           int, Kernel) const;
+template void BlockPattern<6, 3>::multiply(const std::vector<float>&, const double*, double*, std::vector<double>&, int,
+                                           Kernel) const;
 template void BlockPattern<6, 3>::multiply(const std::vector<double>&, const double*, double*, std::vector<double>&,
-                                           int) const;
+                                           int, Kernel) const;
 
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<float>&) const;
 template void NodeBlockPattern::fill(const CsrMatrix&, std::vector<double>&) const;

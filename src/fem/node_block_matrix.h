@@ -90,15 +90,21 @@ struct BlockPattern {
   /// kMaxFill stored values per entry.
   bool build(const CsrMatrix& M, const std::vector<int>& columns);
   bool empty() const { return row_blocks == 0; }
-  /// Values of M (same pattern as build's) in the blocks' layout: RB × CB per block, row-major
-  /// within a block, padding 0. `out` is resized.
+  /// The product's kernels, as NodeBlockPattern's: a block's RB rows one at a time or in the
+  /// lanes of AVX registers, the same values to the bit.
+  using Kernel = NodeBlockPattern::Kernel;
+  /// The number of block values: RB × CB per block and one more (read, never used, by the AVX
+  /// kernel's last column when RB = 3; 0).
+  size_t values() const { return static_cast<size_t>(RB * CB) * col.size() + 1; }
+  /// Values of M (same pattern as build's) in the blocks' layout: RB × CB per block, column-major
+  /// within a block (a column's RB rows side by side), padding 0; values() in all. `out` is resized.
   template <class Value>
   void fill(const CsrMatrix& M, std::vector<Value>& out) const;
-  /// y = M x with the block values `val` (fill's), on `threads` threads. x: M.cols, y: M.rows.
-  /// `scratch`: a work vector (the padded x), resized here.
+  /// y = M x with the block values `val` (fill's), on `threads` threads, by `kernel`. x: M.cols,
+  /// y: M.rows. `scratch`: a work vector (the padded x), resized here.
   template <class Value>
-  void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
-                int threads) const;
+  void multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch, int threads,
+                Kernel kernel = NodeBlockPattern::fastest_kernel()) const;
 };
 
 /// The multigrid's transfers in blocks: P from fine node blocks to aggregates, R = Pᵀ back.

@@ -40,8 +40,8 @@ CsrMatrix node_matrix(int nodes, const std::vector<int>& sizes, unsigned seed) {
 }
 
 /// The products of pattern p (built from M) with M's values in double and in single precision,
-/// on 1 and 2 threads, against sparse_product's row walk (to the bit) and dense arithmetic, for a
-/// random x drawn with `seed`.
+/// on 1 and 2 threads, by the scalar kernel and (where the CPU has AVX) the AVX one, against
+/// sparse_product's row walk (to the bit) and dense arithmetic, for a random x drawn with `seed`.
 template <class Pattern>
 void expect_products_equal_the_row_walk(const Pattern& p, const CsrMatrix& M, unsigned seed) {
   std::vector<double> vd, scratch;
@@ -54,17 +54,21 @@ void expect_products_equal_the_row_walk(const Pattern& p, const CsrMatrix& M, un
   Eigen::VectorXd x(M.cols);
   for (int i = 0; i < M.cols; ++i) x[i] = N(rng);
   const Eigen::VectorXd ref = dense(M) * x;
-  for (int threads : {1, 2}) {
-    Eigen::VectorXd walk(M.rows), blocks(M.rows), walk_f(M.rows), blocks_f(M.rows);
-    sparse_product(M, M.val.data(), x.data(), walk.data(), threads);
-    p.multiply(vd, x.data(), blocks.data(), scratch, threads);
-    sparse_product(M, single.data(), x.data(), walk_f.data(), threads);
-    p.multiply(vf, x.data(), blocks_f.data(), scratch, threads);
-    EXPECT_EQ(blocks, walk) << threads << " threads";  // the same terms in the same order
-    EXPECT_EQ(blocks_f, walk_f) << threads << " threads";
-    EXPECT_LT((blocks - ref).norm(), 1e-13 * ref.norm());
-    EXPECT_GT((blocks_f - blocks).norm(), 0.0);  // the float values were read
-  }
+  using Kernel = NodeBlockPattern::Kernel;
+  for (Kernel kernel : {Kernel::Scalar, Kernel::Avx})
+    for (int threads : {1, 2}) {
+      if (kernel == Kernel::Avx && !__builtin_cpu_supports("avx")) continue;
+      Eigen::VectorXd walk(M.rows), blocks(M.rows), walk_f(M.rows), blocks_f(M.rows);
+      sparse_product(M, M.val.data(), x.data(), walk.data(), threads);
+      p.multiply(vd, x.data(), blocks.data(), scratch, threads, kernel);
+      sparse_product(M, single.data(), x.data(), walk_f.data(), threads);
+      p.multiply(vf, x.data(), blocks_f.data(), scratch, threads, kernel);
+      const int k = static_cast<int>(kernel);
+      EXPECT_EQ(blocks, walk) << "kernel " << k << ", " << threads << " threads";  // the same terms, order
+      EXPECT_EQ(blocks_f, walk_f) << "kernel " << k << ", " << threads << " threads";
+      EXPECT_LT((blocks - ref).norm(), 1e-13 * ref.norm());
+      EXPECT_GT((blocks_f - blocks).norm(), 0.0);  // the float values were read
+    }
 }
 
 void expect_row_walk_sums(const CsrMatrix& M, bool padded) {
