@@ -1,13 +1,16 @@
 // Sparse matrix kernels (see csr_matrix.h).
 #include "fem/csr_matrix.h"
 
-#include <immintrin.h>
 #include <algorithm>
 #include <cassert>
 #include <numeric>
 
 #include "common/parallel.h"
 #include "fem/node_block_matrix.h"
+
+#if TOPOPT_AVX_KERNELS
+#include <immintrin.h>
+#endif
 
 namespace topopt::fem {
 
@@ -98,6 +101,7 @@ struct ScalarColumns {
   }
 };
 
+#if TOPOPT_AVX_KERNELS
 /// ScalarColumns with M's three rows in one AVX register's lanes where the block and B's row
 /// block are full (n = pn = 3): each row's products and sums in the scalar order, rounded alike (no
 /// fused multiply-add), the same values to the bit. The fourth lane reads a[3 + 3 c] (the next
@@ -115,6 +119,7 @@ struct AvxColumns {
   }
 };
 static_assert(CsrMatrix::kMaxBlock >= 4, "AvxColumns writes four sums a column");
+#endif
 
 /// The rows of row block `blk` of M B summed into `w` as block_rows_times sums them from M's
 /// compressed rows (the same terms in the same order: M's columns increase, and B's rows of a
@@ -157,11 +162,13 @@ void scalar_node_block_rows(const NodeBlockPattern& nb, const double* val, const
                             RowAccumulator& w) {
   node_block_rows_times<NR, ScalarColumns>(nb, val, B, blk, w);
 }
+#if TOPOPT_AVX_KERNELS
 template <int NR>
 __attribute__((target("avx"), flatten)) void avx_node_block_rows(const NodeBlockPattern& nb, const double* val,
                                                                  const CsrMatrix& B, int blk, RowAccumulator& w) {
   node_block_rows_times<NR, AvxColumns>(nb, val, B, blk, w);
 }
+#endif
 
 /// add_product_rows for one row block of A (rows r0 .. r0 + nr − 1, from its entry k on, while
 /// the column is below `last`): the terms of X's rows, added into the block's rows of C at the
@@ -272,11 +279,14 @@ CsrMatrix multiply_rows(const CsrMatrix& A, const CsrMatrix& B, long first, long
 CsrMatrix multiply_rows(const NodeBlockPattern& nb, const std::vector<double>& val, const CsrMatrix& A,
                         const CsrMatrix& B, long first, long last, int threads) {
   assert(B.blocks == nb.first && A.blocks == nb.first);
-  const bool avx = NodeBlockPattern::fastest_kernel() == NodeBlockPattern::Kernel::Avx;
+  [[maybe_unused]] const bool avx = NodeBlockPattern::fastest_kernel() == NodeBlockPattern::Kernel::Avx;
   return product_rows(A, B, first, last, threads, [&](int, int nr, int blk, RowAccumulator& w) {
+#if TOPOPT_AVX_KERNELS
     if (avx)
-      nr == 3 ? avx_node_block_rows<3>(nb, val.data(), B, blk, w) : avx_node_block_rows<0>(nb, val.data(), B, blk, w);
-    else if (nr == 3)
+      return nr == 3 ? avx_node_block_rows<3>(nb, val.data(), B, blk, w)
+                     : avx_node_block_rows<0>(nb, val.data(), B, blk, w);
+#endif
+    if (nr == 3)
       scalar_node_block_rows<3>(nb, val.data(), B, blk, w);
     else
       scalar_node_block_rows<0>(nb, val.data(), B, blk, w);

@@ -1,7 +1,9 @@
 // 3×3 node blocks of the elasticity matrix (see node_block_matrix.h).
 #include "fem/node_block_matrix.h"
 
+#if TOPOPT_AVX_KERNELS
 #include <immintrin.h>
+#endif
 
 #include "common/parallel.h"
 
@@ -91,7 +93,11 @@ void NodeBlockPattern::fill(const CsrMatrix& M, std::vector<double>& exact, std:
 }
 
 NodeBlockPattern::Kernel NodeBlockPattern::fastest_kernel() {
+#if TOPOPT_AVX_KERNELS
   return __builtin_cpu_supports("avx") ? Kernel::Avx : Kernel::Scalar;
+#else
+  return Kernel::Scalar;
+#endif
 }
 
 namespace {
@@ -119,6 +125,7 @@ void scalar_block_rows(const NodeBlockPattern& p, const Value* bv, const double*
   }
 }
 
+#if TOPOPT_AVX_KERNELS
 /// A block's column as four doubles (its three rows and the next value, which no row uses).
 __attribute__((target("avx"))) inline __m256d column_of(const float* v) { return _mm256_cvtps_pd(_mm_loadu_ps(v)); }
 __attribute__((target("avx"))) inline __m256d column_of(const double* v) { return _mm256_loadu_pd(v); }
@@ -149,19 +156,21 @@ __attribute__((target("avx"))) void avx_block_rows(const NodeBlockPattern& p, co
   }
 }
 
+#endif
+
 }  // namespace
 
 template <class Value>
 void NodeBlockPattern::multiply(const std::vector<Value>& val, const double* x, double* y, std::vector<double>& scratch,
-                                int threads, Kernel kernel) const {
+                                int threads, [[maybe_unused]] Kernel kernel) const {
   const double* xs = padded_x(first, 3, padded, x, scratch, threads);  // 3 entries per row block
   parallel_for(
       nodes, threads,
       [&](long b, long e) {
-        if (kernel == Kernel::Avx)
-          avx_block_rows(*this, val.data(), xs, y, b, e);
-        else
-          scalar_block_rows(*this, val.data(), xs, y, b, e);
+#if TOPOPT_AVX_KERNELS
+        if (kernel == Kernel::Avx) return avx_block_rows(*this, val.data(), xs, y, b, e);
+#endif
+        scalar_block_rows(*this, val.data(), xs, y, b, e);
       },
       1024);
 }
@@ -248,6 +257,7 @@ void scalar_transfer_rows(const BlockPattern<RB, CB>& p, const Value* bv, const 
   }
 }
 
+#if TOPOPT_AVX_KERNELS
 /// Two of a column's values as doubles (rows 4 and 5 of the restriction's 6).
 __attribute__((target("avx"))) inline __m128d pair_of(const float* v) {
   return _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(v))));
@@ -282,20 +292,22 @@ __attribute__((target("avx"))) void avx_transfer_rows(const BlockPattern<RB, CB>
   }
 }
 
+#endif
+
 }  // namespace
 
 template <int RB, int CB>
 template <class Value>
 void BlockPattern<RB, CB>::multiply(const std::vector<Value>& val, const double* x, double* y,
-                                    std::vector<double>& scratch, int threads, Kernel kernel) const {
+                                    std::vector<double>& scratch, int threads, [[maybe_unused]] Kernel kernel) const {
   const double* xs = padded_x(col_first, CB, padded, x, scratch, threads);  // CB entries per column block
   parallel_for(
       row_blocks, threads,
       [&](long b, long e) {
-        if (kernel == Kernel::Avx)
-          avx_transfer_rows(*this, val.data(), xs, y, b, e);
-        else
-          scalar_transfer_rows(*this, val.data(), xs, y, b, e);
+#if TOPOPT_AVX_KERNELS
+        if (kernel == Kernel::Avx) return avx_transfer_rows(*this, val.data(), xs, y, b, e);
+#endif
+        scalar_transfer_rows(*this, val.data(), xs, y, b, e);
       },
       512);
 }

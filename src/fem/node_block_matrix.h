@@ -11,6 +11,14 @@
 
 #include "fem/csr_matrix.h"
 
+// The AVX kernels need an x86 CPU and GCC's or Clang's target attribute; elsewhere (ARM, MSVC)
+// only the scalar kernels are built, and fastest_kernel() is Scalar.
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
+#define TOPOPT_AVX_KERNELS 1
+#else
+#define TOPOPT_AVX_KERNELS 0
+#endif
+
 namespace topopt::fem {
 
 /// The pattern of a square CsrMatrix whose row blocks (CsrMatrix::blocks: a mesh node's free
