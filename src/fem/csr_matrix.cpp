@@ -170,26 +170,50 @@ __attribute__((target("avx"), flatten)) void avx_node_block_rows(const NodeBlock
 }
 #endif
 
+/// The terms of X's rows i .. i + m − 1 (m = 1, or 3: a node block of X, its rows sharing their
+/// columns) into C's rows c[0 .. n − 1] at the places `slot` gives their columns, with A's values
+/// a[0 .. m − 1][r]: each entry of C takes row i's term, then row i + 1's, then row i + 2's, in
+/// that order whatever m (one pass over the block's columns for three), the same additions.
+template <int NR, int M>
+void add_row_terms(const CsrMatrix& X, int i, const double (*a)[CsrMatrix::kMaxBlock], int n, const int* slot,
+                   double* const* c) {
+  const int p0 = X.ptr[i], len = X.ptr[i + 1] - p0;
+  const int* xc = X.col.data() + p0;
+  const double* xv[3];
+  for (int m = 0; m < M; ++m) xv[m] = X.val.data() + X.ptr[i + m];
+  for (int kx = 0; kx < len; ++kx) {
+    const int t = slot[xc[kx]];
+    for (int r = 0; r < (NR ? NR : n); ++r) {
+      double s = c[r][t];
+      for (int m = 0; m < M; ++m) s += a[m][r] * xv[m][kx];
+      c[r][t] = s;
+    }
+  }
+}
+
 /// add_product_rows for one row block of A (rows r0 .. r0 + nr − 1, from its entry k on, while
 /// the column is below `last`): the terms of X's rows, added into the block's rows of C at the
-/// places `slot` gives their columns. Returns the first entry not added. NR as in
-/// block_rows_times.
+/// places `slot` gives their columns; three of X's rows at a time where A's next three entries
+/// are a node block of X (`triple`: X's rows that start one). Returns the first entry not added.
+/// NR as in block_rows_times.
 template <int NR>
-int add_block_terms(const CsrMatrix& A, const CsrMatrix& X, int first, int last, int r0, int nr, int k,
-                    const int* slot, CsrMatrix& C) {
+int add_block_terms(const CsrMatrix& A, const CsrMatrix& X, int first, int last, int r0, int nr, int k, const int* slot,
+                    const char* triple, CsrMatrix& C) {
   constexpr int kB = CsrMatrix::kMaxBlock;
   const int n = NR ? NR : nr, end = A.ptr[r0 + 1];
   double* c[kB];
   for (int r = 0; r < n; ++r) c[r] = &C.val[C.ptr[r0 + r]];
-  for (; k < end && A.col[k] < last; ++k) {
+  while (k < end && A.col[k] < last) {
     const int i = A.col[k] - first, offset = k - A.ptr[r0];
-    double a[kB];
-    for (int r = 0; r < n; ++r) a[r] = A.val[A.ptr[r0 + r] + offset];
-    for (int kx = X.ptr[i]; kx < X.ptr[i + 1]; ++kx) {
-      const int t = slot[X.col[kx]];
-      const double v = X.val[kx];
-      for (int r = 0; r < n; ++r) c[r][t] += a[r] * v;
-    }
+    const int m = triple[i] && k + 2 < end && A.col[k + 2] == A.col[k] + 2 ? 3 : 1;  // columns increase
+    double a[3][kB];
+    for (int q = 0; q < m; ++q)
+      for (int r = 0; r < n; ++r) a[q][r] = A.val[A.ptr[r0 + r] + offset + q];
+    if (m == 3)
+      add_row_terms<NR, 3>(X, i, a, n, slot, c);
+    else
+      add_row_terms<NR, 1>(X, i, a, n, slot, c);
+    k += m;
   }
   return k;
 }
@@ -300,6 +324,8 @@ void add_product_rows(const CsrMatrix& A, const CsrMatrix& X, int first, std::ve
   const long nblocks = row_blocks(A);
   const int last = first + X.rows;
   assert(static_cast<long>(cursor.size()) == nblocks);
+  std::vector<char> triple(X.rows, 0);  // X's rows that start a node block of 3 (sharing columns)
+  for (size_t b = 0; b + 1 < X.blocks.size(); ++b) triple[X.blocks[b]] = X.blocks[b + 1] - X.blocks[b] == 3;
   parallel_for(
       nblocks, threads,
       [&](long bb, long be) {
@@ -312,8 +338,8 @@ void add_product_rows(const CsrMatrix& A, const CsrMatrix& X, int first, std::ve
           const int c0 = C.ptr[r0], clen = C.ptr[r0 + 1] - c0;
           for (int t = 0; t < clen; ++t) slot[C.col[c0 + t]] = t;
           // an aggregate's six coarse dofs (elasticity), or any count
-          cursor[blk] = nr == 6 ? add_block_terms<6>(A, X, first, last, r0, nr, k, slot.data(), C)
-                                : add_block_terms<0>(A, X, first, last, r0, nr, k, slot.data(), C);
+          cursor[blk] = nr == 6 ? add_block_terms<6>(A, X, first, last, r0, nr, k, slot.data(), triple.data(), C)
+                                : add_block_terms<0>(A, X, first, last, r0, nr, k, slot.data(), triple.data(), C);
         }
       },
       512);

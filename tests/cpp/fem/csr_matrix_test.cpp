@@ -128,6 +128,28 @@ TEST(CsrMatrix, ProductBySlicesMatchesAFreshProductToTheBit) {
   }
 }
 
+TEST(CsrMatrix, ProductBySlicesTakesANodesThreeRowsInOnePassToTheBit) {
+  // R = Pᵀ with P's rows in node blocks of 3 sharing their columns (the prolongator's), so R's
+  // rows meet a node's three rows together; X = B's rows in node blocks of 3, a slice at a time on
+  // block boundaries with its blocks (the refresh's A P): add_product_rows adds a node's three
+  // rows of X in one pass where R's entries reach all three. The fresh product's values to the bit.
+  const CsrMatrix P = random_blocked(30, 8, 3, 41), B = random_blocked(30, 7, 3, 42);
+  const CsrMatrix R = transpose(P);  // one row a block, columns increasing
+  const CsrMatrix fresh = multiply(R, B, 1);
+  for (int threads : {1, 2}) {
+    CsrMatrix C = fresh;
+    std::fill(C.val.begin(), C.val.end(), 0.0);
+    std::vector<int> cursor(R.ptr.begin(), R.ptr.end() - 1);
+    for (const auto& [first, last] : {std::pair{0, 9}, std::pair{9, 12}, std::pair{12, 30}}) {
+      CsrMatrix X = rows_of(B, first, last);
+      for (int r = 0; r <= X.rows; r += 3) X.blocks.push_back(r);
+      ASSERT_TRUE(X.blocks_consistent());
+      add_product_rows(R, X, first, cursor, C, threads);
+    }
+    EXPECT_EQ(C.val, fresh.val) << threads << " threads";
+  }
+}
+
 TEST(CsrMatrix, InconsistentBlocksAreDetected) {
   CsrMatrix A;  // rows 0 and 1 on columns {0, 1}, row 2 on {2}, row 3 on {2, 3}
   A.rows = A.cols = 4;
