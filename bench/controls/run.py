@@ -144,8 +144,9 @@ def overhang_on_given_faces(stl, up, vtu, angle=45.0, tol=1e-3):
 
 def member_columns(build, out, size, mesh_size, stdout):
     """For a run with a minimum member size: the crisp design the user gets (the run's cleaned
-    densities, `design` in density.vtu, through the node densities at the run's threshold, as
-    bench/result/crisp.py takes it) measured by the product's member measure
+    densities, `design` in density.vtu, through the node densities at the run's threshold, by the
+    product's rule: crisp.crisp_tets(product=True); before branch member10 every node of a
+    non-design tet read 1 here, which added a skin one tet thick over the non-design faces) measured by the product's member measure
     (simp/controls/member_measure.h, reach of a mesh size): its smallest member, the share of its
     solid design tets thinner than the size less a mesh size (the measure's resolution), and the
     crisp design's compliance that `topopt optimize` prints with its verification."""
@@ -156,7 +157,8 @@ def member_columns(build, out, size, mesh_size, stdout):
     points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
     h = json.load(open(os.path.join(out, "history.json")))
     domain = arrays["domain"].astype(np.int64)
-    solid = crisp.crisp_tets(points, tets, domain, arrays["design"], h["threshold"]).astype(float)
+    # the product's crisp design (src/result/design_hygiene's crisp_tets of iso_surface's node densities)
+    solid = crisp.crisp_tets(points, tets, domain, arrays["design"], h["threshold"], product=True).astype(float)
     m = _native.measure_members(points, tets, domain, solid, mesh_size)
     design_solid = (domain == 0) & (solid > 0.5)
     thin = (np.asarray(m["thickness"])[design_solid] < size - mesh_size).mean() if design_solid.any() else 0.0

@@ -37,24 +37,32 @@ def grey_share(density, domain, volume, lo=0.1, hi=0.9):
     return volume[grey].sum() / volume[d].sum()
 
 
-def node_densities(points, tets, domain, density):
-    """Volume-weighted mean of the tets' densities around each node, 1 on non-design nodes
-    (what src/result/iso_surface does)."""
+def node_densities(points, tets, domain, density, product=False):
+    """Volume-weighted mean of the tets' densities around each node, 1 on non-design nodes.
+    product=True: what src/result/iso_surface's node_densities does — the mean over the design tets
+    only, 1 on the nodes no design tet touches (a node on a non-design solid's face then reads the
+    design beside it, not 1; the default reads every such node solid, a skin one tet thick over
+    the non-design faces that the product's crisp design does not hold)."""
     vol = np.abs(tet_volumes(points, tets))
+    if product:
+        vol = vol * (domain == 0)
     num = np.zeros(len(points))
     den = np.zeros(len(points))
     for a in range(4):
         np.add.at(num, tets[:, a], vol * density)
         np.add.at(den, tets[:, a], vol)
     nd = num / np.maximum(den, 1e-300)
+    if product:
+        return np.where(den > 0, nd, 1.0)
     nd[np.unique(tets[domain != 0])] = 1.0
     return nd
 
 
-def crisp_tets(points, tets, domain, density, threshold):
+def crisp_tets(points, tets, domain, density, threshold, product=False):
     """Tets of the crisp design: non-design tets, and design tets where the node-density field
-    at the centroid (the mean of its four nodes) reaches the threshold of the result shape."""
-    nd = node_densities(points, tets, domain, density)
+    at the centroid (the mean of its four nodes) reaches the threshold of the result shape
+    (product: node_densities' rule)."""
+    nd = node_densities(points, tets, domain, density, product)
     return (domain != 0) | (nd[tets].mean(axis=1) >= threshold)
 
 

@@ -100,10 +100,14 @@ struct MemberSizeParams {
   /// thickness s reads 1 − e^(−s/2ℓ) at most; on the bracket (10 mm plates, 9 mm, ℓ = 3.42 mm) that
   /// is 0.77, so a member must be about 21 mm wide in the plane to survive erosion (η_e = 0.75)
   /// and the eroded design came apart at volume 0.3 and 0.45 (docs/optimization.md, branch
-  /// member9); at 1.5 sizes a full-thickness member of 1.3 sizes survives (the cantilever, 10 mm at
-  /// 6 mm). A member spanning the part's thickness is the part's, not the design's, as the member
-  /// measure counts it (PartFaces::Clipped). <= 0: every free face padded.
-  double pad_thickness = 1.5;
+  /// member9). Below two sizes a part holds no two members across its thickness with a gap of the
+  /// size between them, so what the padding guards against there — a member along a face read
+  /// as its mirror image, twice as thick — is a flange the size's gap leaves no room to pair;
+  /// padded, a member spanning 1.67 sizes (the cantilever, 10 mm at 6 mm) must be 1.33 sizes wide
+  /// to survive erosion, and the cantilever's eroded design came apart at volume 0.45 (branch
+  /// member10). A member spanning the part's thickness is the part's, not the design's, as the
+  /// member measure counts it (PartFaces::Clipped). <= 0: every free face padded.
+  double pad_thickness = 2.0;
   /// Largest member: no solid ball of this diameter (the local volume constraint, with MMA).
   double max_size = 0;
   double max_solid = 0.9;  ///< 1 − ε: the largest solid share of an element's ball; in (0.5, 1)
