@@ -302,25 +302,29 @@ TEST(MemberSize, AnErodedDesignThatCameApartIsNamed) {
   EXPECT_EQ(fits.find("does not join"), std::string::npos) << fits;
 }
 
-/// A plate 30 × 20 × 5 mm (1.25 mm cells) fixed at x = 0 (Face1), a non-design pad at x in [28, 30]
-/// pulled along −y on its end face (Face2): bent in its plane, so its members span its thickness.
-struct ThinPlate {
+/// A block 30 × 20 × t mm centred on y = z = 0, fixed at x = 0 (Face1), a non-design pad at x in
+/// [28, 30] pulled by `pull` (N) on its end face (Face2).
+struct PulledBlock {
   mesh::StructuredBoxParams box;
   TetMesh mesh;
   fem::Material mat;
   fem::Supports supports;
   Eigen::MatrixXd loads;
-  ThinPlate() {
-    box.origin = {0, -10, -2.5};
-    box.size = {30, 20, 5};
-    box.cells = {24, 16, 4};
-    box.nondesign = {{28, -10, -2.5, 30, 10, 2.5}};
+  PulledBlock(double t, std::array<int, 3> cells, std::array<double, 3> pull) {
+    box.origin = {0, -10, -t / 2};
+    box.size = {30, 20, t};
+    box.cells = cells;
+    box.nondesign = {{28, -10, -t / 2, 30, 10, t / 2}};
     mesh = mesh::structured_box_mesh(box);
     supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
-    fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, -100, 0}, 0, {}};
-    loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {pull}, 1}});
+    fem::LoadSpec force{fem::LoadSpec::Kind::Force, {2}, pull, 0, {}};
+    loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {force}, 1}});
   }
 };
+
+/// A plate 30 × 20 × 5 mm (1.25 mm cells) pulled along −y: bent in its plane, so its members span
+/// its thickness.
+PulledBlock thin_plate() { return PulledBlock(5, {24, 16, 4}, {0, -100, 0}); }
 
 TEST(MemberSize, FacesOfAPartThinnerThanTwoSizesAreNotPadded) {
   // thin_part_nodes flags the nodes of the faces behind which the part is thinner than the given
@@ -331,7 +335,7 @@ TEST(MemberSize, FacesOfAPartThinnerThanTwoSizesAreNotPadded) {
   // sizes), with the supports' and loads'.
   MemberSizeParams p;
   p.min_size = 4.5;
-  const ThinPlate plate;
+  const PulledBlock plate = thin_plate();
   const std::vector<char> thin = thin_part_nodes(plate.mesh, p.pad_thickness * p.min_size);
   long flagged = 0;
   for (long i = 0; i < plate.mesh.V.rows(); ++i) {
@@ -355,25 +359,9 @@ TEST(MemberSize, FacesOfAPartThinnerThanTwoSizesAreNotPadded) {
   EXPECT_EQ(unpadded_nodes(plate.mesh, plate.supports.dofs, plate.loads, p), held);
 }
 
-/// A wide beam 30 × 20 × 10 mm (cells of 1.67 mm) fixed at x = 0 (Face1), a non-design pad at x in [28, 30]
-/// pulled along −z on its end face (Face2): bent across its 10 mm thickness, as the bench's cantilever.
-struct WideBeam {
-  mesh::StructuredBoxParams box;
-  TetMesh mesh;
-  fem::Material mat;
-  fem::Supports supports;
-  Eigen::MatrixXd loads;
-  WideBeam() {
-    box.origin = {0, -10, -5};
-    box.size = {30, 20, 10};
-    box.cells = {18, 12, 6};
-    box.nondesign = {{28, -10, -5, 30, 10, 5}};
-    mesh = mesh::structured_box_mesh(box);
-    supports = fem::make_supports(mesh, {fem::support_on(fem::SupportSpec::Kind::Fixed, {1})});
-    fem::LoadSpec pull{fem::LoadSpec::Kind::Force, {2}, {0, 0, -100}, 0, {}};
-    loads = fem::make_loads(mesh, mat, {fem::LoadCase{"a", {pull}, 1}});
-  }
-};
+/// A wide beam 30 × 20 × 10 mm (cells of 1.67 mm) pulled along −z: bent across its 10 mm
+/// thickness, as the bench's cantilever.
+PulledBlock wide_beam() { return PulledBlock(10, {18, 12, 6}, {0, 0, -100}); }
 
 /// The smallest member (mm) of a crisp design (#T, 0/1) on beam b, by the product's measure with the
 /// reach of member_cell, over the solid design tets the minimum size holds (member_attachments:
@@ -412,7 +400,7 @@ TEST(MemberSize, APartThinnerThanTwoSizesIsNotPaddedSoItsErodedDesignCarriesTheL
   // compliance 18.2 → 256 N·mm, not joined; crisp design's smallest member 5.83 mm). Below two sizes
   // those faces are not padded (MemberSizeParams::pad_thickness): the eroded design joins the
   // support to the pad and the crisp design the user gets holds the set size, nothing added.
-  const WideBeam b;
+  const PulledBlock b = wide_beam();
   const double size = 6;
   SimpParams p;
   p.volume_fraction = 0.45;
