@@ -202,6 +202,26 @@ TEST(MemberSize, MinimumSizeHoldsOnTheCleanedResult) {
   EXPECT_LE(half.thinner2, 0.15);
 }
 
+/// The smallest member (mm) of a crisp design (#T, 0/1) on beam b, by the product's measure with the
+/// reach of member_cell, over the solid design tets the minimum size holds (member_attachments:
+/// not within a mesh size of the non-design pad, no node on the supported or loaded faces).
+template <class Beam>
+double smallest_held(const Beam& b, const VecXd& crisp) {
+  std::vector<char> anchors(b.mesh.V.rows(), 0);
+  for (int dof : b.supports.dofs) anchors[dof / 3] = 1;
+  for (long i = 0; i < b.loads.rows(); ++i)
+    if (b.loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] = 1;
+  const double cell = result::member_cell(b.mesh);
+  const std::vector<char> attached = result::member_attachments(b.mesh, anchors, cell);
+  MemberMeasureParams mp;
+  mp.reach = cell;
+  const MemberMeasure m = measure_members(b.mesh, crisp, mp);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (long t = 0; t < crisp.size(); ++t)
+    if (crisp[t] > 0.5 && b.mesh.domain[t] == 0 && !attached[t]) smallest = std::min(smallest, m.thickness[t]);
+  return smallest;
+}
+
 TEST(MemberSize, TheSizeIsHeldOnTheResultWhereTheRobustDesignFallsShort) {
   // MinimumSizeHoldsOnTheCleanedResult's robust run (4 mm, volume 0.4, padded, 120 iterations),
   // whose crisp design keeps a foot 2.34 mm wide where a web meets the padded bottom face. The
@@ -223,16 +243,6 @@ TEST(MemberSize, TheSizeIsHeldOnTheResultWhereTheRobustDesignFallsShort) {
   for (long i = 0; i < b.loads.rows(); ++i)
     if (b.loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] |= result::kAnchorLoad;
   const double cell = result::member_cell(b.mesh);
-  const std::vector<char> attached = result::member_attachments(b.mesh, anchors, cell);
-  auto held_smallest = [&](const VecXd& crisp) {
-    MemberMeasureParams mp;
-    mp.reach = cell;
-    const MemberMeasure m = measure_members(b.mesh, crisp, mp);
-    double s = std::numeric_limits<double>::infinity();
-    for (long t = 0; t < crisp.size(); ++t)
-      if (crisp[t] > 0.5 && b.mesh.domain[t] == 0 && !attached[t]) s = std::min(s, m.thickness[t]);
-    return s;
-  };
   auto crisp_of = [&](const VecXd& cleaned) {
     const std::vector<char> solid = result::crisp_tets(b.mesh, result::node_densities(b.mesh, cleaned), 0.5);
     VecXd c(static_cast<long>(solid.size()));
@@ -244,7 +254,7 @@ TEST(MemberSize, TheSizeIsHeldOnTheResultWhereTheRobustDesignFallsShort) {
   result::HygieneParams hp;
   hp.min_member_size = size;
   const VecXd held = result::clean_design(b.mesh, robust.density, 0.5, anchors, hp, held_report);
-  const double before = held_smallest(crisp_of(plain)), after = held_smallest(crisp_of(held));
+  const double before = smallest_held(b, crisp_of(plain)), after = smallest_held(b, crisp_of(held));
   const result::MemberEnforcement& r = held_report.members;
   std::cout << "robust design: smallest member " << before << " mm; held: " << after << " mm (report " << r.smallest_before
             << " -> " << r.smallest_after << "), " << r.volume_added << " mm3 added of " << r.design_volume << ", "
@@ -362,26 +372,6 @@ TEST(MemberSize, FacesOfAPartThinnerThanTwoSizesAreNotPadded) {
 /// A wide beam 30 × 20 × 10 mm (cells of 1.67 mm) pulled along −z: bent across its 10 mm
 /// thickness, as the bench's cantilever.
 PulledBlock wide_beam() { return PulledBlock(10, {18, 12, 6}, {0, 0, -100}); }
-
-/// The smallest member (mm) of a crisp design (#T, 0/1) on beam b, by the product's measure with the
-/// reach of member_cell, over the solid design tets the minimum size holds (member_attachments:
-/// not within a mesh size of the non-design pad, no node on the supported or loaded faces).
-template <class Beam>
-double smallest_held(const Beam& b, const VecXd& crisp) {
-  std::vector<char> anchors(b.mesh.V.rows(), 0);
-  for (int dof : b.supports.dofs) anchors[dof / 3] = 1;
-  for (long i = 0; i < b.loads.rows(); ++i)
-    if (b.loads.row(i).cwiseAbs().maxCoeff() > 0) anchors[i / 3] = 1;
-  const double cell = result::member_cell(b.mesh);
-  const std::vector<char> attached = result::member_attachments(b.mesh, anchors, cell);
-  MemberMeasureParams mp;
-  mp.reach = cell;
-  const MemberMeasure m = measure_members(b.mesh, crisp, mp);
-  double smallest = std::numeric_limits<double>::infinity();
-  for (long t = 0; t < crisp.size(); ++t)
-    if (crisp[t] > 0.5 && b.mesh.domain[t] == 0 && !attached[t]) smallest = std::min(smallest, m.thickness[t]);
-  return smallest;
-}
 
 /// The solid share of the design domain's volume of a crisp design (#T, 0/1).
 double design_share(const TetMesh& mesh, const VecXd& crisp) {
