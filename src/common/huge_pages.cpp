@@ -2,6 +2,7 @@
 #include "common/huge_pages.h"
 
 #include <cstdint>
+#include <cstdlib>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -18,6 +19,20 @@ void advise_huge_pages(void* p, std::size_t bytes) {
 #else
   (void)p, (void)bytes;
 #endif
+}
+
+void* malloc_advised(std::size_t bytes) {
+  void* p = std::malloc(bytes);
+  if (p && bytes >= kHugePageAdviceBytes) advise_huge_pages(p, bytes);
+  return p;
+}
+
+void* calloc_advised(std::size_t count, std::size_t size) {
+  // a large block comes fresh from mmap, untouched (calloc does not clear what the kernel
+  // zeroes), so the advice still comes before its first touch
+  void* p = std::calloc(count, size);
+  if (p && size && count >= kHugePageAdviceBytes / size) advise_huge_pages(p, count * size);
+  return p;
 }
 
 }  // namespace topopt

@@ -17,4 +17,10 @@ constexpr std::size_t kHugePageAdviceBytes = std::size_t{4} << 20;
 /// partial 2 MB are left alone (they may share a huge page with other blocks).
 void advise_huge_pages(void* p, std::size_t bytes);
 
+/// malloc and calloc, with the huge-page advice for a block of kHugePageAdviceBytes or more
+/// (the executables' operator new, and CHOLMOD's allocations in them: the coarse multigrid
+/// level's factor). Null where malloc / calloc return null.
+void* malloc_advised(std::size_t bytes);
+void* calloc_advised(std::size_t count, std::size_t size);
+
 }  // namespace topopt

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -44,13 +45,33 @@ long huge_kb_in(const void* p, size_t bytes) {
   return kb;
 }
 
-TEST(HugePages, LargeVectorsAreBackedByHugePages) {
+/// Whether the kernel gives huge pages on request here (THP "always" or "madvise").
+bool huge_pages_on_request() {
   const std::string mode = thp_mode();
-  if (mode != "always" && mode != "madvise") GTEST_SKIP() << "no transparent huge pages on request here";
+  return mode == "always" || mode == "madvise";
+}
+
+// 31 or 32 of a 64 MB block's 2 MB pages can be huge; a fragmented memory may give fewer, not
+// under 8
+constexpr long kLeastHugeKb = 8 * 2048;
+
+TEST(HugePages, LargeVectorsAreBackedByHugePages) {
+  if (!huge_pages_on_request()) GTEST_SKIP() << "no transparent huge pages on request here";
   std::vector<double> v(size_t{8} << 20, 1.0);  // 64 MB, touched by the fill
-  const long kb = huge_kb_in(v.data(), v.size() * sizeof(double));
-  // 31 or 32 of its 2 MB pages can be huge; a fragmented memory may give fewer, not under 8
-  EXPECT_GE(kb, 8 * 2048) << "THP mode " << mode;
+  EXPECT_GE(huge_kb_in(v.data(), v.size() * sizeof(double)), kLeastHugeKb) << "THP mode " << thp_mode();
+}
+
+TEST(HugePages, CallocAdvisedBlocksAreBackedByHugePages) {
+  // CHOLMOD's calloc in the executables (the coarse level's factor)
+  if (!huge_pages_on_request()) GTEST_SKIP() << "no transparent huge pages on request here";
+  const size_t n = size_t{8} << 20;
+  auto* x = static_cast<double*>(calloc_advised(n, sizeof(double)));
+  ASSERT_NE(x, nullptr);
+  double sum = 0;
+  for (size_t i = 0; i < n; i += 512) x[i] = 1, sum += x[i];  // touch every 4 KB page
+  EXPECT_EQ(sum, static_cast<double>(n / 512));
+  EXPECT_GE(huge_kb_in(x, n * sizeof(double)), kLeastHugeKb) << "THP mode " << thp_mode();
+  std::free(x);
 }
 
 }  // namespace
