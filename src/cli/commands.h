@@ -84,4 +84,8 @@ class ArgReader {
   bool help_ = false;
 };
 
+/// CHOLMOD's malloc and calloc with the huge-page advice for large blocks, as the executables'
+/// operator new (src/cli/large_allocations.cpp). Called once by main, before any command.
+void use_huge_pages_in_cholmod();
+
 }  // namespace topopt::cli

@@ -273,6 +273,7 @@ int run_on_ranks(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   using namespace topopt::cli;
+  use_huge_pages_in_cholmod();
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
