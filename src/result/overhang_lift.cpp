@@ -52,7 +52,7 @@ class Lifter {
       double sum = 0;
       const std::vector<int> nb = m_.neighbours(v);
       for (int w : nb) sum += (s_.V.row(v) - s_.V.row(w)).norm();
-      reach_[v] = nb.empty() ? 0 : p_.reach * sum / static_cast<double>(nb.size());
+      reach_[v] = nb.empty() || !on_a_printable_slope(v) ? 0 : p_.reach * sum / static_cast<double>(nb.size());
     }
   }
 
@@ -106,6 +106,25 @@ class Lifter {
       if (m_.tag(t) != 0 && m_.tag(t) != f) return false;
     if (normal) *normal = s_.face_plane[f].head<3>().normalized();
     return true;
+  }
+
+  /// Whether the surface around v as the pass found it — the triangles of its star and its
+  /// neighbours' stars (its 2-ring) taken as one patch, less those resting on the plate — rises at
+  /// least the angle (or faces up). The patch's area vector (the sum of its triangles', which
+  /// depends on the patch's rim only, not on where v lies inside it) is the slope at the scale
+  /// of the surface's edges, the slope the pass restores v's facets to. A patch flatter than the
+  /// angle is a ceiling: tilting its small facets would corrugate it into steep facets that print
+  /// on nothing, so its points stay and a flat ceiling cannot be made to look printable, whatever
+  /// its ripple. A patch whose area vector vanishes has no slope and stays too.
+  bool on_a_printable_slope(int v) const {
+    std::vector<int> patch = m_.star(v);
+    for (int w : m_.neighbours(v)) patch.insert(patch.end(), m_.star(w).begin(), m_.star(w).end());
+    std::sort(patch.begin(), patch.end());
+    patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (int t : patch)
+      if (!on_plate(s_.V, m_.tri(t), b_)) n += normal_of(s_.V, m_.tri(t));
+    return n.norm() > 0 && -n.dot(b_.direction) <= std::cos(b_.angle * kDegree) * n.norm();
   }
 
   /// The summed excess of v's triangles with v at p.

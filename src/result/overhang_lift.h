@@ -2,7 +2,8 @@
 // when the job prints along a build direction. The crossing margin and the smoothing tilt some
 // facets of the lattice's staircase, which the filter built at or above the critical angle, below
 // it; this pass moves points of the downward-facing facets that rise less than the angle from the
-// plate so that they rise at least that much again — each move bounded, keeping every triangle's
+// plate so that they rise at least that much again where the surface around them, at the scale of
+// its edges, rises that much (a ceiling stays a ceiling) — each move bounded, keeping every triangle's
 // shape (no triangle below the angle floor that was above it), turning no triangle over, crossing
 // nothing (exact, crossing_guard.h), non-design points fixed and Ω's face points in their planes.
 #pragma once
@@ -52,7 +53,9 @@ struct OverhangLiftReport {
 /// point, the area-weighted excess of the facets around it (their normal's component along
 /// −direction above cos(angle + lift_margin)) falls, by steepest descent with a backtracking step
 /// and a few fixed directions when that fails. Free points (lock 0) move in space, points of a
-/// planar Ω face's cut line within the face's plane; other points stay. A move is kept only when
+/// planar Ω face's cut line within the face's plane; other points stay, and so does every point
+/// whose 2-ring (off the plate) is, as one patch, flatter than build.angle: a ceiling, whose facets
+/// the pass would only corrugate into steep ones that print on nothing. A move is kept only when
 /// it lowers the excess, stays within `reach`, leaves no triangle around the point below
 /// min_angle that was not (none worse that was), turns none by more than max_normal_turn, and
 /// crosses no triangle of the surface. Does nothing without a build direction.

@@ -17,15 +17,15 @@ namespace topopt::result {
 namespace {
 
 /// A 10 mm cube of 1 mm cells; node densities 0.5 + 0.1 · (signed distance above `level`(x, z)),
-/// each node's value scattered by up to ±`noise` (fixed seed): the iso-surface at 0.5 is the
+/// each node's value scattered by up to ±`noise` (noise seed `seed`): the iso-surface at 0.5 is the
 /// surface z = level, rippled as an optimised design's staircase is.
 template <class Level>
-TriSurface rippled_surface(Level level, double noise) {
+TriSurface rippled_surface(Level level, double noise, unsigned seed = 7) {
   mesh::StructuredBoxParams box;
   box.size = {10, 10, 10};
   box.cells = {10, 10, 10};
   const TetMesh m = mesh::structured_box_mesh(box);
-  std::mt19937 rng(7);
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-noise, noise);
   VecXd nd(m.V.rows());
   for (long i = 0; i < m.V.rows(); ++i) nd[i] = 0.5 + 0.1 * level(m.V(i, 0), m.V(i, 2)) + u(rng);
@@ -102,19 +102,22 @@ TEST(OverhangLift, LiftsTheFacetsOfAPrintableSlopeBackAboveTheAngle) {
 }
 
 TEST(OverhangLift, CannotMakeAFlatCeilingPrint) {
-  // the solid above z = 5: its underside is a ceiling facing straight down. Within its reach no
-  // move makes it steep without a keel or a lowest point, so it stays too flat but for small
-  // triangles on the ripple's bumps (measured: 105.1 -> 95.4 mm², the lifted 9 % scattered over it)
-  const TriSurface rippled = rippled_surface([](double, double z) { return z - 5; }, 0.02);
-  const Finished both = finished_both_ways(rippled);
-  const TriSurface &plain = both.plain, &lifted = both.lifted;
-  const DesignSurfaceReport& report = both.report;
-  const double before = both.too_flat_before, after = both.too_flat_after;
-  std::cout << "ceiling too flat: " << before << " mm2 -> " << after << " mm2, " << report.lift.moves << " moves\n";
-  EXPECT_GT(before, 90);  // the 100 mm² ceiling, less what the ripple tilts
-  EXPECT_GE(after, 0.9 * before);
-  EXPECT_TRUE(report.check.valid());
-  EXPECT_LE(report.lift.keels_after, report.lift.keels_before + 1e-9);
+  // the solid above z = 5: its underside is a ceiling facing straight down. Tilting the small
+  // triangles on the ripple's bumps would make some of it read as printable while the ceiling
+  // prints on nothing; the figure must hold for every ripple, not one lucky seed (before the lift
+  // kept to printable slopes, main lifted 5-16 % of it: 0.838-0.907, 15 of 16 seeds below 0.9)
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const TriSurface rippled = rippled_surface([](double, double z) { return z - 5; }, 0.02, seed);
+    const Finished both = finished_both_ways(rippled);
+    const DesignSurfaceReport& report = both.report;
+    const double before = both.too_flat_before, after = both.too_flat_after;
+    std::cout << "seed " << seed << ": ceiling too flat: " << before << " mm2 -> " << after << " mm2 ("
+              << after / before << "), " << report.lift.moves << " moves\n";
+    EXPECT_GT(before, 90) << seed;  // the 100 mm² ceiling, less what the ripple tilts
+    EXPECT_GE(after, 0.9 * before) << seed;
+    EXPECT_TRUE(report.check.valid()) << seed;
+    EXPECT_LE(report.lift.keels_after, report.lift.keels_before + 1e-9) << seed;
+  }
 }
 
 TEST(OverhangLift, DoesNothingWithoutABuild) {
