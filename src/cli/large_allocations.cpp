@@ -14,10 +14,15 @@
 #include "cli/commands.h"
 #include "common/huge_pages.h"
 
+// As the standard's: on failure the installed new-handler runs (it may free memory) and the
+// allocation is tried again; with none installed, std::bad_alloc.
 void* operator new(std::size_t bytes) {
-  void* p = topopt::malloc_advised(bytes ? bytes : 1);
-  if (!p) throw std::bad_alloc();
-  return p;
+  for (;;) {
+    if (void* p = topopt::malloc_advised(bytes ? bytes : 1)) return p;
+    const std::new_handler handler = std::get_new_handler();
+    if (!handler) throw std::bad_alloc();
+    handler();
+  }
 }
 
 void* operator new[](std::size_t bytes) { return ::operator new(bytes); }

@@ -26,7 +26,7 @@ MatX3d node_gradients(const TetMesh& mesh, const VecXd& f) {
   VecXd w = VecXd::Zero(mesh.V.rows());
   for (long t = 0; t < mesh.T.rows(); ++t) {
     if (tagged && mesh.domain[t] != 0) continue;
-    double N[12];  // ∂N_a/∂x_c of the tet's linear shape functions (fem::tet_gradients)
+    double N[12] = {};  // ∂N_a/∂x_c of the tet's linear shape functions (fem::tet_gradients)
     const double vol = fem::tet_gradients(mesh, t, N) / 6;
     if (!(vol > 0)) continue;  // the mesh's tets are positive: never taken on a valid mesh
     Eigen::Vector3d grad = Eigen::Vector3d::Zero();

@@ -30,8 +30,9 @@ void expect_stars_exact(const EditableSurface& m) {
       EXPECT_EQ(std::count(m.tri(t).begin(), m.tri(t).end(), v), 1);
     }
   for (int t = 0; t < m.triangles(); ++t)
-    if (m.alive(t))
+    if (m.alive(t)) {
       for (int v : m.tri(t)) EXPECT_EQ(std::count(m.star(v).begin(), m.star(v).end(), t), 1);
+    }
 }
 
 TEST(EditableSurface, LinkConditionRefusesThePinchOfAnOctahedron) {

@@ -400,7 +400,9 @@ TEST(ResultCheck, RemeshMendsANeedleOnACurvedNonDesignFaceNextToTheCrease) {
   ASSERT_EQ(static_cast<long>(r.kept_points.size()), s.V.rows());
   expect_kept_unmoved_and_added_locked(s, s0, r, 2);
   for (long i = 0; i < s.V.rows(); ++i) {
-    if (r.kept_points[i] >= 0) EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
+    if (r.kept_points[i] >= 0) {
+      EXPECT_EQ(s.lock[i], s0.lock[r.kept_points[i]]);
+    }
     if (s.lock[i] == 2) {
       EXPECT_NEAR(std::hypot(s.V(i, 1), s.V(i, 2)), kCylinderRadius, 1e-9 * kCylinderRadius) << "point " << i;
     }

@@ -26,6 +26,7 @@
 #include "simp/density_filter.h"
 #include "simp/optimizer.h"
 #include "simp/test_beam.h"
+#include "testing/uniform_vector.h"
 
 namespace topopt::simp {
 namespace {
@@ -60,13 +61,7 @@ void expect_gradient(const std::function<double(const VecXd&)>& f, const VecXd& 
   }
 }
 
-VecXd random_field(long n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.2, 0.8);
-  VecXd x(n);
-  for (long i = 0; i < n; ++i) x[i] = u(rng);
-  return x;
-}
+VecXd random_field(long n, unsigned seed) { return testing::uniform_vector(n, seed, 0.2, 0.8); }
 
 /// The crisp design as the user gets it (#T, 0/1): design hygiene at the threshold 0.5 (pieces
 /// that carry no load removed, closed voids filled), then the tets whose node densities

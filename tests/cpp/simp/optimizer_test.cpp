@@ -15,6 +15,7 @@
 #include "simp/density_filter.h"
 #include "simp/update.h"
 #include "testing/self_weight.h"
+#include "testing/uniform_vector.h"
 
 namespace topopt::simp {
 namespace {
@@ -196,13 +197,7 @@ SimpParams projected_params() {
 }
 
 /// n design variables drawn uniformly from [0.3, 0.7] with `seed`.
-VecXd random_design(long n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0.3, 0.7);
-  VecXd x(n);
-  for (long i = 0; i < n; ++i) x[i] = u(rng);
-  return x;
-}
+VecXd random_design(long n, unsigned seed) { return testing::uniform_vector(n, seed, 0.3, 0.7); }
 
 TEST(Simp, OcOnTheLinearisedVolumeMeetsTheRealVolumeAsTightlyAsTheExactBisection) {
   // One OC step, as the loop takes it (density filter, Heaviside projection), from a random
