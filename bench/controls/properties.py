@@ -11,7 +11,9 @@ asserts on a structured beam, here on the examples.
   cross the surface more than twice, and the share a die could not release (going up along the
   direction: a void → solid change above the parting height — the upper die —, or solid → void below
   it — the lower die —; one-sided: the parting height is the part's lowest point, so any void under
-  solid counts);
+  solid counts, the part's own bottom faces above its lowest point too: an upper bound); rays within a
+  mesh size of a non-design solid that does not span the part along the direction left out (the
+  given shape: the bracket's pin lug, whose bore lies across z);
 - extrusion: rays along the direction; the share whose crossings are not none or the part's two
   faces across (every section equal: a line along the direction is all solid or all void);
 - maximum member size: the widest ball of the crisp design (`_native.measure_members`, the product's
@@ -99,11 +101,14 @@ def _hits(a, b, c, u, v, axis, x, y):
     return np.sort(h)
 
 
-def draw_shares(hits, lo, parting, tol):
+def draw_shares(hits, lo, parting, tol, skip=lambda key: False):
     """(share of rays crossing more than twice, share not released) for rays along +axis; lo: the
-    part's lowest height, parting: the parting height (lo for one-sided)."""
+    part's lowest height, parting: the parting height (lo for one-sided); rays whose grid key
+    `skip` names left out."""
     many = cut = n = 0
-    for h in hits.values():
+    for key, h in hits.items():
+        if skip(key):
+            continue
         n += 1
         many += len(h) > 2
         for k, z in enumerate(h):  # even k: void -> solid going up; odd: solid -> void
@@ -205,11 +210,12 @@ def measure(folder, job, build):
     if "draw_direction" in c:
         dd = c["draw_direction"]
         axis = int(np.argmax(np.abs(dd["direction"])))
-        hits, _, _ = ray_crossings(tris, axis)
+        hits, gu, gv = ray_crossings(tris, axis)
         parting = dd["parting_point"][axis] if "parting_point" in dd else lo[axis]
-        many, cut = draw_shares(hits, lo[axis], parting, 0.05)
-        rows.append(("rays crossing > 2 times", many))
-        rows.append(("rays not released", cut))
+        skip = off_solids(gu, gv, axis, solids, lo[axis], hi[axis], size)
+        many, cut = draw_shares(hits, lo[axis], parting, 0.05, skip)
+        rows.append(("rays (off the short non-design solids by a mesh size) crossing > 2 times", many))
+        rows.append(("rays (off the short non-design solids by a mesh size) not released", cut))
     if "max_member_size" in c:
         rows.append(("widest ball (mm)", largest_ball(build, folder, size)))
     return rows
