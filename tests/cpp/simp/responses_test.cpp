@@ -455,7 +455,9 @@ TEST(Responses, FrequencyDesignIsOnePieceWithTheLoadPadAndAgreesWithCcx) {
   std::filesystem::create_directories(dir);
   const std::vector<double> theirs = testing::ccx_frequencies(crisp, b.mat, held, 1, dir);
   ASSERT_EQ(theirs.size(), 1u) << "no eigenvalue table from ccx; see " << dir;
-  EXPECT_NEAR(ours, theirs[0], 0.02 * theirs[0]);
+  std::cout << "frequency design's crisp tets: ours " << ours << " Hz, ccx " << theirs[0] << " Hz\n";
+  // issue 22's bound: within 1 % of CalculiX's *FREQUENCY on the same crisp tets (measured 0.04 %)
+  EXPECT_NEAR(ours, theirs[0], 0.01 * theirs[0]);
   std::filesystem::remove_all(dir);
 }
 
