@@ -102,8 +102,10 @@ ComplianceProblem::ComplianceProblem(const TetMesh& mesh, const fem::Material& m
   fe_ = std::make_unique<fem::Elasticity>(mesh, material, supports, params.solver);
   scale_ = VecXd::Ones(nt);
   if (!params.projection.enabled && !draw_ && !overhang_)
-    volume_weights_ =
-        controls_->apply_transpose(params.sensitivity_filter ? vd_ : filter_->apply_transpose(vd_)) / design_volume_;
+    volume_weights_ = controls_->apply_transpose(params.sensitivity_filter
+                                                     ? vd_
+                                                     : filter_->apply_transpose(controls_->orbit_mean_transpose(vd_))) /
+                      design_volume_;
 }
 
 ComplianceProblem::~ComplianceProblem() = default;
@@ -113,7 +115,7 @@ void ComplianceProblem::set_solver_tolerance(double tolerance) { fe_->set_solver
 ComplianceProblem::Stages ComplianceProblem::filtered(const VecXd& x) const {
   Stages s;
   const VecXd z = controls_->apply(x);
-  s.filtered = params_.sensitivity_filter ? z : filter_->apply(z);
+  s.filtered = params_.sensitivity_filter ? z : controls_->orbit_mean(filter_->apply(z));
   s.drawn = draw_ ? draw_->apply(s.filtered) : s.filtered;
   s.tilde = overhang_ ? overhang_->apply(s.drawn) : s.drawn;
   return s;
@@ -183,7 +185,8 @@ VecXd ComplianceProblem::chain(const Stages& s, VecXd d_bar, double eta) const {
   }
   if (overhang_) d_bar = overhang_->apply_transpose(s.drawn, d_bar);
   if (draw_) d_bar = draw_->apply_transpose(s.filtered, d_bar);
-  return controls_->apply_transpose(params_.sensitivity_filter ? d_bar : filter_->apply_transpose(d_bar));
+  return controls_->apply_transpose(
+      params_.sensitivity_filter ? d_bar : filter_->apply_transpose(controls_->orbit_mean_transpose(d_bar)));
 }
 
 VecXd ComplianceProblem::stiffness_derivative(const VecXd& a, const VecXd& b) const {

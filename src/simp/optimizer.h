@@ -151,7 +151,7 @@ class ComplianceProblem {
   VecXd vd_;
   VecXd volume_weights_;  // without projection the volume is linear in x: w·x
   double design_volume_ = 0;
-  std::unique_ptr<DesignMap> controls_;  // x → z, before the filter
+  std::unique_ptr<DesignMap> controls_;  // x → z before the filter, the orbit mean after it
   std::unique_ptr<Filter> filter_;
   std::unique_ptr<DrawFilter> draw_;          // draw direction: after the filter, before the projection
   std::unique_ptr<OverhangFilter> overhang_;  // overhang: after the draw direction, before the projection

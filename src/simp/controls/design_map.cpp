@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "simp/controls/tying.h"
+#include "simp/density_filter.h"
 
 namespace topopt::simp {
 
@@ -23,6 +24,11 @@ DesignMap::DesignMap(const TetMesh& mesh, const std::vector<int>& design, const 
     variable_of_ = std::move(t.variable_of);
     num_variables_ = t.num_variables;
     summary_ = t.summary;
+    tied_ = true;
+    const VecXd all = tet_volumes(mesh);
+    volume_.resize(static_cast<long>(design.size()));
+    for (size_t i = 0; i < design.size(); ++i) volume_[i] = all[design[i]];
+    class_volume_ = apply_transpose(volume_);
     return;
   }
   variable_of_.resize(design.size());
@@ -42,6 +48,16 @@ VecXd DesignMap::apply_transpose(const VecXd& g) const {
   VecXd out = VecXd::Zero(num_variables_);
   for (size_t i = 0; i < variable_of_.size(); ++i) out[variable_of_[i]] += g[i];
   return out;
+}
+
+VecXd DesignMap::orbit_mean(const VecXd& y) const {
+  if (!tied_) return y;
+  return apply(apply_transpose(volume_.cwiseProduct(y)).cwiseQuotient(class_volume_));
+}
+
+VecXd DesignMap::orbit_mean_transpose(const VecXd& g) const {
+  if (!tied_) return g;
+  return volume_.cwiseProduct(apply(apply_transpose(g).cwiseQuotient(class_volume_)));
 }
 
 }  // namespace topopt::simp
