@@ -46,7 +46,7 @@ class DesignMap {
  private:
   std::vector<int> variable_of_;  // #D
   int num_variables_ = 0;
-  bool tied_ = false;
+  bool averaged_ = false;
   VecXd volume_;        // #D element volumes (with ties)
   VecXd class_volume_;  // #N the volume of each class (with ties)
   std::string summary_;
