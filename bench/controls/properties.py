@@ -164,10 +164,7 @@ def largest_ball(build, out, size):
     sys.path.insert(0, os.path.join(ROOT, "bench", "result"))
     import _native  # noqa: E402
     import crisp  # noqa: E402
-    points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
-    h = json.load(open(os.path.join(out, "history.json")))
-    domain = arrays["domain"].astype(np.int64)
-    solid = crisp.crisp_tets(points, tets, domain, arrays["design"], h["threshold"], product=True).astype(float)
+    points, tets, domain, solid = crisp.run_crisp_design(out)
     return _native.measure_members(points, tets, domain, solid, size)["largest_ball"]
 
 

@@ -157,11 +157,9 @@ def member_columns(build, out, size, mesh_size, stdout):
     sys.path.insert(0, os.path.join(ROOT, "bench", "result"))
     import _native  # noqa: E402
     import crisp  # noqa: E402
-    points, tets, arrays = crisp.read_vtu(os.path.join(out, "density.vtu"))
-    h = json.load(open(os.path.join(out, "history.json")))
-    domain = arrays["domain"].astype(np.int64)
     # the product's crisp design (src/result/design_hygiene's crisp_tets of iso_surface's node densities)
-    solid = crisp.crisp_tets(points, tets, domain, arrays["design"], h["threshold"], product=True).astype(float)
+    points, tets, domain, solid = crisp.run_crisp_design(out)
+    h = json.load(open(os.path.join(out, "history.json")))
     m = _native.measure_members(points, tets, domain, solid, mesh_size)
     design_solid = (domain == 0) & (solid > 0.5)
     thin = (np.asarray(m["thickness"])[design_solid] < size - mesh_size).mean() if design_solid.any() else 0.0

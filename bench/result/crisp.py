@@ -66,6 +66,17 @@ def crisp_tets(points, tets, domain, density, threshold, product=False):
     return (domain != 0) | (nd[tets].mean(axis=1) >= threshold)
 
 
+def run_crisp_design(out):
+    """A `topopt optimize` run folder's mesh and the product's crisp design: (points, tets, domain,
+    solid #T as 0/1 floats) from density.vtu at the threshold of history.json."""
+    import json
+    points, tets, arrays = read_vtu(os.path.join(out, "density.vtu"))
+    h = json.load(open(os.path.join(out, "history.json")))
+    domain = arrays["domain"].astype(np.int64)
+    solid = crisp_tets(points, tets, domain, arrays["design"], h["threshold"], product=True).astype(float)
+    return points, tets, domain, solid
+
+
 def parse_inp(path):
     """Nodes (#V x 3, node i+1 on row i), *BOUNDARY lines and *CLOAD (node, dof, value) of a
     deck written by topopt solve --inp, and the *MATERIAL block's text."""

@@ -33,15 +33,21 @@ namespace {
 struct Beam : TestBeam {
   explicit Beam(std::array<int, 3> cells) : TestBeam(cells, {0, -100, -30}) {}
 
+  /// The cell (ijk) of the structured grid that holds p; false outside the box.
+  bool grid_cell(const Eigen::Vector3d& p, int ijk[3]) const {
+    for (int a = 0; a < 3; ++a) {
+      const double s = (p[a] - box.origin[a]) / cell(a);
+      if (s < 0 || s > box.cells[a]) return false;
+      ijk[a] = std::min(box.cells[a] - 1, static_cast<int>(s));
+    }
+    return true;
+  }
+
   /// The density at p of the per-tet field rho (#T): the tet of the Kuhn split that holds p,
   /// 0 outside the box.
   double at(const VecXd& rho, const Eigen::Vector3d& p) const {
     int ijk[3];
-    for (int a = 0; a < 3; ++a) {
-      const double s = (p[a] - box.origin[a]) / cell(a);
-      if (s < 0 || s > box.cells[a]) return 0;
-      ijk[a] = std::min(box.cells[a] - 1, static_cast<int>(s));
-    }
+    if (!grid_cell(p, ijk)) return 0;
     const long first = 6L * (ijk[0] + box.cells[0] * (ijk[1] + static_cast<long>(box.cells[1]) * ijk[2]));
     long best = first;
     double best_min = -1e300;
@@ -561,11 +567,7 @@ struct JitteredBeam : Beam {
   /// p's cell of the unjittered grid) that holds p, 0 outside the box.
   double at(const VecXd& rho, const Eigen::Vector3d& p) const {
     int ijk[3];
-    for (int a = 0; a < 3; ++a) {
-      const double s = (p[a] - box.origin[a]) / cell(a);
-      if (s < 0 || s > box.cells[a]) return 0;
-      ijk[a] = std::min(box.cells[a] - 1, static_cast<int>(s));
-    }
+    if (!grid_cell(p, ijk)) return 0;
     long best = 0;
     double best_min = -1e300;
     for (int i = std::max(0, ijk[0] - 1); i <= std::min(box.cells[0] - 1, ijk[0] + 1); ++i)
