@@ -4,13 +4,14 @@
 // map. The density filter does not keep that: on an unstructured mesh each element's kernel
 // covers a different neighbourhood than its image's, so F z differs across a class, and the
 // projection sharpens the difference into a design that does not repeat (issue 22; on the
-// jittered test beam at β = 32, 11 / 4.4 / 0.8 % of the tets' projected densities lay more than
-// 0.1 off their class's mean with an extrusion / a pattern / a mirror; the cantilever's pattern
-// left 11.5 % of the result surface's area more than a mesh size off its image, 3.6 % with A). The orbit mean A = P (Pᵀ V P)⁻¹ Pᵀ V (V the element volumes) gives every element
-// of a class its class's volume-weighted mean of the filtered field, so the filtered and
-// projected designs repeat exactly class by class; it keeps the filtered field's volume
-// (Σ v A y = Σ v y) and its transpose Aᵀ = V P (Pᵀ V P)⁻¹ Pᵀ carries the chain rule. Without
-// ties both maps are the identity (#N = #D).
+// jittered test beam at β = 32, 4.4 / 0.8 % of the tets' projected densities lay more than 0.1
+// off their class's mean with a pattern / a mirror; the cantilever's pattern left 11.5 % of the
+// result surface's area more than a mesh size off its image, 3.6 % with A). The orbit mean
+// A = P (Pᵀ V P)⁻¹ Pᵀ V (V the element volumes) gives every element of a class its class's
+// volume-weighted mean of the filtered field, so the filtered and projected designs repeat
+// exactly class by class; it keeps the filtered field's volume (Σ v A y = Σ v y) and its
+// transpose Aᵀ = V P (Pᵀ V P)⁻¹ Pᵀ carries the chain rule. Without ties, and with an extrusion
+// among the controls (design_map.cpp says why), both maps are the identity.
 #pragma once
 #include <string>
 #include <vector>
@@ -36,9 +37,9 @@ class DesignMap {
   VecXd apply(const VecXd& x) const;
   /// Chain rule: dF/dx (#N) given dF/dz (#D): each variable sums its elements' g.
   VecXd apply_transpose(const VecXd& g) const;
-  /// The orbit mean A y (#D) of a filtered field y (#D); y itself without ties.
+  /// The orbit mean A y (#D) of a filtered field y (#D); y itself without ties or with an extrusion.
   VecXd orbit_mean(const VecXd& y) const;
-  /// Chain rule of orbit_mean: Aᵀ g (#D); g itself without ties.
+  /// Chain rule of orbit_mean: Aᵀ g (#D); g itself where orbit_mean is the identity.
   VecXd orbit_mean_transpose(const VecXd& g) const;
   /// One line for the log ("" without controls).
   const std::string& describe() const { return summary_; }
@@ -46,9 +47,9 @@ class DesignMap {
  private:
   std::vector<int> variable_of_;  // #D
   int num_variables_ = 0;
-  bool averaged_ = false;
-  VecXd volume_;        // #D element volumes (with ties)
-  VecXd class_volume_;  // #N the volume of each class (with ties)
+  bool averaged_ = false;  // the orbit mean acts: ties, no extrusion
+  VecXd volume_;           // #D element volumes (when averaged_)
+  VecXd class_volume_;     // #N the volume of each class (when averaged_)
   std::string summary_;
 };
 
