@@ -156,23 +156,77 @@ def _style_domain(obj, d):
 
 # --- the result shape ----------------------------------------------------------------------
 
+#: how far a result triangle's centre may lie off a non-design solid's boundary face and still lie
+#: on it: across the face, this share of the face's longest edge (the surface stage projects points
+#: on curved faces onto the true surface: a sagitta of a few per cent of an edge); beyond its edges,
+#: this barycentric margin (the projection's tangential part, well under one per cent) — a design
+#: triangle beside the solid has its centre a third of its own height beyond the face's edge
+ON_FACE_ACROSS = 0.1
+ON_FACE_BEYOND = 0.02
+#: the least |cos| between a result triangle's normal and the face's for it to lie on the face
+ON_FACE_COS = 0.9
+
+
+def solid_boundary_faces(tets, domain):
+    """(#B×3 node indices, #B solid numbers): the faces of each non-design solid's tets that no
+    other tet of the same solid shares — that solid's boundary, against Ω's boundary or the design."""
+    tets = np.asarray(tets, dtype=np.int64)
+    domain = np.asarray(domain, dtype=np.int64)
+    nd = domain > 0
+    faces = np.concatenate([tets[nd][:, [1, 2, 3]], tets[nd][:, [0, 2, 3]], tets[nd][:, [0, 1, 3]],
+                            tets[nd][:, [0, 1, 2]]])
+    owner = np.tile(domain[nd], 4)
+    key = np.column_stack([np.sort(faces, axis=1), owner])
+    _, first, count = np.unique(key, axis=0, return_index=True, return_counts=True)
+    single = first[count == 1]
+    return faces[single], owner[single]
+
+
+def _on_faces(centres, normals, nodes, faces):
+    """#C: for each triangle centre (with its unit normal), whether it lies on one of `faces`
+    (by ON_FACE_ACROSS, ON_FACE_BEYOND and ON_FACE_COS), and which (index into faces, -1 if none)."""
+    a, b, c = nodes[faces[:, 0]], nodes[faces[:, 1]], nodes[faces[:, 2]]
+    n = np.cross(b - a, c - a)
+    area2 = np.linalg.norm(n, axis=1)
+    n = n / np.where(area2 > 0, area2, 1.0)[:, None]
+    size = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                            np.linalg.norm(a - c, axis=1)]), axis=0)
+    which = np.full(len(centres), -1, dtype=np.int64)
+    for start in range(0, len(centres), 256):  # bounded memory: 256 × #faces pairs at a time
+        p = centres[start:start + 256, None, :]
+        off = np.abs(np.einsum("ijk,jk->ij", p - a[None], n))
+        aligned = np.abs(normals[start:start + 256] @ n.T) >= ON_FACE_COS
+        # barycentric coordinates of p's projection, each signed area over the face's
+        bary = [np.einsum("ijk,jk->ij", np.cross(v - p, w - p), n) / np.where(area2 > 0, area2, np.inf)
+                for v, w in ((b[None], c[None]), (c[None], a[None]), (a[None], b[None]))]
+        inside = np.minimum(np.minimum(bary[0], bary[1]), bary[2]) >= -ON_FACE_BEYOND
+        near = (off <= ON_FACE_ACROSS * size[None]) & aligned & inside & (area2[None] > 0)
+        hit = near.any(axis=1)
+        which[start:start + 256][hit] = np.argmax(near[hit], axis=1)
+    return which
+
+
 def facet_domains(points, triangles, nodes, tets, domain, tags=None):
     """#Q: for each triangle of the result shape, the non-design solid it lies on (k > 0) or 0.
-    `tags` (#Q, the core's surface_tags): -k marks a face of non-design solid k inside the
-    part. Elsewhere: non-design solids are kept whole and their points are never moved, so a
-    triangle whose three corners are nodes of non-design tets lies on that solid."""
-    nd = {}
-    for k in range(4):
-        for node, d in zip(tets[domain > 0, k], domain[domain > 0]):
-            nd.setdefault(nodes[node].tobytes(), int(d))
-    point_domain = np.array([nd.get(np.asarray(p, dtype=np.float64).tobytes(), 0) for p in points], dtype=np.int64)
-    corner = point_domain[np.asarray(triangles, dtype=np.int64)]
-    on_nd = (corner > 0).all(axis=1)
-    out = np.where(on_nd, corner[:, 0], 0)
-    if tags is not None:
-        tags = np.asarray(tags, dtype=np.int64)
-        out = np.where(tags < 0, -tags, out)
-    return out
+    `tags` (#Q, the core's surface_tags): -k marks a face of non-design solid k inside the part,
+    0 the iso-surface (in the design). Elsewhere (Ω's boundary) a triangle lies on solid k when
+    its centre lies on a boundary face of k's tets: by place, not by its corners being mesh
+    nodes — the surface stage splits and projects triangles there (new points on a solid's faces)."""
+    points = np.asarray(points, dtype=np.float64)
+    triangles = np.asarray(triangles, dtype=np.int64)
+    nodes = np.asarray(nodes, dtype=np.float64)
+    out = np.zeros(len(triangles), dtype=np.int64)
+    if len(triangles) == 0 or not (np.asarray(domain) > 0).any():
+        return out
+    tags = np.ones(len(triangles), dtype=np.int64) if tags is None else np.asarray(tags, dtype=np.int64)
+    faces, owner = solid_boundary_faces(tets, domain)
+    on_part = np.flatnonzero(tags > 0)
+    corner = points[triangles[on_part]]
+    normal = np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    which = _on_faces(corner.mean(axis=1), normal, nodes, faces)
+    out[on_part] = np.where(which >= 0, owner[np.maximum(which, 0)], 0)
+    return np.where(tags < 0, -tags, out)
 
 
 def colour_result(feature, facet_domain):

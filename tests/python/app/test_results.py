@@ -185,5 +185,81 @@ class Progress(unittest.TestCase):
             .startswith("gmsh"))
 
 
+def _kuhn_box(nx, ny, nz):
+    """Nodes and tets of the box [0, nx] × [0, ny] × [0, nz], each unit cube in six tets."""
+    idx = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k
+    nodes = np.array([(i, j, k) for i in range(nx + 1) for j in range(ny + 1) for k in range(nz + 1)], dtype=float)
+    paths = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+    tets = []
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                for path in paths:
+                    corner = [i, j, k]
+                    tet = [idx(*corner)]
+                    for axis in path:
+                        corner[axis] += 1
+                        tet.append(idx(*corner))
+                    tets.append(tet)
+    return nodes, np.array(tets, dtype=np.int64)
+
+
+def _boundary_split_in_four(nodes, tets):
+    """The box's boundary triangles each split in four at its edges' midpoints (new points, as
+    the surface stage's splits make): points, triangles."""
+    faces = np.concatenate([tets[:, [1, 2, 3]], tets[:, [0, 2, 3]], tets[:, [0, 1, 3]], tets[:, [0, 1, 2]]])
+    _, first, count = np.unique(np.sort(faces, axis=1), axis=0, return_index=True, return_counts=True)
+    points, triangles = [], []
+    for a, b, c in nodes[faces[first[count == 1]]]:
+        base = len(points)
+        points += [a, b, c, (a + b) / 2, (b + c) / 2, (c + a) / 2]
+        triangles += [(base, base + 3, base + 5), (base + 3, base + 1, base + 4), (base + 5, base + 4, base + 2),
+                      (base + 3, base + 4, base + 5)]
+    return np.array(points), np.array(triangles, dtype=np.int64)
+
+
+class ResultColours(unittest.TestCase):
+    """The result shape's faces on a non-design solid are found by place: the surface stage splits
+    and moves triangles there, so their corners need not be mesh nodes (the lever's eyes showed a
+    grey ring on their orange tops before)."""
+
+    def setUp(self):
+        self.nodes, self.tets = _kuhn_box(4, 2, 2)
+        centre_x = self.nodes[self.tets].mean(axis=1)[:, 0]
+        self.domain = np.where(centre_x < 1, 1, 0)  # solid 1: the slab x < 1
+
+    def coloured_area(self, points, triangles, tags=None):
+        domain = results.facet_domains(points, triangles, self.nodes, self.tets, self.domain, tags)
+        p = points[triangles]
+        area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        return area[domain == 1].sum(), area[domain == 0].sum()
+
+    def test_split_triangles_on_a_solid_are_coloured_and_no_others(self):
+        points, triangles = _boundary_split_in_four(self.nodes, self.tets)
+        on_solid, off = self.coloured_area(points, triangles)
+        # the slab's share of the box's boundary: its end 2 × 2, top and bottom 1 × 2, sides 1 × 2
+        self.assertAlmostEqual(on_solid, 4 + 2 * 2 + 2 * 2, places=9)
+        self.assertAlmostEqual(on_solid + off, 2 * (4 * 2 + 4 * 2 + 2 * 2), places=9)
+
+    def test_points_projected_off_the_face_still_count(self):
+        points, triangles = _boundary_split_in_four(self.nodes, self.tets)
+        moved = points.copy()
+        end = np.abs(points[:, 0]) < 1e-12
+        moved[end, 0] -= 0.03 * np.sin(points[end, 1] * 2.1) ** 2  # a curved face's sagitta, 3 % of an edge
+        flat = results.facet_domains(points, triangles, self.nodes, self.tets, self.domain)
+        curved = results.facet_domains(moved, triangles, self.nodes, self.tets, self.domain)
+        self.assertGreater((flat == 1).sum(), 0)
+        self.assertTrue((curved == flat).all())
+
+    def test_tags_decide_inside_the_part(self):
+        points, triangles = _boundary_split_in_four(self.nodes, self.tets)
+        tags = np.ones(len(triangles), dtype=np.int64)
+        tags[:4] = -2  # the core's mark of a face of solid 2 inside the part
+        tags[4:8] = 0  # the iso-surface: in the design, whatever its place
+        domain = results.facet_domains(points, triangles, self.nodes, self.tets, self.domain, tags)
+        self.assertTrue((domain[:4] == 2).all())
+        self.assertTrue((domain[4:8] == 0).all())
+
+
 if __name__ == "__main__":
     unittest.main()
