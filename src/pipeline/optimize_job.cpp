@@ -369,6 +369,16 @@ VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecX
   return nd;
 }
 
+/// Under an extrusion (smooth.extrusion): the cut's free points moved onto the level t of the
+/// section field of `density` (#T) that extraction_densities took (simp::snap_to_section_level),
+/// so that the surface is one extruded shape up to its chords.
+void snap_to_extrusion(const TetMesh& mesh, const VecXd& density, double t, const result::SmoothParams& smooth,
+                       result::TriSurface& s) {
+  if (smooth.extrusion.squaredNorm() == 0) return;
+  const simp::SectionField field = simp::fit_section_field(mesh, density, smooth.extrusion, smooth.extrusion_spacing);
+  simp::snap_to_section_level(field, t, s.V, s.lock);
+}
+
 }  // namespace
 
 result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, double threshold, double volume_fraction,
@@ -393,6 +403,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   } else {
     s = result::extract_iso_surface(mesh, nd, t, margin);
   }
+  snap_to_extrusion(mesh, cleaned, t, smooth, s);
   const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
   result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
   if (smooth.build.active()) {

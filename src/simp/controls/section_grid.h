@@ -21,10 +21,15 @@ class SectionGrid {
   /// #P by #G: the bilinear weights of each point's projection (clamped into the grid); every row
   /// holds at most four non-negative weights summing to 1. points: #P by 3.
   Eigen::SparseMatrix<double> interpolation(const Eigen::MatrixX3d& points) const;
+  /// The node spacing h (mm).
+  double spacing() const { return h_; }
   /// The point of node k at coordinate s along d.
   Eigen::Vector3d node_point(int k, double s) const;
   /// The up to four nodes next to node k along u and v.
   std::vector<int> neighbours(int k) const;
+  /// The value at p's projection of the field g (#G, bilinear; clamped into the grid); with
+  /// `gradient`, its gradient in the section plane there (a 3-vector normal to d).
+  double value(const VecXd& g, const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const;
 
  private:
   Eigen::Vector3d u_, v_, d_;
@@ -32,6 +37,25 @@ class SectionGrid {
   double lo_[2] = {0, 0};
   int n_[2] = {2, 2};
 };
+
+/// A field on a section grid's nodes.
+struct SectionField {
+  SectionGrid grid;
+  VecXd g;  ///< #G node values
+};
+
+/// The design tets' densities (density: #T) fitted on a SectionGrid of spacing h (mm) along d
+/// (unit) over the design tets' nodes: each grid node the mean of the densities of the design
+/// tets around it, weighted by volume × the bilinear weight of their centroid's projection; a
+/// node no centroid reaches takes its neighbours' mean.
+SectionField fit_section_field(const TetMesh& mesh, const VecXd& density, const Eigen::Vector3d& d, double h);
+
+/// Moves the free points (lock 0) of a surface cut at level t from section_node_densities onto the
+/// level curve of the section field itself: Newton steps in the section plane (each at most a grid
+/// spacing, three at most), so that the cut's points lie on one extruded surface whatever the
+/// tets' orientation (the linear crossings on tet edges wander along d by the interpolation's
+/// error). V: #P by 3 (moved in place); lock: #P.
+void snap_to_section_level(const SectionField& field, double t, MatX3d& V, const VecXi& lock);
 
 /// #V node densities for the result's cut under an extrusion along d (unit): the design tets'
 /// densities fitted on a SectionGrid of spacing h over the design tets' nodes (each grid node the
