@@ -288,7 +288,7 @@ result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh
   const simp::ControlsParams& c = set.simp.controls;
   if (c.extrude && c.extrusion.norm() > 0) {  // the section grid of simp::DesignMap's spacing
     smooth.extrusion = c.extrusion.normalized();
-    smooth.extrusion_spacing = (c.tolerance > 0 ? c.tolerance : simp::mean_edge_length(mesh)) / 2;
+    smooth.extrusion_spacing = simp::section_spacing(c.tolerance > 0 ? c.tolerance : simp::mean_edge_length(mesh));
   }
   const simp::OverhangControl& o = set.simp.controls.overhang;
   if (!o.enabled) return smooth;

@@ -50,7 +50,7 @@ void DesignMap::build_section(const TetMesh& mesh, const std::vector<int>& desig
     throw Error(ErrorCode::InvalidParameter, "the extrusion direction is zero or not finite: give a non-zero vector");
   const Eigen::Vector3d d = params.extrusion / n;
   const Eigen::MatrixX3d c = design_centroids(mesh, design);
-  const double h = tolerance / 2;
+  const double h = section_spacing(tolerance);
   const SectionGrid grid(c, d, h);
   const Eigen::SparseMatrix<double> w = grid.interpolation(c);
   // the nodes some centroid reaches are the section's; the other controls tie them (in the plane

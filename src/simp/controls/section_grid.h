@@ -11,6 +11,11 @@
 
 namespace topopt::simp {
 
+/// The node spacing (mm) of an extrusion's section grid for the controls' tolerance (mm, > 0: a
+/// mean edge by default): half of it, so the section is drawn finer than the mesh (columns one
+/// tolerance wide drew it in squares that coarse, branch repeat23).
+inline double section_spacing(double tolerance) { return tolerance / 2; }
+
 class SectionGrid {
  public:
   /// points: #P by 3, the points the grid must cover (their projections lie inside it); d: the
