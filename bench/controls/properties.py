@@ -158,6 +158,27 @@ def off_solids(gu, gv, axis, solids, lo, hi, margin):
     return skip
 
 
+def half_width_shift(axis, lo, hi, solids, margin):
+    """image(q) for map_mismatch: q moved half the part's width along `axis` (wrapped into lo…hi), NaN
+    where q or its image lies within `margin` of a non-design solid's box that does not span the part
+    along `axis` (its surface is the solid's, not the extruded design's)."""
+    short = [(b0, b1) for b0, b1 in solids if b0[axis] > lo[axis] + 1e-6 or b1[axis] < hi[axis] - 1e-6]
+    width = hi[axis] - lo[axis]
+
+    def near_short(q):
+        out = np.zeros(len(q), bool)
+        for b0, b1 in short:
+            out |= np.all((q >= b0 - margin) & (q <= b1 + margin), axis=1)
+        return out
+
+    def image(q):
+        r = q.copy()
+        r[:, axis] = lo[axis] + np.mod(q[:, axis] - lo[axis] + width / 2, width)
+        r[near_short(q) | near_short(r)] = np.nan
+        return r
+    return image
+
+
 def largest_ball(build, out, size):
     """The widest inscribed ball (mm) of the run's crisp design (the product's crisp tets)."""
     sys.path.insert(0, os.path.join(build, "workbench", "TopOpt", "topopt"))
@@ -204,6 +225,8 @@ def measure(folder, job, build):
         skip = off_solids(gu, gv, axis, solids, lo[axis], hi[axis], size)
         rows.append(("rays along the extrusion (off the short non-design solids by a mesh size) not all-or-nothing",
                      extrusion_share(hits, lo[axis], hi[axis], 0.05, skip)))
+        rows += _mismatch_rows("translate by half the width along the extrusion (off the short non-design solids by a "
+                               "mesh size)", map_mismatch(tris, half_width_shift(axis, lo, hi, solids, size), size))
     if "draw_direction" in c:
         dd = c["draw_direction"]
         axis = int(np.argmax(np.abs(dd["direction"])))

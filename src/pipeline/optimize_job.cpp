@@ -19,6 +19,7 @@
 #include "result/iso_surface_refine.h"
 #include "simp/controls/overhang_carry.h"
 #include "simp/controls/overhang_filter.h"
+#include "simp/controls/section_grid.h"
 #include "simp/density_filter.h"
 
 namespace topopt::pipeline {
@@ -284,6 +285,11 @@ std::vector<char> anchor_nodes(const TetMesh& mesh, const Job& job) {
 
 result::SmoothParams surface_settings(const OptimizeSettings& set, const TetMesh& mesh) {
   result::SmoothParams smooth = set.smooth;
+  const simp::ControlsParams& c = set.simp.controls;
+  if (c.extrude && c.extrusion.norm() > 0) {  // the section grid of simp::DesignMap's spacing
+    smooth.extrusion = c.extrusion.normalized();
+    smooth.extrusion_spacing = simp::section_spacing(c.tolerance > 0 ? c.tolerance : simp::mean_edge_length(mesh));
+  }
   const simp::OverhangControl& o = set.simp.controls.overhang;
   if (!o.enabled) return smooth;
   smooth.build.direction = o.direction.normalized();
@@ -350,12 +356,27 @@ VecXd carried_level(const TetMesh& mesh, const result::BuildDirection& build) {
   return simp::carried_level(mesh, c, simp::mean_edge_length(mesh));
 }
 
-/// The node densities the result is cut from: result::node_densities of `density` (#T), at least
-/// `carried` (#V, or empty) so that the design holds the non-design solids' undersides to their edges.
-VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecXd& carried) {
+/// The node densities the result is cut from: result::node_densities of `density` (#T) — under an
+/// extrusion (smooth.extrusion) the section field's (simp::section_node_densities), equal along
+/// it — at least `carried` (#V, or empty) so that the design holds the non-design solids'
+/// undersides to their edges.
+VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecXd& carried,
+                           const result::SmoothParams& smooth) {
   VecXd nd = result::node_densities(mesh, density);
+  if (smooth.extrusion.squaredNorm() > 0)
+    nd = simp::section_node_densities(mesh, density, nd, smooth.extrusion, smooth.extrusion_spacing);
   if (carried.size() == nd.size()) nd = nd.cwiseMax(carried);
   return nd;
+}
+
+/// Under an extrusion (smooth.extrusion): the cut's free points moved onto the level t of the
+/// section field of `density` (#T) that extraction_densities took (simp::snap_to_section_level),
+/// so that the surface is one extruded shape up to its chords.
+void snap_to_extrusion(const TetMesh& mesh, const VecXd& density, double t, const result::SmoothParams& smooth,
+                       result::TriSurface& s) {
+  if (smooth.extrusion.squaredNorm() == 0) return;
+  const simp::SectionField field = simp::fit_section_field(mesh, density, smooth.extrusion, smooth.extrusion_spacing);
+  simp::snap_to_section_level(field, t, s.V, s.lock);
 }
 
 }  // namespace
@@ -367,14 +388,14 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
                                   result::DesignSurfaceReport* surface_report, const result::SourceFaces* source) {
   const VecXd carried = carried_level(mesh, smooth.build);
   const double t = threshold > 0 ? threshold
-                                 : result::threshold_for_volume(mesh, extraction_densities(mesh, density, carried),
-                                                                volume_fraction);
+                                 : result::threshold_for_volume(
+                                       mesh, extraction_densities(mesh, density, carried, smooth), volume_fraction);
   if (threshold_used) *threshold_used = t;
   result::HygieneReport found;
   const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
   for (const std::string& w : found.warnings) progress.warn(w);
   const double margin = smooth.remesh ? smooth.crossing_margin : 0.0;
-  const VecXd nd = extraction_densities(mesh, cleaned, carried);
+  const VecXd nd = extraction_densities(mesh, cleaned, carried, smooth);
   result::TriSurface s;
   if (smooth.resolution > 1) {
     const result::RefinedField fine = result::refine_near_level(mesh, nd, t);
@@ -382,6 +403,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   } else {
     s = result::extract_iso_surface(mesh, nd, t, margin);
   }
+  snap_to_extrusion(mesh, cleaned, t, smooth, s);
   const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
   result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
   if (smooth.build.active()) {

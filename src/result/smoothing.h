@@ -39,6 +39,11 @@ struct SmoothParams {
   /// The job's overhang control (pipeline::surface_settings fills it): with a build direction the
   /// finished surface's too-flat downward facets are lifted back to the angle (overhang_lift.h).
   BuildDirection build;
+  /// The job's extrusion (pipeline::surface_settings fills it): its direction (unit; zero: none)
+  /// and the spacing of the section grid (mm) the cut's node densities are fitted on, so that the
+  /// result is one extruded shape (simp/controls/section_grid.h).
+  Eigen::Vector3d extrusion = Eigen::Vector3d::Zero();
+  double extrusion_spacing = 0;
 };
 
 /// Smooths s.V in place. Vertices with lock 2 do not move; with lock 1 they move only

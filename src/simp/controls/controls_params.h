@@ -123,7 +123,8 @@ struct ControlsParams {
   bool extrude = false;                                  ///< constant cross-section along extrusion
   Eigen::Vector3d extrusion = Eigen::Vector3d::UnitZ();  ///< the extrusion direction
   /// mm: how far a mirrored/rotated/shifted centroid may lie from the design element that
-  /// takes it, and the width of the extrusion's columns; <= 0: the mesh's mean edge length.
+  /// takes it, and twice the node spacing of the extrusion's section grid (section_grid.h);
+  /// <= 0: the mesh's mean edge length.
   double tolerance = 0;
   DrawDirection draw;        ///< after the density filter, before the projection (draw_filter.h)
   OverhangControl overhang;  ///< after the draw direction, before the projection (overhang_filter.h)

@@ -4,6 +4,8 @@
 // along a direction; the element that takes an image is the design element whose centroid
 // lies nearest to it (within a tolerance, so the mesh need not be symmetric), and the tied
 // elements are the connected classes of all those pairs (union-find). One variable per class.
+// The optimiser's DesignMap no longer ties an extrusion's columns here: it puts the extrusion's
+// variables on a section grid (section_grid.h) and ties that grid's nodes by the other controls.
 #pragma once
 #include <string>
 #include <vector>
