@@ -115,7 +115,7 @@ result::StepExportParams step_params(const Job& job, result::StepExportParams pa
 }
 
 result::VerificationProblem verification_problem(const Job& job) {
-  return {job.material, job.supports, job.load_cases};
+  return {job.material, job.supports, job.load_cases, job.optimization.simp.responses.stress_limit};
 }
 
 namespace {

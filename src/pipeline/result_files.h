@@ -43,7 +43,8 @@ result::SourceFaces source_faces(const Job& job, const JobShapes& shapes = {}, c
 /// `params` with what the job's "output" section sets for the STEP export (its triangle budget).
 result::StepExportParams step_params(const Job& job, result::StepExportParams params = {});
 
-/// The job's problem (material, supports, load cases) as the verification solves it.
+/// The job's problem (material, supports, load cases) as the verification solves it, and its stress
+/// limit (optimization.stress_limit) the verification warns past.
 result::VerificationProblem verification_problem(const Job& job);
 
 /// Writes, as job.output asks (step, verification), DIR/result.step, DIR/verification.vtu and

@@ -31,6 +31,9 @@ struct VerificationProblem {
   fem::Material material;
   std::vector<fem::SupportSpec> supports;
   std::vector<fem::LoadCase> load_cases;
+  /// The study's von Mises limit (MPa, optimization.stress_limit); <= 0: none. verify_result
+  /// warns when the result solid's largest stress exceeds it.
+  double stress_limit = 0;
 };
 
 /// One analysis: compliance summed over the load cases with their weights (N·mm), the largest
@@ -90,10 +93,12 @@ AnalysisFigures analyse(const TetMesh& mesh, const TetMesh& loaded, const Verifi
 /// the result (tets sharing nodes) go by the hygiene's rule (piece_fates): those that do not
 /// carry the loads are left out (Verification::unheld_volumes, a warning through progress)
 /// when no load acts on them; Error(NoSupport) naming the piece when one does, or when a piece
-/// kept holds a load and no support (the design does not carry that load). Throws Error(FaceNotFound) naming the face when the result
-/// has nothing left of a face a load or support acts on (the design removed the material there:
-/// the message says to keep optimization.keep_loaded_faces on), and what fill_volume and fem
-/// throw (MeshingFailed).
+/// kept holds a load and no support (the design does not carry that load). With a stress limit
+/// in `problem`, a warning through progress when the result solid's largest von Mises stress
+/// exceeds it: the figure, its load case and place, and the crisp design's largest stress.
+/// Throws Error(FaceNotFound) naming the face when the result has nothing left of a face a load
+/// or support acts on (the design removed the material there: the message says to keep
+/// optimization.keep_loaded_faces on), and what fill_volume and fem throw (MeshingFailed).
 Verification verify_result(const TriSurface& s, const TetMesh& fe, const VecXd& design, double threshold,
                            const VerificationProblem& problem, const VerificationParams& params = {},
                            const Progress& progress = {});
