@@ -17,6 +17,7 @@
 #include "pipeline/problem_checks.h"
 #include "result/curved_faces.h"
 #include "result/iso_surface_refine.h"
+#include "result/result_check.h"
 #include "simp/controls/overhang_carry.h"
 #include "simp/controls/overhang_filter.h"
 #include "simp/controls/section_grid.h"
@@ -371,12 +372,16 @@ VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecX
 
 /// Under an extrusion (smooth.extrusion): the cut's free points moved onto the level t of the
 /// section field of `density` (#T) that extraction_densities took (simp::snap_to_section_level),
-/// so that the surface is one extruded shape up to its chords.
+/// so that the surface is one extruded shape up to its chords. Where the moves make triangles
+/// cross (a point snapped past its neighbours on a short edge: cross_sweep's studies 7, 13 and 17
+/// did), result::untangle takes them back towards the cut, which crosses nothing.
 void snap_to_extrusion(const TetMesh& mesh, const VecXd& density, double t, const result::SmoothParams& smooth,
                        result::TriSurface& s) {
   if (smooth.extrusion.squaredNorm() == 0) return;
   const simp::SectionField field = simp::fit_section_field(mesh, density, smooth.extrusion, smooth.extrusion_spacing);
+  const MatX3d cut = s.V;
   simp::snap_to_section_level(field, t, s.V, s.lock);
+  result::untangle(s, cut);
 }
 
 }  // namespace

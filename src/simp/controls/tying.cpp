@@ -114,21 +114,6 @@ void cross_section_basis(const Eigen::Vector3d& d, Eigen::Vector3d& u, Eigen::Ve
   v = d.cross(u);
 }
 
-std::vector<std::vector<int>> columns_along(const Eigen::MatrixX3d& centroids, const Eigen::Vector3d& d, double width) {
-  Eigen::Vector3d u, v;
-  cross_section_basis(d, u, v);
-  std::unordered_map<long long, int> column_of;
-  std::vector<std::vector<int>> columns;
-  for (long i = 0; i < centroids.rows(); ++i) {
-    const Eigen::Vector3d p = centroids.row(i).transpose();
-    const long long key = cell_key(std::floor(p.dot(u) / width), std::floor(p.dot(v) / width), 0);
-    const auto [it, added] = column_of.emplace(key, static_cast<int>(columns.size()));
-    if (added) columns.emplace_back();
-    columns[it->second].push_back(static_cast<int>(i));
-  }
-  return columns;
-}
-
 Tying tie_design(const Eigen::MatrixX3d& c, const ControlsParams& params, double tolerance) {
   Classes classes(c.rows());
   const NearestCentroid nearest(c, tolerance);
@@ -176,12 +161,6 @@ Tying tie_design(const Eigen::MatrixX3d& c, const ControlsParams& params, double
                       ": no design element has a copy one pitch further: the pitch is longer than the part along "
                       "the direction; give a shorter pitch or another direction");
     log << what << " (" << pat.count << " x " << pat.pitch << " mm) " << percent(out.matched.back()) << " tied; ";
-  }
-  if (params.extrude) {
-    const Eigen::Vector3d d = unit(params.extrusion, "the extrusion direction");
-    for (const std::vector<int>& column : columns_along(c, d, tolerance))
-      for (int e : column) classes.join(column.front(), e);
-    log << "extrusion; ";
   }
   out.variable_of.assign(c.rows(), -1);
   std::vector<int> variable_of_root(c.rows(), -1);
