@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common/error.h"
@@ -357,30 +358,35 @@ VecXd carried_level(const TetMesh& mesh, const result::BuildDirection& build) {
   return simp::carried_level(mesh, c, simp::mean_edge_length(mesh));
 }
 
+/// Under an extrusion (smooth.extrusion): the section field of `density` (#T) the result is cut
+/// from (simp::fit_section_field); none without one.
+std::optional<simp::SectionField> section_field(const TetMesh& mesh, const VecXd& density,
+                                                const result::SmoothParams& smooth) {
+  if (smooth.extrusion.squaredNorm() == 0) return std::nullopt;
+  return simp::fit_section_field(mesh, density, smooth.extrusion, smooth.extrusion_spacing);
+}
+
 /// The node densities the result is cut from: result::node_densities of `density` (#T) — under an
-/// extrusion (smooth.extrusion) the section field's (simp::section_node_densities), equal along
-/// it — at least `carried` (#V, or empty) so that the design holds the non-design solids'
-/// undersides to their edges.
+/// extrusion the section field's (simp::section_node_densities of `section`, fitted on the same
+/// densities), equal along it — at least `carried` (#V, or empty) so that the design holds the
+/// non-design solids' undersides to their edges.
 VecXd extraction_densities(const TetMesh& mesh, const VecXd& density, const VecXd& carried,
-                           const result::SmoothParams& smooth) {
+                           const std::optional<simp::SectionField>& section) {
   VecXd nd = result::node_densities(mesh, density);
-  if (smooth.extrusion.squaredNorm() > 0)
-    nd = simp::section_node_densities(mesh, density, nd, smooth.extrusion, smooth.extrusion_spacing);
+  if (section) nd = simp::section_node_densities(mesh, *section, nd);
   if (carried.size() == nd.size()) nd = nd.cwiseMax(carried);
   return nd;
 }
 
-/// Under an extrusion (smooth.extrusion): the cut's free points moved onto the level t of the
-/// section field of `density` (#T) that extraction_densities took (simp::snap_to_section_level),
-/// so that the surface is one extruded shape up to its chords. Where the moves make triangles
-/// cross (a point snapped past its neighbours on a short edge: cross_sweep's studies 7, 13 and 17
-/// did), result::untangle takes them back towards the cut, which crosses nothing.
-void snap_to_extrusion(const TetMesh& mesh, const VecXd& density, double t, const result::SmoothParams& smooth,
-                       result::TriSurface& s) {
-  if (smooth.extrusion.squaredNorm() == 0) return;
-  const simp::SectionField field = simp::fit_section_field(mesh, density, smooth.extrusion, smooth.extrusion_spacing);
+/// Under an extrusion: the cut's free points moved onto the level t of the section field the cut
+/// was made from (simp::snap_to_section_level), so that the surface is one extruded shape up to
+/// its chords. Where the moves make triangles cross (a point snapped past its neighbours on a
+/// short edge: cross_sweep's studies 7, 13 and 17 did), result::untangle takes them back towards
+/// the cut, which crosses nothing.
+void snap_to_extrusion(const std::optional<simp::SectionField>& section, double t, result::TriSurface& s) {
+  if (!section) return;
   const MatX3d cut = s.V;
-  simp::snap_to_section_level(field, t, s.V, s.lock);
+  simp::snap_to_section_level(*section, t, s.V, s.lock);
   result::untangle(s, cut);
 }
 
@@ -392,15 +398,18 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
                                   result::HygieneReport* report, VecXd* design, const Progress& progress,
                                   result::DesignSurfaceReport* surface_report, const result::SourceFaces* source) {
   const VecXd carried = carried_level(mesh, smooth.build);
-  const double t = threshold > 0 ? threshold
-                                 : result::threshold_for_volume(
-                                       mesh, extraction_densities(mesh, density, carried, smooth), volume_fraction);
+  const double t = threshold > 0
+                       ? threshold
+                       : result::threshold_for_volume(
+                             mesh, extraction_densities(mesh, density, carried, section_field(mesh, density, smooth)),
+                             volume_fraction);
   if (threshold_used) *threshold_used = t;
   result::HygieneReport found;
   const VecXd cleaned = result::clean_design(mesh, density, t, anchors, hygiene, found);
   for (const std::string& w : found.warnings) progress.warn(w);
   const double margin = smooth.remesh ? smooth.crossing_margin : 0.0;
-  const VecXd nd = extraction_densities(mesh, cleaned, carried, smooth);
+  const std::optional<simp::SectionField> section = section_field(mesh, cleaned, smooth);
+  const VecXd nd = extraction_densities(mesh, cleaned, carried, section);
   result::TriSurface s;
   if (smooth.resolution > 1) {
     const result::RefinedField fine = result::refine_near_level(mesh, nd, t);
@@ -408,7 +417,7 @@ result::TriSurface result_surface(const TetMesh& mesh, const VecXd& density, dou
   } else {
     s = result::extract_iso_surface(mesh, nd, t, margin);
   }
-  snap_to_extrusion(mesh, cleaned, t, smooth, s);
+  snap_to_extrusion(section, t, s);
   const result::FaceProjector onto = source ? result::curved_face_projector(*source, s) : result::FaceProjector();
   result::DesignSurfaceReport finished = result::finish_design_surface(s, smooth, {}, onto);
   if (smooth.build.active()) {

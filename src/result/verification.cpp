@@ -230,13 +230,6 @@ VerificationProblem on_kept_faces(const TetMesh& m, const VerificationProblem& p
   return kept;
 }
 
-/// The centroid of tet t of m.
-Eigen::Vector3d tet_centre(const TetMesh& m, long t) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 4; ++k) c += m.V.row(m.T(t, k)).transpose() / 4;
-  return c;
-}
-
 /// Warns through progress when the result solid's largest von Mises stress (v.as_built) exceeds
 /// problem.stress_limit, naming the load case and the place of the tet that carries it and the
 /// crisp design's largest stress on the FE mesh. SIMP holds the limit on the relaxed stresses of

@@ -24,15 +24,10 @@ SectionGrid::SectionGrid(const Eigen::MatrixX3d& points, const Eigen::Vector3d& 
 Eigen::SparseMatrix<double> SectionGrid::interpolation(const Eigen::MatrixX3d& points) const {
   std::vector<Eigen::Triplet<double>> w;
   w.reserve(4 * points.rows());
-  const Eigen::Vector3d axis[2] = {u_, v_};
   for (long p = 0; p < points.rows(); ++p) {
     int i[2];
     double f[2];
-    for (int a = 0; a < 2; ++a) {
-      const double s = (points.row(p).dot(axis[a]) - lo_[a]) / h_;
-      i[a] = std::clamp(static_cast<int>(std::floor(s)), 0, n_[a] - 2);
-      f[a] = std::clamp(s - i[a], 0.0, 1.0);
-    }
+    locate(points.row(p).transpose(), i, f);
     for (int di = 0; di < 2; ++di)
       for (int dj = 0; dj < 2; ++dj) {
         const double weight = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]);
@@ -58,15 +53,19 @@ std::vector<int> SectionGrid::neighbours(int k) const {
   return out;
 }
 
-double SectionGrid::value(const VecXd& g, const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const {
+void SectionGrid::locate(const Eigen::Vector3d& p, int i[2], double f[2]) const {
   const Eigen::Vector3d axis[2] = {u_, v_};
-  int i[2];
-  double f[2];
   for (int a = 0; a < 2; ++a) {
     const double s = (p.dot(axis[a]) - lo_[a]) / h_;
     i[a] = std::clamp(static_cast<int>(std::floor(s)), 0, n_[a] - 2);
     f[a] = std::clamp(s - i[a], 0.0, 1.0);
   }
+}
+
+double SectionGrid::value(const VecXd& g, const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const {
+  int i[2];
+  double f[2];
+  locate(p, i, f);
   const int k = i[0] * n_[1] + i[1];
   const double g00 = g[k], g10 = g[k + n_[1]], g01 = g[k + 1], g11 = g[k + n_[1] + 1];
   if (gradient) {
@@ -142,10 +141,8 @@ SectionField fit_section_field(const TetMesh& mesh, const VecXd& density, const 
   return out;
 }
 
-VecXd section_node_densities(const TetMesh& mesh, const VecXd& density, const VecXd& base, const Eigen::Vector3d& d,
-                             double h) {
+VecXd section_node_densities(const TetMesh& mesh, const SectionField& field, const VecXd& base) {
   const std::vector<int> nodes = design_nodes(mesh, design_of(mesh));
-  const SectionField field = fit_section_field(mesh, density, d, h);
   const VecXd value = field.grid.interpolation(points_of(mesh, nodes)) * field.g;
   VecXd out = base;
   for (size_t k = 0; k < nodes.size(); ++k) out[nodes[k]] = value[k];

@@ -37,6 +37,9 @@ class SectionGrid {
   double value(const VecXd& g, const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const;
 
  private:
+  /// The cell (i, j) of p's projection, clamped into the grid, and p's place in it (f in [0, 1]²).
+  void locate(const Eigen::Vector3d& p, int i[2], double f[2]) const;
+
   Eigen::Vector3d u_, v_, d_;
   double h_ = 1;
   double lo_[2] = {0, 0};
@@ -55,20 +58,17 @@ struct SectionField {
 /// node no centroid reaches takes its neighbours' mean.
 SectionField fit_section_field(const TetMesh& mesh, const VecXd& density, const Eigen::Vector3d& d, double h);
 
-/// Moves the free points (lock 0) of a surface cut at level t from section_node_densities onto the
+/// Moves the free points (lock 0) of a surface cut at level t from section_node_densities of `field` onto the
 /// level curve of the section field itself: Newton steps in the section plane (each at most a grid
 /// spacing, three at most), so that the cut's points lie on one extruded surface whatever the
 /// tets' orientation (the linear crossings on tet edges wander along d by the interpolation's
 /// error). V: #P by 3 (moved in place); lock: #P.
 void snap_to_section_level(const SectionField& field, double t, MatX3d& V, const VecXi& lock);
 
-/// #V node densities for the result's cut under an extrusion along d (unit): the design tets'
-/// densities fitted on a SectionGrid of spacing h over the design tets' nodes (each grid node the
-/// mean of the densities of the design tets around it, weighted by volume × the bilinear weight of
-/// their centroid's projection; a node no centroid reaches takes its neighbours' mean), then each
-/// node of a design tet the section field at its projection — equal along d. Nodes of non-design
-/// tets only keep base (#V, result::node_densities: 1). mesh: the tagged mesh; density: #T.
-VecXd section_node_densities(const TetMesh& mesh, const VecXd& density, const VecXd& base, const Eigen::Vector3d& d,
-                             double h);
+/// #V node densities for the result's cut under an extrusion: each node of a design tet the
+/// section field (fit_section_field of the design's densities) at its projection — equal along
+/// the direction. Nodes of non-design tets only keep base (#V, result::node_densities: 1).
+/// mesh: the tagged mesh the field was fitted on.
+VecXd section_node_densities(const TetMesh& mesh, const SectionField& field, const VecXd& base);
 
 }  // namespace topopt::simp
