@@ -1,8 +1,9 @@
 // The stress limit as built (issue 22): a small bare cantilever made as light as a stress limit
 // allows, run end to end (job -> result shape -> verification). SIMP holds the limit on the
 // relaxed stresses of its own mesh; the result solid cut and smoothed from its densities can
-// carry more (the cantilever example: 415 MPa as built under 290, BENCHMARKS.md, branch
-// stress25), and the verification must say so rather than report the figure silently.
+// carry more (the cantilever example: 2516 MPa as built under 290 with the neck at its load pad,
+// 415 without it on branch junction24's cut; BENCHMARKS.md, rows22 and stress25), and the
+// verification must say so rather than report the figure silently.
 #include <gtest/gtest.h>
 
 #include <iostream>
